@@ -1,0 +1,19 @@
+#!/bin/sh
+# Installs the Debian 12 packages flexmbd needs, only those that are missing.
+# Run as root (or with sudo available). Idempotent: does nothing when all are present.
+set -eu
+PACKAGES="build-essential cmake libeigen3-dev libsundials-dev libsuitesparse-dev \
+libgtest-dev libbenchmark-dev nlohmann-json3-dev python3-matplotlib"
+missing=""
+for p in $PACKAGES; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "setup: installing$missing"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
+else
+  echo "setup: all packages present"
+fi
