@@ -27,8 +27,12 @@ class TimeLaw {
 
 using TimeLawPtr = std::shared_ptr<const TimeLaw>;
 
-/// f(t) = initial + speed * t.
+// All factories throw InputError if any parameter is not finite (NaN or inf); the
+// message names the parameter.
+
+/// f(t) = value.
 TimeLawPtr makeConstantLaw(double value);
+/// f(t) = initial + speed * t.
 TimeLawPtr makeConstantSpeedLaw(double speed, double initial = 0.0);
 /// f(t) = sum_k c[k] t^k (c[0] + c[1] t + ...). @throws InputError if c is empty.
 TimeLawPtr makePolynomialLaw(std::vector<double> coefficients);
@@ -38,7 +42,8 @@ TimeLawPtr makeHarmonicLaw(double amplitude, double omega, double phase = 0.0,
 /// Smooth spin-up to angular speed w over time T (issue 2):
 ///   theta(t) = (w/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1))  for t < T,
 ///   theta(t) = w (t - T/2)                                        for t >= T;
-/// plus `initial`. Continuous up to the second derivative at t = T.
+/// plus `initial`. Continuous up to the second derivative at t = T. For t <= 0 the
+/// law holds `initial` (theta, theta', theta'' all vanish at t = 0, so it stays C2).
 /// @throws InputError if T <= 0.
 TimeLawPtr makeSpinUpLaw(double speed, double rampTime, double initial = 0.0);
 /// Natural cubic spline through (times[i], values[i]); times strictly increasing,

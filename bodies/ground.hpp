@@ -1,0 +1,38 @@
+// The ground: a body without coordinates; its points are fixed in the world frame.
+#pragma once
+
+#include "core/body.hpp"
+
+namespace flexmbd {
+
+class Ground final : public Body {
+ public:
+  Ground() : Body("ground") {}
+  int numCoordinates() const override { return 0; }
+  std::vector<std::string> coordinateNames() const override { return {}; }
+  VecX initialCoordinates() const override { return VecX(0); }
+  VecX initialVelocities() const override { return VecX(0); }
+  double mass() const override { return 0.0; }
+  MatX massMatrix(const ConstVecRef&) const override { return MatX(0, 0); }
+  void addMassMatrixDerivative(const ConstVecRef&, const ConstVecRef&, MatX&) const override {}
+  void addInternalForces(const ConstVecRef&, const ConstVecRef&, VecX&) const override {}
+  void addInternalForceJacobians(const ConstVecRef&, const ConstVecRef&, MatX&,
+                                 MatX&) const override {}
+  void addGravityForce(const ConstVecRef&, const Vec2&, VecX&) const override {}
+  void addGravityJacobian(const ConstVecRef&, const Vec2&, MatX&) const override {}
+  double gravityPotential(const ConstVecRef&, const Vec2&) const override { return 0.0; }
+  PointKinematics pointKinematics(const ConstVecRef&, const Vec2& point) const override {
+    PointKinematics p;
+    p.r = point;
+    p.phi = 0.0;
+    p.Jr.resize(2, 0);
+    p.Jphi.resize(0);
+    p.Hrx.resize(0, 0);
+    p.Hry.resize(0, 0);
+    p.Hphi.resize(0, 0);
+    return p;
+  }
+  Vec2 centreOfMass(const ConstVecRef&) const override { return Vec2::Zero(); }
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,101 @@
+#include "bodies/rigid_body_2d.hpp"
+
+#include "core/errors.hpp"
+
+namespace flexmbd {
+
+RigidBody2d::RigidBody2d(std::string name, const RigidBodyProperties& props,
+                         const FrameState2d& initial)
+    : Body(std::move(name)), props_(props), initial_(initial) {
+  const std::string who = "body '" + this->name() + "'";
+  requirePositive(props.mass, who + ": mass");
+  requirePositive(props.inertia, who + ": inertia");
+  requireFinite(props.com.x(), who + ": com[0]");
+  requireFinite(props.com.y(), who + ": com[1]");
+  requireFinite(initial.position.x(), who + ": position[0]");
+  requireFinite(initial.position.y(), who + ": position[1]");
+  requireFinite(initial.angle, who + ": angle");
+  requireFinite(initial.velocity.x(), who + ": velocity[0]");
+  requireFinite(initial.velocity.y(), who + ": velocity[1]");
+  requireFinite(initial.angularVelocity, who + ": angular_velocity");
+}
+
+VecX RigidBody2d::initialCoordinates() const {
+  return Eigen::Vector3d(initial_.position.x(), initial_.position.y(), initial_.angle);
+}
+
+VecX RigidBody2d::initialVelocities() const {
+  return Eigen::Vector3d(initial_.velocity.x(), initial_.velocity.y(), initial_.angularVelocity);
+}
+
+MatX RigidBody2d::massMatrix(const ConstVecRef& q) const {
+  const double m = props_.mass;
+  const Vec2 sac = perp(rotation(q[2]) * props_.com);  // S A c = dA/dtheta c
+  MatX M(3, 3);
+  M << m, 0.0, m * sac.x(),                           //
+      0.0, m, m * sac.y(),                            //
+      m * sac.x(), m * sac.y(), props_.inertia + m * props_.com.squaredNorm();
+  return M;
+}
+
+void RigidBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
+                                          MatX& K) const {
+  // d(S A c)/dtheta = S S A c = -A c
+  const double m = props_.mass;
+  const Vec2 ac = rotation(q[2]) * props_.com;
+  K(0, 2) += -m * ac.x() * a[2];
+  K(1, 2) += -m * ac.y() * a[2];
+  K(2, 2) += -m * ac.dot(a.head<2>());
+}
+
+void RigidBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const {
+  // Quadratic velocity vector: Q_R = m A c thetadot^2, Q_theta = 0 (Lagrange's equations
+  // of T = 1/2 m |Rdot + S A c thetadot|^2 + 1/2 J thetadot^2).
+  const Vec2 ac = rotation(q[2]) * props_.com;
+  Q.head<2>() += props_.mass * ac * v[2] * v[2];
+}
+
+void RigidBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v,
+                                            MatX& dQdq, MatX& dQdv) const {
+  const Vec2 ac = rotation(q[2]) * props_.com;
+  const double m = props_.mass;
+  dQdq.block<2, 1>(0, 2) += m * perp(ac) * v[2] * v[2];
+  dQdv.block<2, 1>(0, 2) += 2.0 * m * ac * v[2];
+}
+
+void RigidBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const {
+  const double m = props_.mass;
+  Q.head<2>() += m * g;
+  Q[2] += m * perp(rotation(q[2]) * props_.com).dot(g);
+}
+
+void RigidBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const {
+  K(2, 2) += -props_.mass * (rotation(q[2]) * props_.com).dot(g);
+}
+
+double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
+  return -props_.mass * g.dot(centreOfMass(q));
+}
+
+PointKinematics RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point) const {
+  // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta.
+  const Vec2 au = rotation(q[2]) * point;
+  PointKinematics p;
+  p.r = q.head<2>() + au;
+  p.phi = q[2];
+  p.Jr.resize(2, 3);
+  p.Jr << 1.0, 0.0, -au.y(), 0.0, 1.0, au.x();
+  p.Jphi = Eigen::RowVector3d(0.0, 0.0, 1.0);
+  p.Hrx = MatX::Zero(3, 3);
+  p.Hry = MatX::Zero(3, 3);
+  p.Hrx(2, 2) = -au.x();
+  p.Hry(2, 2) = -au.y();
+  p.Hphi = MatX::Zero(3, 3);
+  return p;
+}
+
+Vec2 RigidBody2d::centreOfMass(const ConstVecRef& q) const {
+  return q.head<2>() + rotation(q[2]) * props_.com;
+}
+
+}  // namespace flexmbd

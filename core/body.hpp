@@ -1,0 +1,82 @@
+// The interface every body implements: its coordinates, mass matrix, forces and the
+// kinematics of its material points (what joints and forces attach to).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace flexmbd {
+
+/// Position and material angle of one point of a body, with first and second
+/// derivatives with respect to the body's n coordinates q.
+/// Joints and forces are written once in terms of this, whatever the body type.
+struct PointKinematics {
+  Vec2 r = Vec2::Zero();  ///< world position of the point
+  double phi = 0.0;       ///< world angle of the material cross-section at the point
+  Mat2X Jr;               ///< dr/dq, 2 x n
+  RowVecX Jphi;           ///< dphi/dq, 1 x n
+  MatX Hrx, Hry;          ///< d2 r_x/dq2, d2 r_y/dq2, n x n
+  MatX Hphi;              ///< d2 phi/dq2, n x n
+  /// sum_k w_k d2 r_k/dq2 (n x n).
+  MatX hessianR(const Vec2& w) const { return w.x() * Hrx + w.y() * Hry; }
+};
+
+/// A body contributes to the equations of motion  M(q) v' = Q(t, q, v) + ...
+/// All methods are const and pure: a body holds only constant data.
+class Body {
+ public:
+  explicit Body(std::string name) : name_(std::move(name)) {}
+  virtual ~Body() = default;
+  Body(const Body&) = delete;
+  Body& operator=(const Body&) = delete;
+
+  const std::string& name() const { return name_; }
+
+  /// Number of generalised coordinates n (velocities have the same size).
+  virtual int numCoordinates() const = 0;
+  /// Names of the coordinates, as they appear in results files ("x", "y", "theta").
+  virtual std::vector<std::string> coordinateNames() const = 0;
+  /// Coordinates and velocities given at construction (initial guess).
+  virtual VecX initialCoordinates() const = 0;
+  virtual VecX initialVelocities() const = 0;
+
+  /// Total mass (for checks and the Newton-Euler balance).
+  virtual double mass() const = 0;
+  /// Mass matrix M(q), n x n, symmetric positive definite.
+  virtual MatX massMatrix(const ConstVecRef& q) const = 0;
+  /// K += d(M(q) a)/dq for a fixed vector a (n x n).
+  virtual void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
+                                       MatX& K) const = 0;
+  /// Q += internal generalised forces: quadratic velocity forces (and, for flexible
+  /// bodies, elastic and damping forces).
+  virtual void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const = 0;
+  /// dQdq += d(internal forces)/dq, dQdv += d(internal forces)/dv.
+  virtual void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v,
+                                         MatX& dQdq, MatX& dQdv) const = 0;
+  /// Q += generalised gravity force for the acceleration of gravity g.
+  virtual void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const = 0;
+  /// K += d(gravity force)/dq.
+  virtual void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const = 0;
+  /// Potential energy of gravity (zero at the world origin) and internal (elastic) energy.
+  virtual double gravityPotential(const ConstVecRef& q, const Vec2& g) const = 0;
+  virtual double internalPotential(const ConstVecRef& q) const { (void)q; return 0.0; }
+  /// True if internal forces dissipate energy (damping).
+  virtual bool isDissipative() const { return false; }
+
+  /// Kinematics of the material point with body-frame coordinates `point`.
+  /// @throws InputError if the body has no material point there.
+  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point) const = 0;
+  /// Checks at model build time that `point` is a valid attachment point.
+  virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
+    (void)point; (void)user;
+  }
+  /// World position of the centre of mass.
+  virtual Vec2 centreOfMass(const ConstVecRef& q) const = 0;
+
+ private:
+  std::string name_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,68 @@
+// The interface of constraints: joints (scleronomic) and drivers (rheonomic).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/body.hpp"
+#include "core/types.hpp"
+
+namespace flexmbd {
+
+/// A body together with its current coordinates (a view, nothing is copied).
+struct BodyState {
+  BodyState(const Body& b, const double* data) : body(b), q(data, b.numCoordinates()) {}
+  const Body& body;
+  Eigen::Map<const VecX> q;
+};
+
+/// Constraint equations g(q, t) = h(q) - f(t) = 0 over the local coordinates
+/// q_local = [q_body0; q_body1; ...] of the constraint's bodies.
+struct ConstraintEvaluation {
+  VecX h;               ///< h(q), m
+  MatX G;               ///< dh/dq, m x n_local
+  std::vector<MatX> H;  ///< d2 h_a/dq2, m matrices n_local x n_local (only when asked)
+};
+
+class Constraint {
+ public:
+  Constraint(std::string name, std::vector<BodyIndex> bodies)
+      : name_(std::move(name)), bodies_(std::move(bodies)) {}
+  virtual ~Constraint() = default;
+  Constraint(const Constraint&) = delete;
+  Constraint& operator=(const Constraint&) = delete;
+
+  const std::string& name() const { return name_; }
+  /// The bodies whose coordinates enter h (ground included where it takes part).
+  const std::vector<BodyIndex>& bodies() const { return bodies_; }
+
+  virtual int numEquations() const = 0;
+  /// "revolute", "prismatic", "fixed", "body_coordinate", "joint_angle", ...
+  virtual std::string typeName() const = 0;
+  /// Drivers prescribe motion (do work); joints do not.
+  virtual bool isDriver() const { return false; }
+
+  /// h, G and, if withHessians, the Hessians of each equation.
+  virtual void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
+                        ConstraintEvaluation& out) const = 0;
+  /// Prescribed part f(t) and its exact derivatives (zero for joints).
+  virtual void timeFunction(double t, VecX& f, VecX& df, VecX& ddf) const {
+    (void)t;
+    f.setZero(numEquations());
+    df.setZero(numEquations());
+    ddf.setZero(numEquations());
+  }
+
+  /// Names of the reaction outputs ("fx", "fy", "m" for joints, "effort" for drivers).
+  virtual std::vector<std::string> reactionNames() const = 0;
+  /// Reaction outputs from the multipliers lambda (m): for joints the force (world
+  /// axes) and moment exerted on the last body at its joint point; for drivers the
+  /// generalised force applied along the driven quantity.
+  virtual VecX reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const = 0;
+
+ private:
+  std::string name_;
+  std::vector<BodyIndex> bodies_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,64 @@
+// The DAE F(t, y, y') = 0 that the integrator sees, its residual and its Jacobian
+// dF/dy + cj dF/dy', assembled from the components of a finalized System.
+#pragma once
+
+#include <string>
+
+#include "core/sparse_pattern.hpp"
+#include "core/system.hpp"
+
+namespace flexmbd {
+
+/// How the constrained equations of motion are posed (see docs/formulations.md).
+enum class Formulation {
+  Ggl,     ///< stabilised index 2 (Gear-Gupta-Leimkuhler): y = [q, v, lambda, mu]
+  Index3,  ///< position constraints: y = [q, v, lambda]
+  Index1,  ///< acceleration constraints: y = [q, v, lambda]; drift not corrected
+};
+std::string toString(Formulation f);
+/// "ggl", "index3", "index1". @throws InputError otherwise.
+Formulation parseFormulation(const std::string& name);
+
+/// Where each class of unknowns starts in y (and each class of equations in F).
+struct DaeLayout {
+  int nq = 0;       ///< coordinates (= velocities)
+  int m = 0;        ///< constraint equations
+  int q = 0;        ///< offset of positions
+  int v = 0;        ///< offset of velocities
+  int lambda = 0;   ///< offset of multipliers
+  int mu = -1;      ///< offset of stabilising multipliers (GGL only)
+  int size = 0;
+};
+
+/// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985):
+///   F_q  = q' - v + G^T mu,  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),  F_gv = G v + g_t.
+/// Index 3 drops mu and F_gv; index 1 replaces F_g by G v' + (G v)_q v + g_tt.
+class DaeSystem {
+ public:
+  /// @throws InputError if the system is not finalized.
+  DaeSystem(const System& sys, Formulation formulation);
+
+  const System& system() const { return sys_; }
+  Formulation formulation() const { return formulation_; }
+  const DaeLayout& layout() const { return layout_; }
+  /// Pattern of dF/dy + cj dF/dy', fixed for the whole run.
+  const SparsePattern& pattern() const { return pattern_; }
+  /// 1 for differential, 0 for variables excluded from the error test (multipliers;
+  /// for index 3 also the velocities, which are index-2 variables there).
+  VecX differentialIds() const;
+
+  void residual(double t, const double* y, const double* yp, double* F) const;
+  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const;
+
+  /// y and y' from positions, velocities, accelerations and multipliers (mu = 0).
+  void packState(const VecX& q, const VecX& v, const VecX& a, const VecX& lambda, VecX& y,
+                 VecX& yp) const;
+
+ private:
+  const System& sys_;
+  Formulation formulation_;
+  DaeLayout layout_;
+  SparsePattern pattern_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,42 @@
+// The interface of force elements (springs, dampers, applied loads).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/constraint.hpp"
+
+namespace flexmbd {
+
+/// A force element adds generalised forces Q(t, q, v) over the local coordinates of
+/// its bodies, q_local = [q_body0; q_body1; ...].
+class Force {
+ public:
+  Force(std::string name, std::vector<BodyIndex> bodies)
+      : name_(std::move(name)), bodies_(std::move(bodies)) {}
+  virtual ~Force() = default;
+  Force(const Force&) = delete;
+  Force& operator=(const Force&) = delete;
+
+  const std::string& name() const { return name_; }
+  const std::vector<BodyIndex>& bodies() const { return bodies_; }
+  virtual std::string typeName() const = 0;
+
+  /// Q += generalised force; if dQdq / dQdv are given, they receive += its derivatives.
+  virtual void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v,
+                        VecX& Q, MatX* dQdq, MatX* dQdv) const = 0;
+  /// Potential energy, for forces deriving from one (springs).
+  virtual double potentialEnergy(const std::vector<BodyState>& bodies) const {
+    (void)bodies;
+    return 0.0;
+  }
+  /// True if the force is the negative gradient of potentialEnergy (no damping, no
+  /// prescribed loads): then the total energy of an undriven model is conserved.
+  virtual bool isConservative() const = 0;
+
+ private:
+  std::string name_;
+  std::vector<BodyIndex> bodies_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,73 @@
+// Compressed-sparse-column pattern of the DAE Jacobian, built once after finalize,
+// and the sink the assembly writes entries into (dense or sparse storage).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace flexmbd {
+
+/// Square CSC pattern: column c holds rows rowIndex[colStart[c] .. colStart[c+1]).
+class SparsePattern {
+ public:
+  SparsePattern() = default;
+  /// From (row, col) pairs; duplicates are merged.
+  SparsePattern(int n, std::vector<std::pair<int, int>> entries);
+  int size() const { return n_; }
+  int64_t nonZeros() const { return static_cast<int64_t>(rowIndex_.size()); }
+  const std::vector<int64_t>& colStart() const { return colStart_; }
+  const std::vector<int64_t>& rowIndex() const { return rowIndex_; }
+  /// Position of (row, col) in the value array, or -1 if it is not in the pattern.
+  int64_t find(int row, int col) const {
+    const auto b = rowIndex_.begin() + colStart_[col], e = rowIndex_.begin() + colStart_[col + 1];
+    const auto it = std::lower_bound(b, e, static_cast<int64_t>(row));
+    return (it != e && *it == row) ? static_cast<int64_t>(it - rowIndex_.begin()) : -1;
+  }
+
+ private:
+  int n_ = 0;
+  std::vector<int64_t> colStart_, rowIndex_;
+};
+
+/// Where Jacobian entries go: accumulated into a column-major dense array (leading
+/// dimension n), or into the value array of a SparsePattern.
+class JacobianSink {
+ public:
+  static JacobianSink dense(double* data, int n) { return JacobianSink(data, n, nullptr); }
+  static JacobianSink sparse(double* values, const SparsePattern& p) {
+    return JacobianSink(values, p.size(), &p);
+  }
+  /// Records the positions written (to build the pattern); values are ignored.
+  static JacobianSink recorder(std::vector<std::pair<int, int>>* entries) {
+    JacobianSink s(nullptr, 0, nullptr);
+    s.entries_ = entries;
+    return s;
+  }
+  /// J(row, col) += value. @throws std::logic_error if (row, col) is outside a sparse
+  /// pattern (an assembly bug, never a user error).
+  void add(int row, int col, double value) {
+    if (entries_) {
+      entries_->emplace_back(row, col);
+      return;
+    }
+    if (!pattern_) {
+      data_[static_cast<int64_t>(col) * n_ + row] += value;
+      return;
+    }
+    const int64_t k = pattern_->find(row, col);
+    if (k < 0) throwOutsidePattern(row, col);
+    data_[k] += value;
+  }
+
+ private:
+  JacobianSink(double* d, int n, const SparsePattern* p) : data_(d), n_(n), pattern_(p) {}
+  [[noreturn]] static void throwOutsidePattern(int row, int col);
+  double* data_;
+  int n_;
+  const SparsePattern* pattern_;
+  std::vector<std::pair<int, int>>* entries_ = nullptr;
+};
+
+}  // namespace flexmbd

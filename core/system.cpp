@@ -1,0 +1,269 @@
+#include "core/system.hpp"
+
+#include <set>
+
+#include "bodies/ground.hpp"
+#include "bodies/rigid_body_2d.hpp"
+#include "core/errors.hpp"
+#include "forces/applied_load.hpp"
+#include "forces/rotational_spring_damper.hpp"
+#include "forces/spring_damper.hpp"
+#include "joints/drivers.hpp"
+#include "joints/fixed_joint.hpp"
+#include "joints/prismatic_joint.hpp"
+#include "joints/revolute_joint.hpp"
+
+namespace flexmbd {
+
+System::System() { bodies_.push_back(std::make_unique<Ground>()); }
+System::~System() = default;
+System::System(System&&) noexcept = default;
+System& System::operator=(System&&) noexcept = default;
+
+void System::requireBuildPhase(const std::string& what) const {
+  if (finalized_) {
+    throw InputError("cannot add " + what + ": the system is finalized (add everything before finalize())");
+  }
+}
+
+void System::requireFinalized(const char* what) const {
+  if (!finalized_) throw InputError(std::string(what) + ": call finalize() first");
+}
+
+void System::checkNewName(const std::string& name, const std::string& kind) const {
+  if (name.empty()) throw InputError(kind + ": the name must not be empty");
+  for (const auto& b : bodies_) {
+    if (b->name() == name) throw InputError(kind + " '" + name + "': duplicate name (a body already has it)");
+  }
+  for (const auto& c : constraints_) {
+    if (c->name() == name) {
+      throw InputError(kind + " '" + name + "': duplicate name (" + (c->isDriver() ? "a driver" : "a joint") +
+                       " already has it)");
+    }
+  }
+  for (const auto& f : forces_) {
+    if (f->name() == name) throw InputError(kind + " '" + name + "': duplicate name (a force already has it)");
+  }
+}
+
+void System::checkBody(BodyIndex i, const std::string& user) const {
+  if (i.value < 0 || i.value >= numBodies()) {
+    throw InputError(user + ": body index " + std::to_string(i.value) + " does not exist");
+  }
+}
+
+BodyIndex System::addBody(std::unique_ptr<Body> body) {
+  requireBuildPhase("body");
+  if (!body) throw InputError("addBody: null body");
+  checkNewName(body->name(), "body");
+  bodies_.push_back(std::move(body));
+  return BodyIndex(numBodies() - 1);
+}
+
+ConstraintIndex System::addConstraint(std::unique_ptr<Constraint> c) {
+  requireBuildPhase("constraint");
+  if (!c) throw InputError("addConstraint: null constraint");
+  const std::string kind = c->isDriver() ? "driver" : "joint";
+  checkNewName(c->name(), kind);
+  for (BodyIndex b : c->bodies()) checkBody(b, kind + " '" + c->name() + "'");
+  constraints_.push_back(std::move(c));
+  return ConstraintIndex(numConstraints() - 1);
+}
+
+ForceIndex System::addForce(std::unique_ptr<Force> f) {
+  requireBuildPhase("force");
+  if (!f) throw InputError("addForce: null force");
+  checkNewName(f->name(), "force");
+  for (BodyIndex b : f->bodies()) checkBody(b, "force '" + f->name() + "'");
+  forces_.push_back(std::move(f));
+  return ForceIndex(numForces() - 1);
+}
+
+void System::setGravity(const Vec2& g) {
+  requireBuildPhase("gravity");
+  requireFinite(g.x(), "gravity[0]");
+  requireFinite(g.y(), "gravity[1]");
+  gravity_ = g;
+}
+
+BodyIndex System::addRigidBody(const std::string& name, const RigidBodyProperties& props,
+                               const FrameState2d& initial) {
+  return addBody(std::make_unique<RigidBody2d>(name, props, initial));
+}
+
+double System::initialRelativeAngle(BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
+                                    const Vec2& pointJ) const {
+  const VecX qi = body(bodyI).initialCoordinates();
+  const VecX qj = body(bodyJ).initialCoordinates();
+  return body(bodyJ).pointKinematics(qj, pointJ).phi - body(bodyI).pointKinematics(qi, pointI).phi;
+}
+
+ConstraintIndex System::addRevoluteJoint(const std::string& name, BodyIndex bodyI,
+                                         const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ) {
+  checkBody(bodyI, "joint '" + name + "'");
+  checkBody(bodyJ, "joint '" + name + "'");
+  return addConstraint(std::make_unique<RevoluteJoint>(name, bodyI, pointI, bodyJ, pointJ));
+}
+
+ConstraintIndex System::addPrismaticJoint(const std::string& name, BodyIndex bodyI,
+                                          const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ,
+                                          const Vec2& axis) {
+  checkBody(bodyI, "joint '" + name + "'");
+  checkBody(bodyJ, "joint '" + name + "'");
+  const double phi0 = initialRelativeAngle(bodyI, pointI, bodyJ, pointJ);
+  return addConstraint(
+      std::make_unique<PrismaticJoint>(name, bodyI, pointI, bodyJ, pointJ, axis, phi0));
+}
+
+ConstraintIndex System::addFixedJoint(const std::string& name, BodyIndex bodyI,
+                                      const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ) {
+  checkBody(bodyI, "joint '" + name + "'");
+  checkBody(bodyJ, "joint '" + name + "'");
+  const double phi0 = initialRelativeAngle(bodyI, pointI, bodyJ, pointJ);
+  return addConstraint(std::make_unique<FixedJoint>(name, bodyI, pointI, bodyJ, pointJ, phi0));
+}
+
+ConstraintIndex System::addBodyCoordinateDriver(const std::string& name, BodyIndex b,
+                                                const std::string& coordinate, TimeLawPtr law) {
+  checkBody(b, "driver '" + name + "'");
+  const auto names = body(b).coordinateNames();
+  for (int k = 0; k < static_cast<int>(names.size()); ++k) {
+    if (names[k] == coordinate) {
+      return addConstraint(std::make_unique<BodyCoordinateDriver>(name, b, k, coordinate, std::move(law)));
+    }
+  }
+  std::string known;
+  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+  throw InputError("driver '" + name + "': body '" + body(b).name() + "' has no coordinate '" +
+                   coordinate + "' (it has: " + (known.empty() ? "none" : known) + ")");
+}
+
+ConstraintIndex System::addJointDriver(const std::string& name, ConstraintIndex joint,
+                                       TimeLawPtr law) {
+  if (joint.value < 0 || joint.value >= numConstraints()) {
+    throw InputError("driver '" + name + "': joint index does not exist");
+  }
+  const Constraint& c = constraint(joint);
+  if (const auto* r = dynamic_cast<const RevoluteJoint*>(&c)) {
+    return addConstraint(std::make_unique<JointAngleDriver>(name, r->bodies()[0], r->pointI(),
+                                                            r->bodies()[1], r->pointJ(), std::move(law)));
+  }
+  if (const auto* p = dynamic_cast<const PrismaticJoint*>(&c)) {
+    return addConstraint(std::make_unique<JointDisplacementDriver>(
+        name, p->bodies()[0], p->pointI(), p->bodies()[1], p->pointJ(), p->axis(), std::move(law)));
+  }
+  throw InputError("driver '" + name + "': joint '" + c.name() + "' is a " + c.typeName() +
+                   " joint; expected a revolute (angle) or prismatic (displacement) joint");
+}
+
+ForceIndex System::addSpringDamper(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
+                                   BodyIndex bodyJ, const Vec2& pointJ, double stiffness,
+                                   double damping, double freeLength) {
+  checkBody(bodyI, "force '" + name + "'");
+  checkBody(bodyJ, "force '" + name + "'");
+  return addForce(std::make_unique<SpringDamper>(name, bodyI, pointI, bodyJ, pointJ, stiffness,
+                                                 damping, freeLength));
+}
+
+ForceIndex System::addRotationalSpringDamper(const std::string& name, ConstraintIndex joint,
+                                             double stiffness, double damping, double freeAngle) {
+  if (joint.value < 0 || joint.value >= numConstraints()) {
+    throw InputError("force '" + name + "': joint index does not exist");
+  }
+  const auto* r = dynamic_cast<const RevoluteJoint*>(&constraint(joint));
+  if (!r) {
+    throw InputError("force '" + name + "': joint '" + constraint(joint).name() +
+                     "' is not a revolute joint; a rotational spring-damper needs one");
+  }
+  return addForce(std::make_unique<RotationalSpringDamper>(name, r->bodies()[0], r->pointI(),
+                                                           r->bodies()[1], r->pointJ(), stiffness,
+                                                           damping, freeAngle));
+}
+
+ForceIndex System::addAppliedLoad(const std::string& name, BodyIndex b, const Vec2& point,
+                                  TimeLawPtr forceX, TimeLawPtr forceY, TimeLawPtr torque) {
+  checkBody(b, "force '" + name + "'");
+  return addForce(std::make_unique<AppliedLoad>(name, b, point, std::move(forceX),
+                                                std::move(forceY), std::move(torque)));
+}
+
+BodyIndex System::findBody(const std::string& name) const {
+  for (int i = 0; i < numBodies(); ++i) {
+    if (bodies_[i]->name() == name) return BodyIndex(i);
+  }
+  std::string known;
+  for (const auto& b : bodies_) known += (known.empty() ? "" : ", ") + b->name();
+  throw InputError("unknown body '" + name + "' (known bodies: " + known + ")");
+}
+
+ConstraintIndex System::findConstraint(const std::string& name) const {
+  for (int i = 0; i < numConstraints(); ++i) {
+    if (constraints_[i]->name() == name) return ConstraintIndex(i);
+  }
+  std::string known;
+  for (const auto& c : constraints_) known += (known.empty() ? "" : ", ") + c->name();
+  throw InputError("unknown joint '" + name + "' (known joints: " + (known.empty() ? "none" : known) + ")");
+}
+
+void System::finalize() {
+  requireBuildPhase("finalize twice");
+  bodyOffset_.clear();
+  nq_ = 0;
+  for (const auto& b : bodies_) {
+    bodyOffset_.push_back(nq_);
+    nq_ += b->numCoordinates();
+  }
+  auto columns = [&](const std::vector<BodyIndex>& bs) {
+    std::vector<int> cols;
+    for (BodyIndex b : bs) {
+      for (int k = 0; k < body(b).numCoordinates(); ++k) cols.push_back(bodyOffset_[b.value] + k);
+    }
+    return cols;
+  };
+  m_ = 0;
+  constraintOffset_.clear();
+  constraintCols_.clear();
+  for (const auto& c : constraints_) {
+    constraintOffset_.push_back(m_);
+    m_ += c->numEquations();
+    constraintCols_.push_back(columns(c->bodies()));
+  }
+  forceCols_.clear();
+  for (const auto& f : forces_) forceCols_.push_back(columns(f->bodies()));
+  finalized_ = true;
+}
+
+VecX System::initialCoordinates() const {
+  requireFinalized("initialCoordinates");
+  VecX q(nq_);
+  for (int i = 0; i < numBodies(); ++i) {
+    q.segment(bodyOffset_[i], bodies_[i]->numCoordinates()) = bodies_[i]->initialCoordinates();
+  }
+  return q;
+}
+
+VecX System::initialVelocities() const {
+  requireFinalized("initialVelocities");
+  VecX v(nq_);
+  for (int i = 0; i < numBodies(); ++i) {
+    v.segment(bodyOffset_[i], bodies_[i]->numCoordinates()) = bodies_[i]->initialVelocities();
+  }
+  return v;
+}
+
+std::vector<BodyState> System::bodyStates(const std::vector<BodyIndex>& bs, const double* q) const {
+  std::vector<BodyState> out;
+  out.reserve(bs.size());
+  for (BodyIndex b : bs) out.emplace_back(body(b), q + bodyOffset_[b.value]);
+  return out;
+}
+
+std::vector<std::string> System::coordinateNames() const {
+  std::vector<std::string> names;
+  for (const auto& b : bodies_) {
+    for (const auto& c : b->coordinateNames()) names.push_back(b->name() + "." + c);
+  }
+  return names;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,110 @@
+// The multibody system model: bodies, constraints (joints and drivers) and forces are
+// added, then finalize() freezes the model and builds the index maps.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/body.hpp"
+#include "core/constraint.hpp"
+#include "core/force.hpp"
+#include "core/time_law.hpp"
+
+namespace flexmbd {
+
+struct RigidBodyProperties;
+struct FrameState2d;
+
+/// A planar multibody system. Build phase: add*; then finalize(); afterwards the model
+/// is immutable and add* throws InputError. Body 0 is the ground ("ground").
+class System {
+ public:
+  System();
+  ~System();
+  System(System&&) noexcept;
+  System& operator=(System&&) noexcept;
+
+  // ----- build phase -------------------------------------------------------------
+  BodyIndex addBody(std::unique_ptr<Body> body);
+  ConstraintIndex addConstraint(std::unique_ptr<Constraint> constraint);
+  ForceIndex addForce(std::unique_ptr<Force> force);
+  /// Acceleration of gravity (world axes), default zero.
+  void setGravity(const Vec2& g);
+
+  // Convenience builders (the C++ API most users need).
+  BodyIndex addRigidBody(const std::string& name, const RigidBodyProperties& props,
+                         const FrameState2d& initial);
+  ConstraintIndex addRevoluteJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
+                                   BodyIndex bodyJ, const Vec2& pointJ);
+  /// The relative rotation is locked at its value in the initial positions.
+  ConstraintIndex addPrismaticJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
+                                    BodyIndex bodyJ, const Vec2& pointJ, const Vec2& axis);
+  /// The relative rotation is locked at its value in the initial positions.
+  ConstraintIndex addFixedJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
+                                BodyIndex bodyJ, const Vec2& pointJ);
+  /// Prescribes coordinate `coordinate` ("x", "y", "theta", ...) of a body.
+  ConstraintIndex addBodyCoordinateDriver(const std::string& name, BodyIndex body,
+                                          const std::string& coordinate, TimeLawPtr law);
+  /// Prescribes a revolute joint's relative angle or a prismatic joint's displacement.
+  ConstraintIndex addJointDriver(const std::string& name, ConstraintIndex joint, TimeLawPtr law);
+  ForceIndex addSpringDamper(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
+                             BodyIndex bodyJ, const Vec2& pointJ, double stiffness,
+                             double damping, double freeLength);
+  /// Acts on a revolute joint's relative angle; freeAngle: angle of zero torque.
+  ForceIndex addRotationalSpringDamper(const std::string& name, ConstraintIndex revoluteJoint,
+                                       double stiffness, double damping, double freeAngle);
+  ForceIndex addAppliedLoad(const std::string& name, BodyIndex body, const Vec2& point,
+                            TimeLawPtr forceX, TimeLawPtr forceY, TimeLawPtr torque);
+
+  /// Freezes the model: index maps, checks of attachment points and names.
+  void finalize();
+  bool isFinalized() const { return finalized_; }
+
+  // ----- queries (any time) ------------------------------------------------------
+  int numBodies() const { return static_cast<int>(bodies_.size()); }
+  int numConstraints() const { return static_cast<int>(constraints_.size()); }
+  int numForces() const { return static_cast<int>(forces_.size()); }
+  const Body& body(BodyIndex i) const { return *bodies_.at(i.value); }
+  const Constraint& constraint(ConstraintIndex i) const { return *constraints_.at(i.value); }
+  const Force& force(ForceIndex i) const { return *forces_.at(i.value); }
+  const Vec2& gravity() const { return gravity_; }
+  /// @throws InputError listing the known bodies if there is none of that name.
+  BodyIndex findBody(const std::string& name) const;
+  ConstraintIndex findConstraint(const std::string& name) const;
+
+  // ----- after finalize ----------------------------------------------------------
+  int numCoordinates() const { return nq_; }
+  int numConstraintEquations() const { return m_; }
+  int coordinateOffset(BodyIndex i) const { return bodyOffset_.at(i.value); }
+  int constraintOffset(ConstraintIndex i) const { return constraintOffset_.at(i.value); }
+  /// Global coordinate index of each local coordinate of a constraint / force.
+  const std::vector<int>& constraintColumns(ConstraintIndex i) const { return constraintCols_.at(i.value); }
+  const std::vector<int>& forceColumns(ForceIndex i) const { return forceCols_.at(i.value); }
+  /// Coordinates and velocities given at construction, stacked (nq).
+  VecX initialCoordinates() const;
+  VecX initialVelocities() const;
+  /// Views of the given bodies at the global coordinates q (size nq).
+  std::vector<BodyState> bodyStates(const std::vector<BodyIndex>& bodies, const double* q) const;
+  /// "crank.x", ... for every coordinate, in order.
+  std::vector<std::string> coordinateNames() const;
+
+ private:
+  void requireBuildPhase(const std::string& what) const;
+  void requireFinalized(const char* what) const;
+  void checkNewName(const std::string& name, const std::string& kind) const;
+  void checkBody(BodyIndex i, const std::string& user) const;
+  double initialRelativeAngle(BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
+                              const Vec2& pointJ) const;
+
+  std::vector<std::unique_ptr<Body>> bodies_;
+  std::vector<std::unique_ptr<Constraint>> constraints_;
+  std::vector<std::unique_ptr<Force>> forces_;
+  Vec2 gravity_ = Vec2::Zero();
+  bool finalized_ = false;
+  int nq_ = 0, m_ = 0;
+  std::vector<int> bodyOffset_, constraintOffset_;
+  std::vector<std::vector<int>> constraintCols_, forceCols_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,156 @@
+#include "core/system_evaluation.hpp"
+
+namespace flexmbd {
+namespace {
+
+VecX gather(const std::vector<int>& cols, const VecX& x) {
+  VecX out(cols.size());
+  for (size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
+  return out;
+}
+
+}  // namespace
+
+void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, MatX* G) {
+  const int m = sys.numConstraintEquations();
+  if (g) g->setZero(m);
+  if (G) G->setZero(m, sys.numCoordinates());
+  ConstraintEvaluation ev;
+  VecX f, df, ddf;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
+    con.timeFunction(t, f, df, ddf);
+    const int row = sys.constraintOffset(ci);
+    const int me = con.numEquations();
+    if (g) g->segment(row, me) = ev.h - f;
+    if (G) {
+      const auto& cols = sys.constraintColumns(ci);
+      for (size_t k = 0; k < cols.size(); ++k) G->block(row, cols[k], me, 1) += ev.G.col(k);
+    }
+  }
+}
+
+VecX velocityConstraintResidual(const System& sys, const VecX& q, const VecX& v, double t) {
+  VecX out(sys.numConstraintEquations());
+  ConstraintEvaluation ev;
+  VecX f, df, ddf;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
+    con.timeFunction(t, f, df, ddf);
+    out.segment(sys.constraintOffset(ci), con.numEquations()) =
+        ev.G * gather(sys.constraintColumns(ci), v) - df;
+  }
+  return out;
+}
+
+VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, double t) {
+  VecX out(sys.numConstraintEquations());
+  ConstraintEvaluation ev;
+  VecX f, df, ddf;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    con.evaluate(sys.bodyStates(con.bodies(), q.data()), true, ev);
+    con.timeFunction(t, f, df, ddf);
+    const VecX vl = gather(sys.constraintColumns(ci), v);
+    const int row = sys.constraintOffset(ci);
+    for (int a = 0; a < con.numEquations(); ++a) out[row + a] = ddf[a] - vl.dot(ev.H[a] * vl);
+  }
+  return out;
+}
+
+MatX massMatrix(const System& sys, const VecX& q) {
+  const int n = sys.numCoordinates();
+  MatX M = MatX::Zero(n, n);
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int nb = body.numCoordinates();
+    if (nb == 0) continue;
+    const int off = sys.coordinateOffset(BodyIndex(b));
+    M.block(off, off, nb, nb) = body.massMatrix(q.segment(off, nb));
+  }
+  return M;
+}
+
+VecX generalizedForces(const System& sys, double t, const VecX& q, const VecX& v) {
+  VecX Q = VecX::Zero(sys.numCoordinates());
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int nb = body.numCoordinates();
+    if (nb == 0) continue;
+    const int off = sys.coordinateOffset(BodyIndex(b));
+    VecX Qb = VecX::Zero(nb);
+    body.addInternalForces(q.segment(off, nb), v.segment(off, nb), Qb);
+    body.addGravityForce(q.segment(off, nb), sys.gravity(), Qb);
+    Q.segment(off, nb) += Qb;
+  }
+  for (int f = 0; f < sys.numForces(); ++f) {
+    const ForceIndex fi(f);
+    const Force& force = sys.force(fi);
+    const auto& cols = sys.forceColumns(fi);
+    VecX Ql = VecX::Zero(cols.size());
+    force.addForce(t, sys.bodyStates(force.bodies(), q.data()), gather(cols, v), Ql, nullptr, nullptr);
+    for (size_t k = 0; k < cols.size(); ++k) Q[cols[k]] += Ql[k];
+  }
+  return Q;
+}
+
+double kineticEnergy(const System& sys, const VecX& q, const VecX& v) {
+  return 0.5 * v.dot(massMatrix(sys, q) * v);
+}
+
+double potentialEnergy(const System& sys, const VecX& q) {
+  double V = 0.0;
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int nb = body.numCoordinates();
+    if (nb == 0) continue;
+    const auto qb = q.segment(sys.coordinateOffset(BodyIndex(b)), nb);
+    V += body.gravityPotential(qb, sys.gravity()) + body.internalPotential(qb);
+  }
+  for (int f = 0; f < sys.numForces(); ++f) {
+    const Force& force = sys.force(ForceIndex(f));
+    V += force.potentialEnergy(sys.bodyStates(force.bodies(), q.data()));
+  }
+  return V;
+}
+
+bool isConservative(const System& sys) {
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    if (sys.constraint(ConstraintIndex(c)).isDriver()) return false;
+  }
+  for (int f = 0; f < sys.numForces(); ++f) {
+    if (!sys.force(ForceIndex(f)).isConservative()) return false;
+  }
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    if (sys.body(BodyIndex(b)).isDissipative()) return false;
+  }
+  return true;
+}
+
+VecX reactionOutputs(const System& sys, const VecX& q, const VecX& lambda) {
+  std::vector<double> out;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    const VecX r = con.reactions(sys.bodyStates(con.bodies(), q.data()),
+                                 lambda.segment(sys.constraintOffset(ci), con.numEquations()));
+    out.insert(out.end(), r.data(), r.data() + r.size());
+  }
+  return Eigen::Map<VecX>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
+std::vector<std::string> reactionOutputNames(const System& sys) {
+  std::vector<std::string> names;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const Constraint& con = sys.constraint(ConstraintIndex(c));
+    for (const auto& r : con.reactionNames()) names.push_back(con.name() + "." + r);
+  }
+  return names;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,24 @@
+// Prescribed force (world components) at a body point and torque on the body.
+#pragma once
+
+#include "core/force.hpp"
+#include "core/time_law.hpp"
+
+namespace flexmbd {
+
+/// Q = Jr^T F(t) + Jphi^T tau(t) at the given body point; absent laws count as zero.
+class AppliedLoad final : public Force {
+ public:
+  AppliedLoad(std::string name, BodyIndex body, const Vec2& point, TimeLawPtr forceX,
+              TimeLawPtr forceY, TimeLawPtr torque);
+  std::string typeName() const override { return "applied_load"; }
+  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
+                MatX* dQdq, MatX* dQdv) const override;
+  bool isConservative() const override { return false; }
+
+ private:
+  Vec2 point_;
+  TimeLawPtr forceX_, forceY_, torque_;
+};
+
+}  // namespace flexmbd

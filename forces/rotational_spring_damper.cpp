@@ -1,0 +1,45 @@
+#include "forces/rotational_spring_damper.hpp"
+
+#include "core/errors.hpp"
+#include "joints/point_pair.hpp"
+
+namespace flexmbd {
+
+RotationalSpringDamper::RotationalSpringDamper(std::string name, BodyIndex bodyI,
+                                               const Vec2& pointI, BodyIndex bodyJ,
+                                               const Vec2& pointJ, double stiffness,
+                                               double damping, double freeAngle)
+    : Force(std::move(name), {bodyI, bodyJ}),
+      pointI_(pointI),
+      pointJ_(pointJ),
+      stiffness_(stiffness),
+      damping_(damping),
+      freeAngle_(freeAngle) {
+  const std::string who = "force '" + this->name() + "'";
+  requireFinite(stiffness, who + ": stiffness");
+  requireFinite(damping, who + ": damping");
+  requireFinite(freeAngle, who + ": free_angle");
+  if (stiffness < 0.0) throw InputError(who + ": stiffness must be >= 0, got " + std::to_string(stiffness));
+  if (damping < 0.0) throw InputError(who + ": damping must be >= 0, got " + std::to_string(damping));
+}
+
+void RotationalSpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v,
+                                      VecX& Q, MatX* dQdq, MatX* dQdv) const {
+  const PointPair p = makePointPair(b[0].body.pointKinematics(b[0].q, pointI_),
+                                    b[1].body.pointKinematics(b[1].q, pointJ_));
+  const RowVecX J = p.JphiJ - p.JphiI;
+  const MatX H = p.HphiJ - p.HphiI;
+  const double phi = p.phiJ - p.phiI;
+  const double tau = stiffness_ * (phi - freeAngle_) + damping_ * J.dot(v);
+  Q -= tau * J.transpose();
+  if (dQdq) *dQdq -= J.transpose() * (stiffness_ * J + damping_ * v.transpose() * H) + tau * H;
+  if (dQdv) *dQdv -= damping_ * J.transpose() * J;
+}
+
+double RotationalSpringDamper::potentialEnergy(const std::vector<BodyState>& b) const {
+  const double phi = b[1].body.pointKinematics(b[1].q, pointJ_).phi -
+                     b[0].body.pointKinematics(b[0].q, pointI_).phi;
+  return 0.5 * stiffness_ * (phi - freeAngle_) * (phi - freeAngle_);
+}
+
+}  // namespace flexmbd

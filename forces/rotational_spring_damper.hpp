@@ -1,0 +1,26 @@
+// Rotational spring-damper acting in a revolute joint.
+#pragma once
+
+#include "core/force.hpp"
+
+namespace flexmbd {
+
+/// Torque tau = k (phi - phi0) + c phidot on the relative angle phi = phi_j - phi_i of
+/// the joint's two points; Q = -tau dphi/dq^T; potential V = k (phi - phi0)^2 / 2.
+class RotationalSpringDamper final : public Force {
+ public:
+  RotationalSpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
+                         const Vec2& pointJ, double stiffness, double damping,
+                         double freeAngle);
+  std::string typeName() const override { return "rotational_spring_damper"; }
+  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
+                MatX* dQdq, MatX* dQdv) const override;
+  double potentialEnergy(const std::vector<BodyState>& bodies) const override;
+  bool isConservative() const override { return damping_ == 0.0; }
+
+ private:
+  Vec2 pointI_, pointJ_;
+  double stiffness_, damping_, freeAngle_;
+};
+
+}  // namespace flexmbd

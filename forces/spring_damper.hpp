@@ -1,0 +1,28 @@
+// Linear translational spring-damper between two body points.
+#pragma once
+
+#include "core/force.hpp"
+
+namespace flexmbd {
+
+/// Tension f = k (l - l0) + c ldot along e = d/l, d = r_j - r_i; generalised force
+/// Q = -f D^T e (D = dd/dq); potential V = k (l - l0)^2 / 2.
+class SpringDamper final : public Force {
+ public:
+  /// @throws InputError if k < 0, c < 0, l0 < 0 or a value is not finite.
+  SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
+               const Vec2& pointJ, double stiffness, double damping, double freeLength);
+  std::string typeName() const override { return "spring_damper"; }
+  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
+                MatX* dQdq, MatX* dQdv) const override;
+  double potentialEnergy(const std::vector<BodyState>& bodies) const override;
+  bool isConservative() const override { return damping_ == 0.0; }
+  /// Current length (for outputs and tests).
+  double length(const std::vector<BodyState>& bodies) const;
+
+ private:
+  Vec2 pointI_, pointJ_;
+  double stiffness_, damping_, freeLength_;
+};
+
+}  // namespace flexmbd

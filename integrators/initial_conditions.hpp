@@ -1,0 +1,35 @@
+// Consistent initial values for the constrained equations of motion.
+#pragma once
+
+#include "core/system.hpp"
+
+namespace flexmbd {
+
+struct ConsistentState {
+  VecX q, v, a, lambda;
+  int positionIterations = 0;    ///< Newton iterations of the position projection
+  double positionResidual = 0.0; ///< max |g| after projection
+};
+
+/// 1. positions projected onto g(q, t0) = 0 (Newton, minimum-norm corrections),
+/// 2. velocities onto G v = -g_t (closest to v0 in the mass metric),
+/// 3. accelerations and multipliers from [M G^T; G 0][a; lambda] = [Q; -gamma].
+/// @throws ModelError naming the constraints if they are redundant or conflicting
+/// (rank-revealing check in the order they were added), or if the mechanism cannot
+/// be assembled (remaining residual and the joints that carry it).
+ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0,
+                                       const VecX& v0);
+
+/// Indices of the constraint equations that are linearly dependent on earlier ones
+/// (modified Gram-Schmidt on the rows of G, relative tolerance rankTolerance).
+std::vector<int> dependentConstraintRows(const MatX& G, double rankTolerance = 1e-9);
+
+/// Solves [M G^T; G 0][x; y] = [r1; r2]. @throws ModelError if it is singular.
+void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
+
+/// Accelerations and multipliers of the state (q, v) at time t, from the augmented
+/// system [M G^T; G 0][a; lambda] = [Q; f'' - v^T H v] (index-1 equations).
+void computeAccelerations(const System& sys, double t, const VecX& q, const VecX& v, VecX& a,
+                          VecX& lambda);
+
+}  // namespace flexmbd

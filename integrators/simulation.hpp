@@ -1,0 +1,60 @@
+// A whole run: consistent initialisation, time integration with output at a fixed step
+// and exactly at the end time, statistics and constraint drift.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "core/dae_system.hpp"
+#include "integrators/ida_solver.hpp"
+
+namespace flexmbd {
+
+struct SolverSettings {
+  Formulation formulation = Formulation::Ggl;
+  double rtol = 1e-8;
+  double atol = 1e-10;            ///< positions; velocities too unless atolVelocity set
+  std::optional<double> atolVelocity;
+  double tStart = 0.0;
+  double tEnd = 1.0;
+  double outputStep = 0.01;
+  double maxStepSize = 0.0;       ///< 0: no limit
+  long maxSteps = 1000000;        ///< per output interval
+  LinearSolverKind linearSolver = LinearSolverKind::Automatic;
+  bool finiteDifferenceJacobian = false;
+  bool progress = true;           ///< progress on stderr for long runs (if a terminal)
+  /// @throws InputError naming the solver key that is out of range.
+  void validate() const;
+};
+
+/// One output instant: positions, velocities, accelerations, multipliers.
+struct OutputSample {
+  double t = 0.0;
+  VecX q, v, a, lambda;
+};
+
+struct SimulationSummary {
+  bool ok = true;
+  std::string message;
+  double tReached = 0.0;
+  IntegratorStats stats;
+  double cpuSeconds = 0.0;
+  double maxPositionViolation = 0.0;  ///< max over outputs of max |g(q, t)|
+  double maxVelocityViolation = 0.0;  ///< max over outputs of max |G v + g_t|
+  std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
+  bool usedKlu = false;
+  int initialPositionIterations = 0;
+};
+
+/// Called at t0 and at every output time (also the last one reached before a failure).
+using OutputCallback = std::function<void(const OutputSample&)>;
+
+/// Runs the system from its initial values. Input and model errors (including failed
+/// assembly) throw InputError/ModelError before any output; a solver failure mid-run
+/// returns ok = false with the time, step size and IDA's reason in `message`, after
+/// the samples up to the failure were passed to `onOutput`.
+SimulationSummary simulate(const System& sys, const SolverSettings& settings,
+                           const OutputCallback& onOutput);
+
+}  // namespace flexmbd
