@@ -159,6 +159,7 @@ IdaSolver::IdaSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX
   d.check(IDASetSuppressAlg(d.mem, SUNTRUE), "IDASetSuppressAlg");
   d.check(IDASetMaxNumSteps(d.mem, o.maxSteps), "IDASetMaxNumSteps");
   if (o.maxStepSize > 0.0) d.check(IDASetMaxStep(d.mem, o.maxStepSize), "IDASetMaxStep");
+  if (o.minStepSize > 0.0) d.check(IDASetMinStep(d.mem, o.minStepSize), "IDASetMinStep");
 
   LinearSolverKind kind = o.linearSolver;
   if (kind == LinearSolverKind::Automatic) {

@@ -31,6 +31,7 @@ struct IntegratorOptions {
   double atolMultiplier = 1e10;
   long maxSteps = 1000000;        ///< per call of advance()
   double maxStepSize = 0.0;      ///< 0: no limit
+  double minStepSize = 0.0;      ///< IDA fails (IDA_ERR_FAIL/IDA_CONV_FAIL) below this
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;  ///< IDA's own difference quotients (dense only)
 };

@@ -66,6 +66,10 @@ void SolverSettings::validate() const {
                  outputStep);
   requireSetting(maxStepSize >= 0.0 && std::isfinite(maxStepSize), "max_step",
                  "a non-negative number (0: no limit)", maxStepSize);
+  if (minStepSize) {
+    requireSetting(*minStepSize >= 0.0 && std::isfinite(*minStepSize), "min_step",
+                   "a non-negative number", *minStepSize);
+  }
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
 }
 
@@ -118,6 +122,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.atolVelocity = settings.atolVelocity.value_or(settings.atol);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
+  o.minStepSize = settings.minStepSize.value_or(1e-12 * (tEnd - t0));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
   IdaSolver ida(dae, t0, y0, yp0, o);
@@ -136,6 +141,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   } catch (const SolverError& e) {
     summary.ok = false;
     summary.message = e.what();
+    summary.failureTime = e.time();
   }
   summary.stats = ida.stats();
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;

@@ -20,6 +20,9 @@ struct SolverSettings {
   double tEnd = 1.0;
   double outputStep = 0.01;
   double maxStepSize = 0.0;       ///< 0: no limit
+  /// Smallest step IDA may take before it reports failure (a lock-up or a singularity
+  /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start).
+  std::optional<double> minStepSize;
   long maxSteps = 1000000;        ///< per output interval
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;
@@ -37,7 +40,8 @@ struct OutputSample {
 struct SimulationSummary {
   bool ok = true;
   std::string message;
-  double tReached = 0.0;
+  double tReached = 0.0;           ///< time of the last output passed to onOutput
+  double failureTime = 0.0;        ///< where IDA stopped, if !ok
   IntegratorStats stats;
   double cpuSeconds = 0.0;
   double maxPositionViolation = 0.0;  ///< max over outputs of max |g(q, t)|

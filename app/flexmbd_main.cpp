@@ -1,0 +1,303 @@
+// flexmbd: the command line.
+//   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]
+//   flexmbd --help | --version
+// Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
+// kept in DIR/results.csv, DIR/summary.json says "failed"); 2 bad input (command line,
+// scene file, model that cannot be set up): one line "flexmbd: error: ..." on stderr,
+// no results.csv.
+#include <cmath>
+#include <cstdlib>
+#include <ctime>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "integrators/simulation.hpp"
+#include "io/results_writer.hpp"
+#include "io/scene.hpp"
+
+#ifndef FLEXMBD_VERSION
+#define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
+#endif
+
+namespace {
+
+using namespace flexmbd;
+
+constexpr int kExitOk = 0;
+constexpr int kExitSolverFailure = 1;
+constexpr int kExitInputError = 2;
+
+const char* const kUsage =
+    "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]\n"
+    "       flexmbd --help\n"
+    "       flexmbd --version\n"
+    "\n"
+    "Simulates the planar multibody model described by SCENE.json (see docs/scene-format.md)\n"
+    "and writes DIR/results.csv (one row per output time) and DIR/summary.json.\n"
+    "\n"
+    "options of run:\n"
+    "  --out DIR    output directory (created if needed; required)\n"
+    "  --t-end T    end time, overrides solver.t_end of the scene\n"
+    "  --rtol R     relative tolerance, overrides solver.rtol\n"
+    "  --atol A     absolute tolerance of positions, overrides solver.atol (and of\n"
+    "               velocities too unless the scene sets solver.atol_velocity)\n"
+    "  --quiet, -q  no progress display\n"
+    "  --help, -h   this text\n"
+    "\n"
+    "exit status: 0 success; 1 solver failure during the run (results up to the failure\n"
+    "are kept); 2 invalid command line, scene or model (nothing is integrated).\n";
+
+/// A bad command line (exit status 2).
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  bool help = false;
+  bool version = false;
+  std::string scenePath;
+  std::string outDir;
+  std::optional<double> tEnd, rtol, atol;
+  bool quiet = false;
+};
+
+/// Messages go to the terminal on one line.
+std::string oneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+std::string fmt(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+double parseNumberOption(const std::string& option, const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double x = std::strtod(begin, &end);
+  if (text.empty() || end == begin || *end != '\0') {
+    throw UsageError("option " + option + " expects a number, got '" + text + "'");
+  }
+  if (!std::isfinite(x)) throw UsageError("option " + option + " expects a finite number, got '" + text + "'");
+  return x;
+}
+
+double parsePositiveOption(const std::string& option, const std::string& text) {
+  const double x = parseNumberOption(option, text);
+  if (!(x > 0.0)) throw UsageError("option " + option + " must be > 0, got " + text);
+  return x;
+}
+
+Options parseCommandLine(int argc, char** argv) {
+  Options o;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) throw UsageError("no command given (try 'flexmbd --help')");
+  for (const auto& a : args) {
+    if (a == "--help" || a == "-h") {
+      o.help = true;
+      return o;
+    }
+  }
+  if (args[0] == "--version" || args[0] == "-V") {
+    if (args.size() > 1) throw UsageError("--version takes no arguments");
+    o.version = true;
+    return o;
+  }
+  if (args[0] == "help") {
+    o.help = true;
+    return o;
+  }
+  if (args[0] != "run") {
+    throw UsageError("unknown command '" + args[0] + "' (expected 'run', '--help' or '--version')");
+  }
+  std::vector<std::string> positional;
+  for (std::size_t k = 1; k < args.size(); ++k) {
+    std::string a = args[k];
+    if (a.size() < 2 || a[0] != '-') {
+      positional.push_back(a);
+      continue;
+    }
+    if (a == "--quiet" || a == "-q") {
+      o.quiet = true;
+      continue;
+    }
+    // --name VALUE or --name=VALUE
+    std::string name = a, value;
+    bool haveValue = false;
+    if (const auto eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = a.substr(0, eq);
+      value = a.substr(eq + 1);
+      haveValue = true;
+    }
+    if (name != "--out" && name != "--t-end" && name != "--rtol" && name != "--atol") {
+      throw UsageError("unknown option '" + name + "' (known options: --out, --t-end, --rtol, --atol, --quiet, --help)");
+    }
+    if (!haveValue) {
+      if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
+      value = args[++k];
+    }
+    if (name == "--out") {
+      if (value.empty()) throw UsageError("option --out needs a directory");
+      o.outDir = value;
+    } else if (name == "--t-end") {
+      o.tEnd = parseNumberOption(name, value);
+    } else if (name == "--rtol") {
+      o.rtol = parsePositiveOption(name, value);
+    } else {
+      o.atol = parsePositiveOption(name, value);
+    }
+  }
+  if (positional.empty()) throw UsageError("run: missing the scene file (flexmbd run SCENE.json --out DIR)");
+  if (positional.size() > 1) {
+    throw UsageError("run: expected one scene file, got " + std::to_string(positional.size()) + " arguments ('" +
+                     positional[0] + "', '" + positional[1] + "', ...)");
+  }
+  o.scenePath = positional[0];
+  if (o.outDir.empty()) throw UsageError("run: missing --out DIR (the output directory)");
+  return o;
+}
+
+void printError(const std::string& message) { std::cerr << "flexmbd: error: " << oneLine(message) << std::endl; }
+
+/// Input error once the output directory is known: no results.csv, a summary.json that
+/// says why (best effort: a failure to write it must not hide the original error).
+int reportInputError(const std::filesystem::path& outDir, const std::string& message) {
+  try {
+    removeStaleResults(outDir);
+    writeInputErrorSummary(outDir, oneLine(message));
+  } catch (...) {
+  }
+  printError(message);
+  return kExitInputError;
+}
+
+double cpuSecondsSince(std::clock_t start) {
+  return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
+}
+
+int runCommand(const Options& o) {
+  const std::filesystem::path outDir(o.outDir);
+  std::error_code ec;
+  if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec)) {
+    printError("--out '" + o.outDir + "' exists and is not a directory");
+    return kExitInputError;
+  }
+
+  // ----- input: scene, overrides, settings (exit 2 on any error) -----
+  std::optional<Scene> scene;
+  try {
+    scene.emplace(loadScene(o.scenePath));
+    SolverSettings& s = scene->solver;
+    if (o.tEnd) {
+      if (!(*o.tEnd > s.tStart)) {
+        throw InputError("option --t-end must be > t_start (" + fmt(s.tStart) + ") of the scene, got " + fmt(*o.tEnd));
+      }
+      s.tEnd = *o.tEnd;
+    }
+    if (o.rtol) s.rtol = *o.rtol;
+    if (o.atol) s.atol = *o.atol;
+    s.progress = !o.quiet;
+    checkSolverSettings(s);
+  } catch (const std::exception& e) {
+    return reportInputError(outDir, e.what());
+  }
+
+  std::optional<ResultsWriter> writer;
+  try {
+    writer.emplace(outDir, *scene);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
+
+  // ----- the run -----
+  const std::clock_t start = std::clock();
+  SimulationSummary summary;
+  try {
+    summary = simulate(scene->system, scene->solver,
+                       [&](const OutputSample& sample) { writer->write(sample); });
+  } catch (const InputError& e) {
+    // Includes ModelError: the model cannot be set up (assembly, redundant or
+    // conflicting constraints). Nothing was integrated.
+    return reportInputError(outDir, o.scenePath + ": " + e.what());
+  } catch (const SolverError& e) {
+    summary = SimulationSummary{};
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = e.time();
+    summary.stats.lastStepSize = e.stepSize();
+    summary.cpuSeconds = cpuSecondsSince(start);
+  } catch (const std::exception& e) {
+    summary = SimulationSummary{};
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = writer->lastTime();
+    summary.cpuSeconds = cpuSecondsSince(start);
+  }
+
+  try {
+    writeSummary(outDir, summary, *scene);
+  } catch (const std::exception& e) {
+    printError(std::string("cannot write the summary: ") + e.what());
+    return kExitSolverFailure;
+  }
+
+  if (!summary.ok) {
+    const std::string kept = writer->rowsWritten() > 0
+                                 ? "results up to t = " + fmt(writer->lastTime()) + " kept in " +
+                                       writer->resultsPath().string()
+                                 : "no results were written";
+    printError("solver failure: " + summary.message + " (" + kept + ")");
+    return kExitSolverFailure;
+  }
+  std::cout << "flexmbd: ok: t = " << fmt(summary.tReached) << " reached, " << summary.stats.steps << " steps, "
+            << fmt(summary.cpuSeconds) << " s CPU; results in " << writer->resultsPath().string() << std::endl;
+  return kExitOk;
+}
+
+int mainImpl(int argc, char** argv) {
+  Options o;
+  try {
+    o = parseCommandLine(argc, argv);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
+  if (o.help) {
+    std::cout << kUsage;
+    return kExitOk;
+  }
+  if (o.version) {
+    std::cout << "flexmbd " << FLEXMBD_VERSION << std::endl;
+    return kExitOk;
+  }
+  return runCommand(o);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return mainImpl(argc, argv);
+  } catch (const InputError& e) {
+    printError(e.what());
+    return kExitInputError;
+  } catch (const std::exception& e) {
+    printError(std::string("unexpected failure: ") + e.what());
+    return kExitSolverFailure;
+  } catch (...) {
+    printError("unexpected failure (unknown exception)");
+    return kExitSolverFailure;
+  }
+}

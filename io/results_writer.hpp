@@ -1,0 +1,69 @@
+// Results of a run: DIR/results.csv (one row per output time, written as the run goes)
+// and DIR/summary.json (status and statistics, written at the end).
+#pragma once
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "integrators/simulation.hpp"
+#include "io/scene.hpp"
+
+namespace flexmbd {
+
+/// Writes DIR/results.csv: a header row, then one row per OutputSample, each flushed
+/// so that the rows written survive a failure later in the run. Columns: t; every
+/// coordinate "<body>.<coord>" (System::coordinateNames()); every velocity
+/// "<body>.<coord>_dot"; the reaction outputs (reactionOutputNames: "<joint>.fx",
+/// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs.
+/// Numbers are written with 17 significant digits (they read back exactly).
+/// The file is created at the first sample, so a run that fails before its first
+/// output leaves no results.csv behind.
+class ResultsWriter {
+ public:
+  /// Creates `dir` (and parents) and deletes a stale results.csv and summary.json.
+  /// `scene` must outlive the writer. @throws std::runtime_error if dir cannot be made.
+  ResultsWriter(const std::filesystem::path& dir, const Scene& scene);
+  ResultsWriter(const ResultsWriter&) = delete;
+  ResultsWriter& operator=(const ResultsWriter&) = delete;
+
+  /// Appends one row. @throws std::runtime_error if the sample has the wrong sizes or
+  /// the file cannot be written.
+  void write(const OutputSample& sample);
+
+  const std::vector<std::string>& columns() const { return columns_; }
+  const std::filesystem::path& resultsPath() const { return path_; }
+  long rowsWritten() const { return rows_; }
+  /// Time of the last row written (NaN if none).
+  double lastTime() const { return lastTime_; }
+
+ private:
+  void open();
+
+  const Scene& scene_;
+  std::filesystem::path path_;
+  std::vector<std::string> columns_;
+  std::ofstream out_;
+  long rows_ = 0;
+  double lastTime_;
+};
+
+/// Deletes DIR/results.csv and DIR/summary.json if they exist (stale from an earlier
+/// run); the directory itself is kept.
+void removeStaleResults(const std::filesystem::path& dir);
+
+/// Writes DIR/summary.json: status ("ok"/"failed"), message, t_reached, steps,
+/// residual_evals, jacobian_evals, nonlinear_iterations, nonlinear_conv_failures,
+/// error_test_failures, linear_setups, last_step_size, initial_position_iterations,
+/// cpu_seconds, max_position_violation, max_velocity_violation, energy_start and
+/// energy_end (null when absent), formulation, linear_solver ("dense"/"klu"), rtol,
+/// atol, atol_velocity, t_start, t_end, output_step, scene (the scene name).
+/// Creates `dir` if needed; the file is replaced atomically (written beside, renamed).
+void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene);
+
+/// Writes DIR/summary.json for a run that stopped on an input or model error before
+/// integrating: {"status": "failed", "message": ..., "error": "input"}.
+void writeInputErrorSummary(const std::filesystem::path& dir, const std::string& message);
+
+}  // namespace flexmbd

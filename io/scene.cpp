@@ -1,0 +1,771 @@
+// Strict reader of scene files (docs/scene-format.md). Every object is checked for
+// unknown keys before anything else (a typo is reported as such, not as a missing key),
+// every number for type and finiteness, every name reference against what exists.
+// Errors are one line: "<location>: <what is wrong>, got <what was found>".
+#include "io/scene.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+#include "bodies/rigid_body_2d.hpp"
+#include "core/errors.hpp"
+#include "core/system_evaluation.hpp"
+#include "joints/point_pair.hpp"
+
+namespace flexmbd {
+namespace {
+
+using nlohmann::json;
+
+// ----- formatting ------------------------------------------------------------------
+
+/// Shortest text that reads back as the same double ("-1", "0.1", "1e-08").
+std::string fmt(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[40];
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+/// "string \"abc\"", "number 3", "array [1,2]", "null", ... (long values shortened).
+std::string describe(const json& v) {
+  if (v.is_null()) return "null";
+  if (v.is_number_float() && !std::isfinite(v.get<double>())) return "number " + fmt(v.get<double>());
+  std::string d = v.dump();
+  if (d.size() > 60) d = d.substr(0, 57) + "...";
+  switch (v.type()) {
+    case json::value_t::string: return "string " + d;
+    case json::value_t::boolean: return "boolean " + d;
+    case json::value_t::array: return "array " + d;
+    case json::value_t::object: return "object " + d;
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "number " + d;
+    default: return d;
+  }
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+
+// ----- reading one JSON object ---------------------------------------------------------
+
+/// Typed, checked access to the keys of one JSON object at a location of the scene.
+/// Every failure throws InputError("<location>: <message>").
+class ObjectReader {
+ public:
+  ObjectReader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
+    if (!j_.is_object()) fail("expected an object {...}, got " + describe(j_));
+  }
+
+  const std::string& where() const { return where_; }
+  [[noreturn]] void fail(const std::string& message) const { throw InputError(where_ + ": " + message); }
+
+  /// Adds the object's name to the location: `bodies[1]` -> `bodies[1] ("rod")`.
+  /// Used as soon as a string name is found, so later messages carry it.
+  void peekName() {
+    const auto it = j_.find("name");
+    if (it != j_.end() && it->is_string()) where_ += " (" + inQuotes(it->get<std::string>()) + ")";
+  }
+
+  /// Rejects keys not in `allowed`; `what` qualifies the list (" for a harmonic law").
+  void allowOnly(const std::vector<std::string>& allowed, const std::string& what = "") const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
+        fail("unknown key " + inQuotes(it.key()) + " (allowed keys" + what + ": " + join(allowed) + ")");
+      }
+    }
+  }
+
+  bool has(const std::string& key) const { return j_.contains(key); }
+
+  const json& required(const std::string& key) const {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail("missing required key " + inQuotes(key));
+    return *it;
+  }
+
+  // --- scalars ---
+  double number(const std::string& key) const { return toNumber(required(key), key); }
+  double number(const std::string& key, double fallback) const {
+    return has(key) ? number(key) : fallback;
+  }
+  double positive(const std::string& key) const { return checkPositive(number(key), key); }
+  double positive(const std::string& key, double fallback) const {
+    return has(key) ? positive(key) : fallback;
+  }
+  double nonNegative(const std::string& key) const { return checkNonNegative(number(key), key); }
+  double nonNegative(const std::string& key, double fallback) const {
+    return has(key) ? nonNegative(key) : fallback;
+  }
+
+  std::string string(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_string()) fail("key " + inQuotes(key) + " must be a string, got " + describe(v));
+    return v.get<std::string>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+  /// A required, non-empty name (of this object or of one it refers to).
+  std::string name(const std::string& key) const {
+    std::string s = string(key);
+    if (s.empty()) fail("key " + inQuotes(key) + " must not be empty");
+    return s;
+  }
+
+  bool boolean(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    const json& v = required(key);
+    if (!v.is_boolean()) fail("key " + inQuotes(key) + " must be true or false, got " + describe(v));
+    return v.get<bool>();
+  }
+
+  /// An integer >= minimum (1e6 written as a float is accepted if integral).
+  long integer(const std::string& key, long fallback, long minimum) const {
+    if (!has(key)) return fallback;
+    const json& v = required(key);
+    long value = 0;
+    if (v.is_number_integer() || v.is_number_unsigned()) {
+      if (v.is_number_unsigned() &&
+          v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max())) {
+        fail("key " + inQuotes(key) + " is too large, got " + describe(v));
+      }
+      value = v.get<long>();
+    } else if (v.is_number_float()) {
+      const double d = toNumber(v, key);
+      if (d != std::floor(d) || std::fabs(d) > 9.0e18) {
+        fail("key " + inQuotes(key) + " must be an integer, got " + fmt(d));
+      }
+      value = static_cast<long>(d);
+    } else {
+      fail("key " + inQuotes(key) + " must be an integer, got " + describe(v));
+    }
+    if (value < minimum) {
+      fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + std::to_string(value));
+    }
+    return value;
+  }
+
+  // --- vectors ---
+  Vec2 vec2(const std::string& key) const { return toVec2(required(key), key); }
+  Vec2 vec2(const std::string& key, const Vec2& fallback) const {
+    return has(key) ? vec2(key) : fallback;
+  }
+
+  /// [[xi, yi], [xj, yj]]
+  std::array<Vec2, 2> pointPair(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.size() != 2) {
+      fail("key " + inQuotes(key) + " must be two points [[xi, yi], [xj, yj]], got " + describe(v));
+    }
+    return {toVec2(v[0], key + "[0]"), toVec2(v[1], key + "[1]")};
+  }
+
+  /// [nameI, nameJ]
+  std::array<std::string, 2> namePair(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.size() != 2 || !v[0].is_string() || !v[1].is_string()) {
+      fail("key " + inQuotes(key) + " must be two body names [\"bodyI\", \"bodyJ\"], got " + describe(v));
+    }
+    return {v[0].get<std::string>(), v[1].get<std::string>()};
+  }
+
+  /// A non-empty array of finite numbers.
+  std::vector<double> numbers(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.empty()) {
+      fail("key " + inQuotes(key) + " must be a non-empty array of numbers, got " + describe(v));
+    }
+    std::vector<double> out;
+    out.reserve(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) out.push_back(toNumber(v[k], key + "[" + std::to_string(k) + "]"));
+    return out;
+  }
+
+  const json& object(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_object()) fail("key " + inQuotes(key) + " must be an object {...}, got " + describe(v));
+    return v;
+  }
+
+  /// The array under `key`, or an empty one if the key is absent.
+  const json& array(const std::string& key) const {
+    static const json kEmpty = json::array();
+    if (!has(key)) return kEmpty;
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array [...], got " + describe(v));
+    return v;
+  }
+
+  double checkPositive(double x, const std::string& key) const {
+    if (!(x > 0.0)) fail("key " + inQuotes(key) + " must be > 0, got " + fmt(x));
+    return x;
+  }
+  double checkNonNegative(double x, const std::string& key) const {
+    if (!(x >= 0.0)) fail("key " + inQuotes(key) + " must be >= 0, got " + fmt(x));
+    return x;
+  }
+
+ private:
+  double toNumber(const json& v, const std::string& label) const {
+    if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail("key " + inQuotes(label) + " must be a finite number, got " + fmt(x));
+    return x;
+  }
+  Vec2 toVec2(const json& v, const std::string& label) const {
+    if (!v.is_array() || v.size() != 2) {
+      fail("key " + inQuotes(label) + " must be an array of 2 numbers [x, y], got " + describe(v));
+    }
+    return Vec2(toNumber(v[0], label + "[0]"), toNumber(v[1], label + "[1]"));
+  }
+
+  const json& j_;
+  std::string where_;
+};
+
+/// Runs a System / law-factory call and puts the scene location in front of its
+/// InputError messages (keeping the exception type).
+template <class F>
+auto located(const std::string& where, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const ModelError& e) {
+    throw ModelError(where + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+/// Checks the "type" key against the allowed values and returns it.
+std::string readType(const ObjectReader& r, const std::string& kind,
+                     const std::vector<std::string>& types) {
+  const std::string type = r.string("type");
+  if (std::find(types.begin(), types.end(), type) == types.end()) {
+    r.fail("unknown " + kind + " type " + inQuotes(type) + " (expected one of: " + join(types) + ")");
+  }
+  return type;
+}
+
+// ----- name look-ups ---------------------------------------------------------------------
+
+BodyIndex lookupBody(const System& sys, const std::string& name, const ObjectReader& r) {
+  std::vector<std::string> known;
+  for (int i = 0; i < sys.numBodies(); ++i) {
+    if (sys.body(BodyIndex(i)).name() == name) return BodyIndex(i);
+    known.push_back(sys.body(BodyIndex(i)).name());
+  }
+  r.fail("unknown body " + inQuotes(name) + " (known bodies: " + join(known) + ")");
+}
+
+/// A joint (not a driver) by name.
+ConstraintIndex lookupJoint(const System& sys, const std::string& name, const ObjectReader& r) {
+  std::vector<std::string> known;
+  for (int i = 0; i < sys.numConstraints(); ++i) {
+    const Constraint& c = sys.constraint(ConstraintIndex(i));
+    if (c.isDriver()) continue;
+    if (c.name() == name) return ConstraintIndex(i);
+    known.push_back(c.name());
+  }
+  r.fail("unknown joint " + inQuotes(name) + " (known joints: " + (known.empty() ? "none" : join(known)) + ")");
+}
+
+/// Relative angle phi_j - phi_i of a joint's two points in the initial positions.
+double initialJointAngle(const System& sys, ConstraintIndex joint) {
+  const auto& c = dynamic_cast<const TwoPointConstraint&>(sys.constraint(joint));
+  const Body& bi = sys.body(c.bodies()[0]);
+  const Body& bj = sys.body(c.bodies()[1]);
+  return bj.pointKinematics(bj.initialCoordinates(), c.pointJ()).phi -
+         bi.pointKinematics(bi.initialCoordinates(), c.pointI()).phi;
+}
+
+// ----- sections --------------------------------------------------------------------------
+
+TimeLawPtr parseLaw(const json& j, const std::string& where) {
+  ObjectReader r(j, where);
+  const std::string type =
+      readType(r, "law", {"constant", "constant_speed", "polynomial", "harmonic", "spin_up", "tabulated"});
+  const std::string forA = " for a " + type + " law";
+  if (type == "constant") {
+    r.allowOnly({"type", "value"}, forA);
+    const double value = r.number("value");
+    return located(where, [&] { return makeConstantLaw(value); });
+  }
+  if (type == "constant_speed") {
+    r.allowOnly({"type", "speed", "initial"}, forA);
+    const double speed = r.number("speed");
+    const double initial = r.number("initial", 0.0);
+    return located(where, [&] { return makeConstantSpeedLaw(speed, initial); });
+  }
+  if (type == "polynomial") {
+    r.allowOnly({"type", "coefficients"}, forA);
+    std::vector<double> c = r.numbers("coefficients");
+    return located(where, [&] { return makePolynomialLaw(std::move(c)); });
+  }
+  if (type == "harmonic") {
+    r.allowOnly({"type", "amplitude", "omega", "phase", "offset"}, forA);
+    const double amplitude = r.number("amplitude");
+    const double omega = r.number("omega");
+    const double phase = r.number("phase", 0.0);
+    const double offset = r.number("offset", 0.0);
+    return located(where, [&] { return makeHarmonicLaw(amplitude, omega, phase, offset); });
+  }
+  if (type == "spin_up") {
+    r.allowOnly({"type", "speed", "ramp_time", "initial"}, forA);
+    const double speed = r.number("speed");
+    const double rampTime = r.positive("ramp_time");
+    const double initial = r.number("initial", 0.0);
+    return located(where, [&] { return makeSpinUpLaw(speed, rampTime, initial); });
+  }
+  // tabulated
+  r.allowOnly({"type", "times", "values"}, forA);
+  std::vector<double> times = r.numbers("times");
+  std::vector<double> values = r.numbers("values");
+  if (times.size() != values.size()) {
+    r.fail("keys \"times\" and \"values\" must have the same length, got " + std::to_string(times.size()) +
+           " and " + std::to_string(values.size()));
+  }
+  return located(where, [&] { return makeTabulatedLaw(std::move(times), std::move(values)); });
+}
+
+void parseBody(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  readType(r, "body", {"rigid"});
+  r.allowOnly({"name", "type", "mass", "inertia", "com", "position", "angle", "velocity", "angular_velocity"});
+  const std::string name = r.name("name");
+  if (name == "ground") {
+    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
+           "in joints, do not define it)");
+  }
+  RigidBodyProperties props;
+  props.mass = r.positive("mass");
+  props.inertia = r.positive("inertia");
+  props.com = r.vec2("com", Vec2::Zero());
+  FrameState2d init;
+  init.position = r.vec2("position", Vec2::Zero());
+  init.angle = r.number("angle", 0.0);
+  init.velocity = r.vec2("velocity", Vec2::Zero());
+  init.angularVelocity = r.number("angular_velocity", 0.0);
+  located(r.where(), [&] { return sys.addRigidBody(name, props, init); });
+}
+
+void parseJoint(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "joint", {"revolute", "prismatic", "fixed"});
+  if (type != "prismatic" && r.has("axis")) {
+    r.fail("key \"axis\" is only allowed for prismatic joints (this joint is " + type + ")");
+  }
+  if (type == "prismatic") {
+    r.allowOnly({"name", "type", "bodies", "points", "axis"}, " for a prismatic joint");
+  } else {
+    r.allowOnly({"name", "type", "bodies", "points"}, " for a " + type + " joint");
+  }
+  const std::string name = r.name("name");
+  const auto bodyNames = r.namePair("bodies");
+  const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
+  const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
+  if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a joint connects two different bodies");
+  const auto points = r.pointPair("points");
+  if (type == "revolute") {
+    located(r.where(), [&] { return sys.addRevoluteJoint(name, bi, points[0], bj, points[1]); });
+  } else if (type == "fixed") {
+    located(r.where(), [&] { return sys.addFixedJoint(name, bi, points[0], bj, points[1]); });
+  } else {
+    const Vec2 axis = r.vec2("axis");
+    if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0]");
+    located(r.where(), [&] { return sys.addPrismaticJoint(name, bi, points[0], bj, points[1], axis); });
+  }
+}
+
+void parseDriver(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type =
+      readType(r, "driver", {"body_angle", "body_x", "body_y", "joint_angle", "joint_displacement"});
+  const bool onJoint = type == "joint_angle" || type == "joint_displacement";
+  r.allowOnly({"name", "type", onJoint ? "joint" : "body", "law"}, " for a " + type + " driver");
+  const std::string name = r.name("name");
+  if (onJoint) {
+    const std::string jointName = r.name("joint");
+    const ConstraintIndex joint = lookupJoint(sys, jointName, r);
+    const std::string jointType = sys.constraint(joint).typeName();
+    const std::string needed = type == "joint_angle" ? "revolute" : "prismatic";
+    if (jointType != needed) {
+      r.fail("a " + type + " driver needs a " + needed + " joint, but joint " + inQuotes(jointName) + " is " +
+             jointType +
+             (jointType == "prismatic" ? " (use a joint_displacement driver)"
+              : jointType == "revolute" ? " (use a joint_angle driver)"
+                                        : " (it has no free motion to drive)"));
+    }
+    TimeLawPtr law = parseLaw(r.object("law"), r.where() + ".law");
+    located(r.where(), [&] { return sys.addJointDriver(name, joint, law); });
+  } else {
+    const BodyIndex body = lookupBody(sys, r.name("body"), r);
+    const std::string coordinate = type == "body_angle" ? "theta" : type == "body_x" ? "x" : "y";
+    TimeLawPtr law = parseLaw(r.object("law"), r.where() + ".law");
+    located(r.where(), [&] { return sys.addBodyCoordinateDriver(name, body, coordinate, law); });
+  }
+}
+
+void parseForce(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load"});
+  const std::string forA = " for a " + type + " force";
+  if (type == "spring_damper") {
+    r.allowOnly({"name", "type", "bodies", "points", "stiffness", "damping", "free_length"}, forA);
+    const std::string name = r.name("name");
+    const auto bodyNames = r.namePair("bodies");
+    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
+    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
+    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a spring connects two different bodies");
+    const auto points = r.pointPair("points");
+    const double stiffness = r.nonNegative("stiffness");
+    const double damping = r.nonNegative("damping", 0.0);
+    double freeLength = 0.0;
+    if (r.has("free_length")) {
+      freeLength = r.nonNegative("free_length");
+    } else {
+      freeLength = located(r.where(), [&] {
+        const Body& a = sys.body(bi);
+        const Body& b = sys.body(bj);
+        return (b.pointKinematics(b.initialCoordinates(), points[1]).r -
+                a.pointKinematics(a.initialCoordinates(), points[0]).r).norm();
+      });
+    }
+    located(r.where(), [&] {
+      return sys.addSpringDamper(name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
+    });
+  } else if (type == "rotational_spring_damper") {
+    r.allowOnly({"name", "type", "joint", "stiffness", "damping", "free_angle"}, forA);
+    const std::string name = r.name("name");
+    const std::string jointName = r.name("joint");
+    const ConstraintIndex joint = lookupJoint(sys, jointName, r);
+    const std::string jointType = sys.constraint(joint).typeName();
+    if (jointType != "revolute") {
+      r.fail("a rotational_spring_damper needs a revolute joint, but joint " + inQuotes(jointName) + " is " + jointType);
+    }
+    const double stiffness = r.nonNegative("stiffness");
+    const double damping = r.nonNegative("damping", 0.0);
+    const double freeAngle = r.has("free_angle") ? r.number("free_angle")
+                                                 : located(r.where(), [&] { return initialJointAngle(sys, joint); });
+    located(r.where(), [&] { return sys.addRotationalSpringDamper(name, joint, stiffness, damping, freeAngle); });
+  } else {
+    r.allowOnly({"name", "type", "body", "point", "force_x", "force_y", "torque"}, forA);
+    const std::string name = r.name("name");
+    const BodyIndex body = lookupBody(sys, r.name("body"), r);
+    const Vec2 point = r.vec2("point", Vec2::Zero());
+    if (!r.has("force_x") && !r.has("force_y") && !r.has("torque")) {
+      r.fail("an applied_load needs at least one of the keys \"force_x\", \"force_y\", \"torque\" (each a law object)");
+    }
+    TimeLawPtr fx, fy, tau;
+    if (r.has("force_x")) fx = parseLaw(r.object("force_x"), r.where() + ".force_x");
+    if (r.has("force_y")) fy = parseLaw(r.object("force_y"), r.where() + ".force_y");
+    if (r.has("torque")) tau = parseLaw(r.object("torque"), r.where() + ".torque");
+    located(r.where(), [&] { return sys.addAppliedLoad(name, body, point, fx, fy, tau); });
+  }
+}
+
+OutputRequest parseOutput(const json& j, const std::string& where, const System& sys,
+                          const std::vector<OutputRequest>& earlier) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "output", {"point", "energy"});
+  OutputRequest out;
+  if (type == "energy") {
+    r.allowOnly({"type"}, " for an energy output");
+    for (const auto& o : earlier) {
+      if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
+    }
+    out.type = OutputRequest::Type::Energy;
+    return out;
+  }
+  r.allowOnly({"type", "name", "body", "point"}, " for a point output");
+  out.type = OutputRequest::Type::Point;
+  out.name = r.name("name");
+  // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
+  // "<joint>.fx" or with another output's columns.
+  if (out.name == "energy") r.fail("the name \"energy\" is reserved for the energy output columns");
+  for (int i = 0; i < sys.numBodies(); ++i) {
+    if (sys.body(BodyIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a body; give the output its own name");
+    }
+  }
+  for (int i = 0; i < sys.numConstraints(); ++i) {
+    if (sys.constraint(ConstraintIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a joint or driver; give the output its own name");
+    }
+  }
+  for (const auto& o : earlier) {
+    if (o.type == OutputRequest::Type::Point && o.name == out.name) {
+      r.fail("duplicate output name " + inQuotes(out.name));
+    }
+  }
+  out.bodyName = r.name("body");
+  out.body = lookupBody(sys, out.bodyName, r);
+  out.point = r.vec2("point", Vec2::Zero());
+  located(r.where(), [&] { sys.body(out.body).checkAttachmentPoint(out.point, "output " + inQuotes(out.name)); });
+  return out;
+}
+
+SolverSettings parseSolver(const json& j) {
+  ObjectReader r(j, "solver");
+  r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
+               "min_step", "max_steps", "linear_solver", "fd_jacobian"});
+  SolverSettings s;
+  if (r.has("formulation")) {
+    const std::string f = r.string("formulation");
+    try {
+      s.formulation = parseFormulation(f);
+    } catch (const InputError&) {
+      r.fail("unknown formulation " + inQuotes(f) + " (expected one of: ggl, index3, index1)");
+    }
+  }
+  if (r.has("linear_solver")) {
+    const std::string ls = r.string("linear_solver");
+    try {
+      s.linearSolver = parseLinearSolver(ls);
+    } catch (const InputError&) {
+      r.fail("unknown linear solver " + inQuotes(ls) + " (expected one of: auto, dense, klu)");
+    }
+  }
+  s.rtol = r.number("rtol", s.rtol);
+  s.atol = r.number("atol", s.atol);
+  if (r.has("atol_velocity")) s.atolVelocity = r.number("atol_velocity");
+  s.tStart = r.number("t_start", s.tStart);
+  s.tEnd = r.number("t_end", s.tEnd);
+  s.outputStep = r.number("output_step", s.outputStep);
+  s.maxStepSize = r.number("max_step", s.maxStepSize);
+  if (r.has("min_step")) s.minStepSize = r.number("min_step", 0.0);
+  s.maxSteps = r.integer("max_steps", s.maxSteps, 1);
+  s.finiteDifferenceJacobian = r.boolean("fd_jacobian", s.finiteDifferenceJacobian);
+  checkSolverSettings(s);
+  return s;
+}
+
+// ----- JSON text -----------------------------------------------------------------------------
+
+/// Follows the parser through the document so that a number overflow or a duplicate
+/// key can be reported with its location (nlohmann only gives a byte position).
+class PathTracker {
+ public:
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        countElement();
+        stack_.push_back(Frame{event == json::parse_event_t::array_start, "", -1, {}});
+        break;
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+        if (!stack_.empty()) stack_.pop_back();
+        break;
+      case json::parse_event_t::key:
+        if (!stack_.empty()) {
+          Frame& f = stack_.back();
+          f.key = parsed.get<std::string>();
+          if (!f.keys.insert(f.key).second) {
+            throw InputError(path(false) + ": duplicate key " + inQuotes(f.key) + " (each key may appear once)");
+          }
+        }
+        break;
+      case json::parse_event_t::value:
+        countElement();
+        break;
+    }
+    return true;
+  }
+
+  /// Location of the value being parsed; pendingScalar: the parser failed on a scalar
+  /// that has not been reported as a value yet.
+  std::string path(bool pendingScalar) const {
+    std::string p;
+    for (std::size_t k = 0; k < stack_.size(); ++k) {
+      const Frame& f = stack_[k];
+      if (f.array) {
+        const long index = f.index + ((pendingScalar && k + 1 == stack_.size()) ? 1 : 0);
+        p += "[" + std::to_string(index) + "]";
+      } else if (!f.key.empty()) {
+        p += (p.empty() ? "" : ".") + f.key;
+      }
+    }
+    return p.empty() ? "top level" : p;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    std::string key;
+    long index;
+    std::set<std::string> keys;
+  };
+  void countElement() {
+    if (!stack_.empty() && stack_.back().array) ++stack_.back().index;
+  }
+  std::vector<Frame> stack_;
+};
+
+/// nlohmann's message without its "[json.exception.xxx.nnn] " prefix.
+std::string plainMessage(const json::exception& e) {
+  std::string m = e.what();
+  if (!m.empty() && m[0] == '[') {
+    const auto close = m.find("] ");
+    if (close != std::string::npos) m = m.substr(close + 2);
+  }
+  return m;
+}
+
+}  // namespace
+
+// ----- public API ------------------------------------------------------------------------------
+
+std::vector<std::string> OutputRequest::columnNames() const {
+  if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
+  return {name + ".x", name + ".y", name + ".vx", name + ".vy"};
+}
+
+std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, const VecX& v) const {
+  if (type == Type::Energy) {
+    const double kinetic = kineticEnergy(sys, q, v);
+    const double potential = potentialEnergy(sys, q);
+    return {kinetic, potential, kinetic + potential};
+  }
+  const Body& b = sys.body(body);
+  const int off = sys.coordinateOffset(body);
+  const int n = b.numCoordinates();
+  const PointKinematics pk = b.pointKinematics(q.segment(off, n), point);
+  const Vec2 vel = n > 0 ? Vec2(pk.Jr * v.segment(off, n)) : Vec2::Zero();
+  return {pk.r.x(), pk.r.y(), vel.x(), vel.y()};
+}
+
+void checkSolverSettings(const SolverSettings& s) {
+  const auto fail = [](const std::string& m) { throw InputError("solver: " + m); };
+  const auto positive = [&](double x, const char* key) {
+    if (!std::isfinite(x)) fail(std::string("key \"") + key + "\" must be a finite number, got " + fmt(x));
+    if (!(x > 0.0)) fail(std::string("key \"") + key + "\" must be > 0, got " + fmt(x));
+  };
+  positive(s.rtol, "rtol");
+  positive(s.atol, "atol");
+  if (s.atolVelocity) positive(*s.atolVelocity, "atol_velocity");
+  if (!std::isfinite(s.tStart)) fail("key \"t_start\" must be a finite number, got " + fmt(s.tStart));
+  if (!std::isfinite(s.tEnd)) fail("key \"t_end\" must be a finite number, got " + fmt(s.tEnd));
+  if (!(s.tEnd > s.tStart)) {
+    fail("key \"t_end\" must be > t_start (" + fmt(s.tStart) + "), got " + fmt(s.tEnd));
+  }
+  positive(s.outputStep, "output_step");
+  if (!std::isfinite(s.maxStepSize) || s.maxStepSize < 0.0) {
+    fail("key \"max_step\" must be >= 0 (0: no limit), got " + fmt(s.maxStepSize));
+  }
+  if (s.maxSteps < 1) fail("key \"max_steps\" must be >= 1, got " + std::to_string(s.maxSteps));
+  try {
+    s.validate();
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    if (m.rfind("solver", 0) == 0) throw;
+    fail(m);
+  }
+}
+
+Scene parseScene(const json& j) {
+  ObjectReader top(j, "top level");
+  top.allowOnly({"name", "gravity", "bodies", "joints", "drivers", "forces", "outputs", "solver"});
+  Scene scene;
+  scene.name = top.string("name", "");
+  System& sys = scene.system;
+
+  if (!top.has("bodies")) top.fail("missing required key \"bodies\"");
+  const json& bodies = top.array("bodies");
+  if (bodies.empty()) top.fail("key \"bodies\" must list at least one body");
+  for (std::size_t i = 0; i < bodies.size(); ++i) parseBody(bodies[i], "bodies[" + std::to_string(i) + "]", sys);
+
+  const json& joints = top.array("joints");
+  for (std::size_t i = 0; i < joints.size(); ++i) parseJoint(joints[i], "joints[" + std::to_string(i) + "]", sys);
+
+  const json& drivers = top.array("drivers");
+  for (std::size_t i = 0; i < drivers.size(); ++i) {
+    parseDriver(drivers[i], "drivers[" + std::to_string(i) + "]", sys);
+  }
+
+  const json& forces = top.array("forces");
+  for (std::size_t i = 0; i < forces.size(); ++i) parseForce(forces[i], "forces[" + std::to_string(i) + "]", sys);
+
+  const Vec2 g = top.vec2("gravity", Vec2::Zero());
+  located("top level", [&] { sys.setGravity(g); });
+
+  const json& outputs = top.array("outputs");
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    scene.outputs.push_back(parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs));
+  }
+
+  scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};
+  if (!top.has("solver")) checkSolverSettings(scene.solver);
+
+  located("scene", [&] { sys.finalize(); });
+  return scene;
+}
+
+Scene parseSceneText(const std::string& text, const std::string& source) {
+  PathTracker tracker;
+  json j;
+  try {
+    j = json::parse(text, std::ref(tracker), /*allow_exceptions=*/true);
+  } catch (const json::parse_error& e) {
+    throw InputError(source + ": invalid JSON at byte " + std::to_string(e.byte) + ": " + plainMessage(e));
+  } catch (const json::out_of_range& e) {
+    // 406: a number literal that does not fit a double (1e999).
+    throw InputError(source + ": " + tracker.path(true) + ": " + plainMessage(e) +
+                     " (the number is too large for a double; numbers must be finite)");
+  } catch (const json::exception& e) {
+    throw InputError(source + ": invalid JSON: " + plainMessage(e));
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  try {
+    return parseScene(j);
+  } catch (const ModelError& e) {
+    throw ModelError(source + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+}
+
+Scene loadScene(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError("cannot read scene file '" + path + "': it is a directory");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open scene file '" + path + "' for reading");
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  if (in.bad()) throw InputError("cannot read scene file '" + path + "'");
+  return parseSceneText(buf.str(), path);
+}
+
+}  // namespace flexmbd

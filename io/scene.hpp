@@ -1,0 +1,65 @@
+// Scene files: a JSON description of a model, its solver settings and extra outputs,
+// read strictly (unknown keys, missing keys, wrong types and out-of-range numbers are
+// errors that name their location). The format is documented in docs/scene-format.md.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/system.hpp"
+#include "integrators/simulation.hpp"
+
+namespace flexmbd {
+
+/// An extra quantity written to results.csv at every output time.
+struct OutputRequest {
+  enum class Type {
+    Point,   ///< world position and velocity of a body point
+    Energy,  ///< kinetic, potential and total energy of the system
+  };
+  Type type = Type::Point;
+  std::string name;            ///< Point: prefix of the columns
+  std::string bodyName;        ///< Point: the body the point belongs to
+  BodyIndex body;              ///< Point: index of that body in the System
+  Vec2 point = Vec2::Zero();   ///< Point: body-frame coordinates of the point
+
+  /// Point: "<name>.x", "<name>.y", "<name>.vx", "<name>.vy";
+  /// Energy: "energy.kinetic", "energy.potential", "energy.total".
+  std::vector<std::string> columnNames() const;
+  /// Values matching columnNames() at global coordinates q and velocities v (size nq).
+  /// Point: r and Jr v_body from Body::pointKinematics; Energy: kineticEnergy,
+  /// potentialEnergy and their sum.
+  /// @pre sys is finalized and q, v have numCoordinates() entries.
+  std::vector<double> evaluate(const System& sys, const VecX& q, const VecX& v) const;
+};
+
+/// A model ready to run. System is move-only, so a Scene is too.
+struct Scene {
+  std::string name;
+  System system;  ///< finalized
+  SolverSettings solver;
+  std::vector<OutputRequest> outputs;
+};
+
+/// Reads and parses a scene file. Error messages start with the file path.
+/// @throws InputError if the file cannot be read, is not valid JSON (the message gives
+///         nlohmann's byte position), or does not describe a valid scene.
+Scene loadScene(const std::string& path);
+
+/// Parses JSON text; `source` names the text in error messages (a file path).
+/// A number too large for a double (1e999) is an InputError naming its location.
+Scene parseSceneText(const std::string& text, const std::string& source = "<scene>");
+
+/// Builds a scene from parsed JSON; the System is finalized at the end.
+/// @throws InputError (one line, starting with the location, e.g.
+///         `bodies[1] ("rod"): key "mass" must be > 0, got -1`) on any invalid input.
+Scene parseScene(const nlohmann::json& j);
+
+/// Range checks of solver settings with the scene's key names (rtol > 0, t_end >
+/// t_start, ...), then SolverSettings::validate(). Used after command-line overrides.
+/// @throws InputError starting with "solver: ".
+void checkSolverSettings(const SolverSettings& s);
+
+}  // namespace flexmbd

@@ -1,0 +1,719 @@
+// Unit tests of every analytic derivative of the engine against central finite
+// differences: rigid-body kinematics, mass-matrix derivative, internal and gravity
+// force Jacobians; constraint Jacobians and Hessians of every joint and driver; force
+// Jacobians of every force element (and force = -grad(energy) for conservative ones);
+// the full DAE iteration matrix dF/dy + cj dF/dy' of every formulation, and the
+// agreement of the sparse and dense Jacobian sinks.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bodies/rigid_body_2d.hpp"
+#include "core/dae_system.hpp"
+#include "core/errors.hpp"
+#include "core/sparse_pattern.hpp"
+#include "core/system.hpp"
+#include "core/time_law.hpp"
+#include "forces/applied_load.hpp"
+#include "forces/rotational_spring_damper.hpp"
+#include "forces/spring_damper.hpp"
+#include "joints/drivers.hpp"
+#include "joints/fixed_joint.hpp"
+#include "joints/prismatic_joint.hpp"
+#include "joints/revolute_joint.hpp"
+
+namespace flexmbd {
+
+// Readable parameter values in GoogleTest messages (found by ADL in flexmbd).
+void PrintTo(Formulation f, std::ostream* os) { *os << toString(f); }
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// Fixed seed: the random configurations are the same on every run (reproducible).
+constexpr unsigned kSeed = 20240611u;
+// Random configurations per case: enough to visit every quadrant of the angles.
+constexpr int kSamples = 8;
+
+// Central-difference step relative to the variable: h = kFdRelStep (1 + |x|).
+// Balances truncation h^2/6 |f'''| against roundoff eps |f| / h near their minimum
+// (h ~ eps^(1/3) ~ 6e-6).
+constexpr double kFdRelStep = 1e-6;
+// Tolerance of analytic vs finite-difference derivatives, relative to
+// max(1, largest entry compared). With h = 1e-6 (1 + |x|), |x| <= 4: truncation
+// h^2/6 |f'''| <= 5e-12 |f'''| and roundoff ~ eps |f| / h <= 2.2e-10 |f|. Here
+// |f| <= ~1e3 (springs k <= 150 over lengths <= 8, gravity ~10 m) and |f'''| <= ~1e4
+// (spring lengths kept >= 0.5), so the error is <= ~3e-7 absolute against entries
+// >= ~1e2 in those rows, i.e. <= ~1e-8 relative (measured: <= 1.2e-8, the dQ/dv of
+// the stiff springs; <= 2e-9 elsewhere). 1e-6 leaves a wide margin while a wrong sign
+// or a missing term gives errors of order 1 (checked by mutating the library).
+constexpr double kFdTol = 1e-6;
+// Hessians are assembled from a handful of products; H and H^T differ only by the
+// order of floating-point additions: a few ulps of the entries, <= 1e-15 relative.
+// 1e-13 bounds that; a genuinely unsymmetric term would be O(1) relative.
+constexpr double kSymmetryTol = 1e-13;
+// Identities that hold exactly in exact arithmetic and are evaluated with a few
+// dozen operations on O(1..1e3) numbers: error <= ~1e-13 relative.
+constexpr double kRoundoffTol = 1e-12;
+
+double fdStep(double x) { return kFdRelStep * (1.0 + std::abs(x)); }
+
+/// Central-difference Jacobian (m x n) of f: R^n -> R^m at x.
+MatX fdJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x) {
+  const VecX f0 = f(x);
+  MatX J(f0.size(), x.size());
+  for (int k = 0; k < x.size(); ++k) {
+    const double h = fdStep(x[k]);
+    VecX xp = x, xm = x;
+    xp[k] += h;
+    xm[k] -= h;
+    J.col(k) = (f(xp) - f(xm)) / (2.0 * h);
+  }
+  return J;
+}
+
+/// Central-difference gradient (as a column) of a scalar function.
+VecX fdGradient(const std::function<double(const VecX&)>& f, const VecX& x) {
+  return fdJacobian([&](const VecX& z) { return VecX::Constant(1, f(z)); }, x).transpose();
+}
+
+std::string show(const MatX& A) {
+  std::ostringstream os;
+  os.precision(10);
+  os << A;
+  return os.str();
+}
+
+/// max |A - B| <= tol * max(1, max |A|, max |B|); prints both on failure.
+void expectMatrixNear(const MatX& analytic, const MatX& reference, double tol,
+                      const std::string& what) {
+  ASSERT_EQ(analytic.rows(), reference.rows()) << what;
+  ASSERT_EQ(analytic.cols(), reference.cols()) << what;
+  if (analytic.size() == 0) return;
+  const double scale =
+      std::max({1.0, analytic.cwiseAbs().maxCoeff(), reference.cwiseAbs().maxCoeff()});
+  const double err = (analytic - reference).cwiseAbs().maxCoeff();
+  EXPECT_LE(err, tol * scale) << what << "\nanalytic:\n"
+                              << show(analytic) << "\nreference:\n"
+                              << show(reference);
+}
+
+/// Seeded random numbers for configurations.
+class Random {
+ public:
+  explicit Random(unsigned seed) : gen_(seed) {}
+  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(gen_); }
+  /// An angle anywhere on the circle.
+  double angle() { return uniform(-kPi, kPi); }
+  Vec2 vec2(double a, double b) { return Vec2(uniform(a, b), uniform(a, b)); }
+  /// A frame state (x, y, theta) with the origin off the world origin.
+  VecX frame() { return Eigen::Vector3d(uniform(-3.0, 3.0), uniform(-3.0, 3.0), angle()); }
+  VecX vector(int n, double a, double b) {
+    VecX x(n);
+    for (int k = 0; k < n; ++k) x[k] = uniform(a, b);
+    return x;
+  }
+
+ private:
+  std::mt19937 gen_;
+};
+
+RigidBodyProperties randomProperties(Random& rnd) {
+  RigidBodyProperties p;
+  p.mass = rnd.uniform(0.5, 5.0);
+  p.inertia = rnd.uniform(0.1, 2.0);
+  // centre of mass clearly off the frame origin
+  p.com = Vec2(rnd.uniform(0.3, 1.2), rnd.uniform(-0.8, -0.2));
+  return p;
+}
+
+// =====================================================================================
+// 1. RigidBody2d
+// =====================================================================================
+
+TEST(RigidBodyJacobians, PointKinematicsFirstAndSecondDerivatives) {
+  Random rnd(kSeed);
+  for (int s = 0; s < kSamples; ++s) {
+    const RigidBody2d body("link", randomProperties(rnd), FrameState2d{});
+    const VecX q = rnd.frame();
+    const Vec2 u = rnd.vec2(-2.0, 2.0);
+    const PointKinematics pk = body.pointKinematics(q, u);
+    const std::string at = "sample " + std::to_string(s);
+
+    // J = d[r; phi]/dq
+    const MatX Jfd = fdJacobian(
+        [&](const VecX& z) {
+          const PointKinematics p = body.pointKinematics(z, u);
+          return VecX(Eigen::Vector3d(p.r.x(), p.r.y(), p.phi));
+        },
+        q);
+    expectMatrixNear(pk.Jr, Jfd.topRows(2), kFdTol, "Jr, " + at);
+    expectMatrixNear(pk.Jphi, Jfd.row(2), kFdTol, "Jphi, " + at);
+
+    // Hessians = d(J rows)/dq
+    auto rowOf = [&](int which) {
+      return [&, which](const VecX& z) -> VecX {
+        const PointKinematics p = body.pointKinematics(z, u);
+        if (which < 2) return p.Jr.row(which).transpose();
+        return p.Jphi.transpose();
+      };
+    };
+    expectMatrixNear(pk.Hrx, fdJacobian(rowOf(0), q), kFdTol, "Hrx, " + at);
+    expectMatrixNear(pk.Hry, fdJacobian(rowOf(1), q), kFdTol, "Hry, " + at);
+    expectMatrixNear(pk.Hphi, fdJacobian(rowOf(2), q), kFdTol, "Hphi, " + at);
+    // hessianR(w) is the w-weighted sum
+    const Vec2 w = rnd.vec2(-2.0, 2.0);
+    expectMatrixNear(pk.hessianR(w), w.x() * pk.Hrx + w.y() * pk.Hry, kRoundoffTol,
+                     "hessianR, " + at);
+  }
+}
+
+TEST(RigidBodyJacobians, MassMatrixDerivative) {
+  Random rnd(kSeed + 1);
+  for (int s = 0; s < kSamples; ++s) {
+    const RigidBody2d body("link", randomProperties(rnd), FrameState2d{});
+    const VecX q = rnd.frame();
+    const VecX a = rnd.vector(3, -3.0, 3.0);
+    // The method accumulates (+=): start from a non-zero matrix.
+    const MatX K0 = MatX::Constant(3, 3, 0.25);
+    MatX K = K0;
+    body.addMassMatrixDerivative(q, a, K);
+    const MatX Kfd = fdJacobian([&](const VecX& z) -> VecX { return body.massMatrix(z) * a; }, q);
+    expectMatrixNear(K - K0, Kfd, kFdTol, "d(M a)/dq, sample " + std::to_string(s));
+  }
+}
+
+TEST(RigidBodyJacobians, InternalForceJacobians) {
+  Random rnd(kSeed + 2);
+  for (int s = 0; s < kSamples; ++s) {
+    const RigidBody2d body("link", randomProperties(rnd), FrameState2d{});
+    const VecX q = rnd.frame();
+    const VecX v = rnd.vector(3, -3.0, 3.0);
+    auto Q = [&](const VecX& qq, const VecX& vv) {
+      VecX out = VecX::Zero(3);
+      body.addInternalForces(qq, vv, out);
+      return out;
+    };
+    MatX dQdq = MatX::Zero(3, 3), dQdv = MatX::Zero(3, 3);
+    body.addInternalForceJacobians(q, v, dQdq, dQdv);
+    const std::string at = "sample " + std::to_string(s);
+    expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, v); }, q), kFdTol,
+                     "dQ/dq, " + at);
+    expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return Q(q, z); }, v), kFdTol,
+                     "dQ/dv, " + at);
+  }
+}
+
+TEST(RigidBodyJacobians, GravityJacobianAndPotential) {
+  Random rnd(kSeed + 3);
+  for (int s = 0; s < kSamples; ++s) {
+    const RigidBody2d body("link", randomProperties(rnd), FrameState2d{});
+    const VecX q = rnd.frame();
+    const Vec2 g = rnd.vec2(-10.0, 10.0);
+    auto Q = [&](const VecX& z) {
+      VecX out = VecX::Zero(3);
+      body.addGravityForce(z, g, out);
+      return out;
+    };
+    MatX K = MatX::Zero(3, 3);
+    body.addGravityJacobian(q, g, K);
+    const std::string at = "sample " + std::to_string(s);
+    expectMatrixNear(K, fdJacobian(Q, q), kFdTol, "d(gravity)/dq, " + at);
+    // A conservative force: Q_g = -dV/dq.
+    const VecX gradV = fdGradient([&](const VecX& z) { return body.gravityPotential(z, g); }, q);
+    expectMatrixNear(Q(q), -gradV, kFdTol, "gravity force vs -dV/dq, " + at);
+  }
+}
+
+// =====================================================================================
+// 2. Constraints
+// =====================================================================================
+
+/// A system with two free rigid bodies "a" and "b" and the given constraints.
+struct ConstraintCase {
+  System sys;
+  BodyIndex a, b;
+};
+
+/// Checks h, G and the Hessians of constraint ci at the global coordinates q.
+void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const VecX& q,
+                                const std::string& at) {
+  const Constraint& con = sys.constraint(ci);
+  const std::vector<int>& cols = sys.constraintColumns(ci);
+  const int me = con.numEquations(), nl = static_cast<int>(cols.size());
+  const std::string who = con.typeName() + " '" + con.name() + "', " + at;
+
+  ConstraintEvaluation ev;
+  con.evaluate(sys.bodyStates(con.bodies(), q.data()), true, ev);
+  ASSERT_EQ(ev.h.size(), me) << who;
+  ASSERT_EQ(ev.G.rows(), me) << who;
+  ASSERT_EQ(ev.G.cols(), nl) << who;
+  ASSERT_EQ(static_cast<int>(ev.H.size()), me) << who;
+
+  // Without Hessians h and G are the same (bitwise: same code path).
+  ConstraintEvaluation ev0;
+  con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev0);
+  EXPECT_TRUE(ev0.h == ev.h) << who;
+  EXPECT_TRUE(ev0.G == ev.G) << who;
+
+  VecX ql(nl);
+  for (int k = 0; k < nl; ++k) ql[k] = q[cols[k]];
+  // Evaluates the constraint with the local coordinates replaced by z.
+  auto evalAt = [&](const VecX& z) {
+    VecX qg = q;
+    for (int k = 0; k < nl; ++k) qg[cols[k]] = z[k];
+    ConstraintEvaluation e;
+    con.evaluate(sys.bodyStates(con.bodies(), qg.data()), false, e);
+    return e;
+  };
+  expectMatrixNear(ev.G, fdJacobian([&](const VecX& z) { return evalAt(z).h; }, ql), kFdTol,
+                   "G vs FD of h, " + who);
+  for (int a = 0; a < me; ++a) {
+    ASSERT_EQ(ev.H[a].rows(), nl) << who;
+    ASSERT_EQ(ev.H[a].cols(), nl) << who;
+    const MatX Hfd = fdJacobian(
+        [&](const VecX& z) -> VecX { return evalAt(z).G.row(a).transpose(); }, ql);
+    expectMatrixNear(ev.H[a], Hfd, kFdTol, "H_" + std::to_string(a) + " vs FD of G row, " + who);
+    expectMatrixNear(ev.H[a], ev.H[a].transpose(), kSymmetryTol,
+                     "H_" + std::to_string(a) + " symmetric, " + who);
+  }
+}
+
+TEST(ConstraintJacobians, EveryConstraintTypeBetweenBodiesAndWithGround) {
+  Random rnd(kSeed + 10);
+  System sys;
+  const BodyIndex a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
+  const BodyIndex b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const Vec2 prismaticAxis(0.6, -1.3);      // not unit, not axis-aligned
+  const Vec2 displacementAxis(-0.8, 0.5);   // not unit, not axis-aligned
+  const double prismaticReference = 0.7;
+  const double fixedReference = -0.4;
+
+  // Every two-point constraint for the pairs (a, b), (ground, b), (a, ground).
+  const std::vector<std::pair<BodyIndex, BodyIndex>> pairs = {{a, b}, {kGround, b}, {a, kGround}};
+  const std::vector<std::string> pairNames = {"a_b", "ground_b", "a_ground"};
+  std::vector<ConstraintIndex> all;
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const auto [i, j] = pairs[p];
+    const std::string sfx = "_" + pairNames[p];
+    const Vec2 ui = rnd.vec2(-1.5, 1.5), uj = rnd.vec2(-1.5, 1.5);
+    all.push_back(sys.addConstraint(std::make_unique<RevoluteJoint>("rev" + sfx, i, ui, j, uj)));
+    all.push_back(sys.addConstraint(std::make_unique<PrismaticJoint>(
+        "pri" + sfx, i, ui, j, uj, prismaticAxis, prismaticReference)));
+    all.push_back(sys.addConstraint(
+        std::make_unique<FixedJoint>("fix" + sfx, i, ui, j, uj, fixedReference)));
+    all.push_back(sys.addConstraint(std::make_unique<JointAngleDriver>(
+        "ang" + sfx, i, ui, j, uj, makeHarmonicLaw(0.5, 2.0, 0.1, 0.2))));
+    all.push_back(sys.addConstraint(std::make_unique<JointDisplacementDriver>(
+        "dis" + sfx, i, ui, j, uj, displacementAxis, makeConstantSpeedLaw(0.3, 0.1))));
+  }
+  // Body-coordinate drivers on every coordinate of b.
+  for (const char* c : {"x", "y", "theta"}) {
+    all.push_back(sys.addBodyCoordinateDriver(std::string("drv_") + c, b, c,
+                                              makeHarmonicLaw(1.0, 3.0)));
+  }
+  // The convenience builders of System (reference angles from the initial positions,
+  // drivers derived from the joints).
+  const ConstraintIndex rev = sys.addRevoluteJoint("rev_builder", a, Vec2(0.4, -0.2), b,
+                                                   Vec2(-0.6, 0.3));
+  const ConstraintIndex pri =
+      sys.addPrismaticJoint("pri_builder", kGround, Vec2(0.5, 0.5), b, Vec2(0.2, -0.1),
+                            Vec2(1.0, 2.0));
+  all.push_back(rev);
+  all.push_back(pri);
+  all.push_back(sys.addFixedJoint("fix_builder", a, Vec2(1.0, 0.0), b, Vec2(0.0, 1.0)));
+  all.push_back(sys.addJointDriver("ang_builder", rev, makeConstantSpeedLaw(1.0)));
+  all.push_back(sys.addJointDriver("dis_builder", pri, makeConstantSpeedLaw(1.0)));
+  sys.finalize();
+
+  for (int s = 0; s < kSamples; ++s) {
+    VecX q(sys.numCoordinates());
+    q.segment(sys.coordinateOffset(a), 3) = rnd.frame();
+    q.segment(sys.coordinateOffset(b), 3) = rnd.frame();
+    for (ConstraintIndex ci : all) {
+      checkConstraintDerivatives(sys, ci, q, "sample " + std::to_string(s));
+    }
+  }
+}
+
+// =====================================================================================
+// 3. Forces
+// =====================================================================================
+
+/// Checks dQ/dq, dQ/dv of force fi against finite differences of addForce.
+void checkForceDerivatives(const System& sys, ForceIndex fi, double t, const VecX& q,
+                           const VecX& v, const std::string& at) {
+  const Force& force = sys.force(fi);
+  const std::vector<int>& cols = sys.forceColumns(fi);
+  const int nl = static_cast<int>(cols.size());
+  const std::string who = force.typeName() + " '" + force.name() + "', " + at;
+  VecX ql(nl), vl(nl);
+  for (int k = 0; k < nl; ++k) {
+    ql[k] = q[cols[k]];
+    vl[k] = v[cols[k]];
+  }
+  auto Q = [&](const VecX& qz, const VecX& vz) {
+    VecX qg = q;
+    for (int k = 0; k < nl; ++k) qg[cols[k]] = qz[k];
+    VecX out = VecX::Zero(nl);
+    force.addForce(t, sys.bodyStates(force.bodies(), qg.data()), vz, out, nullptr, nullptr);
+    return out;
+  };
+  VecX Qj = VecX::Zero(nl);
+  MatX dQdq = MatX::Zero(nl, nl), dQdv = MatX::Zero(nl, nl);
+  force.addForce(t, sys.bodyStates(force.bodies(), q.data()), vl, Qj, &dQdq, &dQdv);
+  // The force itself does not depend on whether Jacobians are requested.
+  EXPECT_TRUE(Qj == Q(ql, vl)) << who;
+  expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, vl); }, ql), kFdTol,
+                   "dQ/dq, " + who);
+  expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return Q(ql, z); }, vl), kFdTol,
+                   "dQ/dv, " + who);
+}
+
+/// Q(q, v = 0) = -dV/dq (a damper exerts no force at rest, so this holds for c > 0 too).
+void checkForceIsEnergyGradient(const System& sys, ForceIndex fi, const VecX& q,
+                                const std::string& at) {
+  const Force& force = sys.force(fi);
+  const std::vector<int>& cols = sys.forceColumns(fi);
+  const int nl = static_cast<int>(cols.size());
+  const std::string who = force.typeName() + " '" + force.name() + "', " + at;
+  VecX ql(nl);
+  for (int k = 0; k < nl; ++k) ql[k] = q[cols[k]];
+  auto withLocal = [&](const VecX& z) {
+    VecX qg = q;
+    for (int k = 0; k < nl; ++k) qg[cols[k]] = z[k];
+    return qg;
+  };
+  VecX Q = VecX::Zero(nl);
+  force.addForce(0.0, sys.bodyStates(force.bodies(), q.data()), VecX::Zero(nl), Q, nullptr,
+                 nullptr);
+  const VecX gradV = fdGradient(
+      [&](const VecX& z) {
+        const VecX qg = withLocal(z);
+        return force.potentialEnergy(sys.bodyStates(force.bodies(), qg.data()));
+      },
+      ql);
+  expectMatrixNear(Q, -gradV, kFdTol, "Q vs -dV/dq, " + who);
+}
+
+struct ForceCase {
+  System sys;
+  BodyIndex a, b;
+  ForceIndex load;
+  std::vector<ForceIndex> all, conservative;
+};
+
+std::unique_ptr<ForceCase> makeForceCase(Random& rnd) {
+  auto fc = std::make_unique<ForceCase>();
+  System& sys = fc->sys;
+  fc->a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
+  fc->b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const BodyIndex a = fc->a, b = fc->b;
+  const std::vector<std::pair<BodyIndex, BodyIndex>> pairs = {{a, b}, {kGround, b}, {a, kGround}};
+  const std::vector<std::string> pairNames = {"a_b", "ground_b", "a_ground"};
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const auto [i, j] = pairs[p];
+    const std::string sfx = "_" + pairNames[p];
+    const Vec2 ui = rnd.vec2(-1.0, 1.0), uj = rnd.vec2(-1.0, 1.0);
+    fc->all.push_back(sys.addForce(
+        std::make_unique<SpringDamper>("spring" + sfx, i, ui, j, uj, 150.0, 4.5, 0.8)));
+    fc->conservative.push_back(sys.addForce(
+        std::make_unique<SpringDamper>("spring0" + sfx, i, uj, j, ui, 90.0, 0.0, 1.3)));
+    fc->all.push_back(sys.addForce(std::make_unique<RotationalSpringDamper>(
+        "torsion" + sfx, i, ui, j, uj, 35.0, 2.5, 0.3)));
+    fc->conservative.push_back(sys.addForce(std::make_unique<RotationalSpringDamper>(
+        "torsion0" + sfx, i, ui, j, uj, 20.0, 0.0, -1.1)));
+  }
+  fc->load = sys.addForce(std::make_unique<AppliedLoad>(
+      "load", b, Vec2(0.7, -0.4), makeHarmonicLaw(3.0, 2.0, 0.4, 1.0),
+      makePolynomialLaw({-2.0, 1.5, 0.5}), makeConstantSpeedLaw(-1.2, 0.8)));
+  fc->all.push_back(fc->load);
+  fc->all.push_back(sys.addForce(std::make_unique<AppliedLoad>(
+      "load_partial", a, Vec2(-0.3, 1.1), nullptr, makeHarmonicLaw(2.0, 1.0), nullptr)));
+  for (ForceIndex f : fc->conservative) fc->all.push_back(f);
+  sys.finalize();
+  return fc;
+}
+
+/// Random q with every spring longer than 0.5 (the spring direction d/l is then smooth
+/// on the finite-difference stencil and its third derivatives stay moderate).
+VecX randomForceConfiguration(Random& rnd, const ForceCase& fc) {
+  const System& sys = fc.sys;
+  for (;;) {
+    VecX q(sys.numCoordinates());
+    q.segment(sys.coordinateOffset(fc.a), 3) = rnd.frame();
+    q.segment(sys.coordinateOffset(fc.b), 3) = rnd.frame();
+    bool ok = true;
+    for (int f = 0; f < sys.numForces(); ++f) {
+      const auto* s = dynamic_cast<const SpringDamper*>(&sys.force(ForceIndex(f)));
+      if (s && s->length(sys.bodyStates(s->bodies(), q.data())) < 0.5) ok = false;
+    }
+    if (ok) return q;
+  }
+}
+
+TEST(ForceJacobians, EveryForceTypeMatchesFiniteDifferences) {
+  Random rnd(kSeed + 20);
+  const auto fc = makeForceCase(rnd);
+  const System& sys = fc->sys;
+  for (int s = 0; s < kSamples; ++s) {
+    const VecX q = randomForceConfiguration(rnd, *fc);
+    const VecX v = rnd.vector(sys.numCoordinates(), -3.0, 3.0);
+    const double t = rnd.uniform(0.0, 3.0);
+    for (ForceIndex f : fc->all) checkForceDerivatives(sys, f, t, q, v, "sample " + std::to_string(s));
+  }
+}
+
+TEST(ForceJacobians, ConservativeForcesAreMinusEnergyGradient) {
+  Random rnd(kSeed + 21);
+  const auto fc = makeForceCase(rnd);
+  const System& sys = fc->sys;
+  for (ForceIndex f : fc->conservative) EXPECT_TRUE(sys.force(f).isConservative()) << sys.force(f).name();
+  for (int s = 0; s < kSamples; ++s) {
+    const VecX q = randomForceConfiguration(rnd, *fc);
+    for (int f = 0; f < sys.numForces(); ++f) {
+      const Force& force = sys.force(ForceIndex(f));
+      if (force.typeName() == "applied_load") continue;  // no potential
+      // c = 0 forces, and damped ones at rest
+      checkForceIsEnergyGradient(sys, ForceIndex(f), q, "sample " + std::to_string(s));
+    }
+  }
+}
+
+TEST(ForceJacobians, AppliedLoadIsTheVirtualWorkOfForceAndTorque) {
+  // Q = [F; (A u) x F + tau] for a rigid body (virtual work of F at r = R + A u and tau).
+  Random rnd(kSeed + 22);
+  const auto fc = makeForceCase(rnd);
+  const System& sys = fc->sys;
+  const ForceIndex load = fc->load;
+  ASSERT_EQ(sys.force(load).name(), "load");
+  const auto F = makeHarmonicLaw(3.0, 2.0, 0.4, 1.0);
+  const auto Fy = makePolynomialLaw({-2.0, 1.5, 0.5});
+  const auto tau = makeConstantSpeedLaw(-1.2, 0.8);
+  const Vec2 u(0.7, -0.4);
+  for (int s = 0; s < kSamples; ++s) {
+    const VecX q = randomForceConfiguration(rnd, *fc);
+    const double t = rnd.uniform(0.0, 3.0);
+    VecX Q = VecX::Zero(3);
+    sys.force(load).addForce(t, sys.bodyStates(sys.force(load).bodies(), q.data()), VecX::Zero(3), Q,
+                             nullptr, nullptr);
+    const double th = q[sys.coordinateOffset(fc->b) + 2];
+    const Vec2 au(std::cos(th) * u.x() - std::sin(th) * u.y(),
+                  std::sin(th) * u.x() + std::cos(th) * u.y());
+    const Vec2 f(F->evaluate(t).f, Fy->evaluate(t).f);
+    const VecX expected = Eigen::Vector3d(f.x(), f.y(), au.x() * f.y() - au.y() * f.x() + tau->evaluate(t).f);
+    expectMatrixNear(Q, expected, kRoundoffTol, "applied load, sample " + std::to_string(s));
+  }
+}
+
+// =====================================================================================
+// 4. DaeSystem
+// =====================================================================================
+
+/// A model with every component: slider-crank with centre-of-mass offsets on a tilted
+/// slide line, driven by a harmonic body-angle driver; a small body welded to the rod;
+/// a spring-damper from ground to the slider; a rotational spring-damper in the crank
+/// pin; an applied load on the rod; gravity; a carriage on a tilted prismatic joint to
+/// ground driven in displacement and an arm hinged on it driven in angle.
+System makeEverythingSystem() {
+  System sys;
+  sys.setGravity(Vec2(0.0, -9.81));
+  const double l1 = 1.0, l2 = 2.0;
+  const double slideAngle = 0.35;
+  const Vec2 slideAxis(std::cos(slideAngle), std::sin(slideAngle));
+  const double crank0 = 0.9;
+  const Vec2 pin(l1 * std::cos(crank0), l1 * std::sin(crank0));
+  // slider on the line s * slideAxis at distance l2 from the pin
+  const double pa = pin.dot(slideAxis);
+  const double sSlider = pa + std::sqrt(l2 * l2 - (pin.squaredNorm() - pa * pa));
+  const Vec2 sliderPos = sSlider * slideAxis;
+  const double rodAngle = std::atan2(sliderPos.y() - pin.y(), sliderPos.x() - pin.x());
+
+  const BodyIndex crank = sys.addRigidBody("crank", {2.0, 0.2, Vec2(0.45, 0.06)},
+                                           {Vec2::Zero(), crank0, Vec2::Zero(), 0.0});
+  const BodyIndex rod = sys.addRigidBody("rod", {3.0, 1.1, Vec2(1.1, -0.12)},
+                                         {pin, rodAngle, Vec2::Zero(), 0.0});
+  const BodyIndex slider = sys.addRigidBody("slider", {1.5, 0.05, Vec2(0.08, 0.03)},
+                                            {sliderPos, slideAngle, Vec2::Zero(), 0.0});
+  const Vec2 weldPoint(1.0, 0.2);
+  const Vec2 weightPos = pin + rotation(rodAngle) * weldPoint;
+  const BodyIndex weight = sys.addRigidBody("weight", {0.3, 0.01, Vec2(0.02, -0.05)},
+                                            {weightPos, rodAngle + 0.5, Vec2::Zero(), 0.0});
+  const ConstraintIndex pivot = sys.addRevoluteJoint("pivot", kGround, Vec2::Zero(), crank, Vec2::Zero());
+  (void)pivot;
+  const ConstraintIndex crankPin = sys.addRevoluteJoint("crank_pin", crank, Vec2(l1, 0.0), rod, Vec2::Zero());
+  sys.addRevoluteJoint("wrist", rod, Vec2(l2, 0.0), slider, Vec2::Zero());
+  sys.addPrismaticJoint("slide", kGround, Vec2::Zero(), slider, Vec2::Zero(), slideAxis);
+  sys.addFixedJoint("weld", rod, weldPoint, weight, Vec2::Zero());
+  sys.addBodyCoordinateDriver("motor", crank, "theta", makeHarmonicLaw(0.4, 3.0, 0.2, crank0));
+
+  const Vec2 carriageAxis(-0.5, 1.0);
+  const BodyIndex carriage = sys.addRigidBody("carriage", {1.2, 0.3, Vec2(-0.1, 0.2)},
+                                              {Vec2(3.0, 1.0), 0.25, Vec2::Zero(), 0.0});
+  const BodyIndex arm = sys.addRigidBody("arm", {0.8, 0.15, Vec2(0.6, 0.05)},
+                                         {Vec2(3.2, 1.1), -0.6, Vec2::Zero(), 0.0});
+  const ConstraintIndex carriageSlide =
+      sys.addPrismaticJoint("carriage_slide", kGround, Vec2(3.0, 1.0), carriage, Vec2::Zero(), carriageAxis);
+  const ConstraintIndex hinge =
+      sys.addRevoluteJoint("hinge", carriage, Vec2(0.2, 0.1), arm, Vec2::Zero());
+  sys.addJointDriver("lift", carriageSlide, makePolynomialLaw({0.0, 0.2, -0.1}));
+  sys.addJointDriver("swing", hinge, makeHarmonicLaw(0.3, 1.5, 0.0, -0.85));
+
+  sys.addSpringDamper("spring", kGround, Vec2(-1.0, 0.5), slider, Vec2(0.1, 0.05), 120.0, 3.0, 1.5);
+  sys.addRotationalSpringDamper("torsion", crankPin, 25.0, 1.5, 0.2);
+  sys.addAppliedLoad("load", rod, Vec2(1.5, 0.1), makeHarmonicLaw(4.0, 2.5, 0.3),
+                     makeConstantLaw(-2.0), makePolynomialLaw({0.5, -0.3}));
+  sys.finalize();
+  return sys;
+}
+
+/// Random state (y, yp) of the DAE; positions anywhere (angles on the whole circle).
+void randomDaeState(Random& rnd, const System& sys, const DaeSystem& dae, VecX& y, VecX& yp) {
+  const DaeLayout& L = dae.layout();
+  for (;;) {
+    y = rnd.vector(L.size, -3.0, 3.0);
+    yp = rnd.vector(L.size, -3.0, 3.0);
+    for (int b = 1; b < sys.numBodies(); ++b) y[L.q + sys.coordinateOffset(BodyIndex(b)) + 2] = rnd.angle();
+    // keep the spring away from zero length (its direction is undefined there)
+    bool ok = true;
+    for (int f = 0; f < sys.numForces(); ++f) {
+      const auto* s = dynamic_cast<const SpringDamper*>(&sys.force(ForceIndex(f)));
+      if (s && s->length(sys.bodyStates(s->bodies(), y.data() + L.q)) < 0.5) ok = false;
+    }
+    if (ok) return;
+  }
+}
+
+/// dF/dy + cj dF/dy' by central differences of the residual.
+MatX fdIterationMatrix(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, double cj) {
+  const int n = dae.layout().size;
+  MatX J(n, n);
+  VecX Fp(n), Fm(n);
+  for (int k = 0; k < n; ++k) {
+    VecX yy = y, ypp = yp;
+    const double hy = fdStep(y[k]);
+    yy[k] = y[k] + hy;
+    dae.residual(t, yy.data(), yp.data(), Fp.data());
+    yy[k] = y[k] - hy;
+    dae.residual(t, yy.data(), yp.data(), Fm.data());
+    J.col(k) = (Fp - Fm) / (2.0 * hy);
+    const double hp = fdStep(yp[k]);
+    ypp[k] = yp[k] + hp;
+    dae.residual(t, y.data(), ypp.data(), Fp.data());
+    ypp[k] = yp[k] - hp;
+    dae.residual(t, y.data(), ypp.data(), Fm.data());
+    J.col(k) += cj * (Fp - Fm) / (2.0 * hp);
+  }
+  return J;
+}
+
+/// Row by row: |A - B| <= tol * max(1, largest entry of the row in A or B) (the rows
+/// of the DAE have very different scales: cj, masses, stiffnesses).
+void expectRowsNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what) {
+  ASSERT_EQ(analytic.rows(), reference.rows());
+  ASSERT_EQ(analytic.cols(), reference.cols());
+  int failures = 0;
+  for (int i = 0; i < analytic.rows(); ++i) {
+    const double scale = std::max({1.0, analytic.row(i).cwiseAbs().maxCoeff(),
+                                   reference.row(i).cwiseAbs().maxCoeff()});
+    for (int j = 0; j < analytic.cols(); ++j) {
+      const double err = std::abs(analytic(i, j) - reference(i, j));
+      if (!(err <= tol * scale) && failures++ < 10) {
+        ADD_FAILURE() << what << ": entry (" << i << ", " << j << ") analytic " << analytic(i, j)
+                      << " vs finite differences " << reference(i, j) << " (row scale " << scale << ")";
+      }
+    }
+  }
+  EXPECT_EQ(failures, 0) << what << ": entries outside tolerance";
+}
+
+class DaeJacobian : public ::testing::TestWithParam<Formulation> {};
+
+TEST_P(DaeJacobian, IterationMatrixMatchesFiniteDifferencesOfResidual) {
+  const System sys = makeEverythingSystem();
+  const DaeSystem dae(sys, GetParam());
+  const int n = dae.layout().size;
+  constexpr double kCj = 7.3;  // any value: the identity holds for every cj
+  Random rnd(kSeed + 30 + static_cast<unsigned>(GetParam()));
+  for (int s = 0; s < kSamples / 2; ++s) {
+    VecX y, yp;
+    randomDaeState(rnd, sys, dae, y, yp);
+    const double t = rnd.uniform(0.0, 2.0);
+    for (const double cj : {kCj, 0.0}) {
+      MatX J = MatX::Zero(n, n);
+      JacobianSink sink = JacobianSink::dense(J.data(), n);
+      dae.jacobian(t, y.data(), yp.data(), cj, sink);
+      expectRowsNear(J, fdIterationMatrix(dae, t, y, yp, cj), kFdTol,
+                     toString(GetParam()) + " dF/dy + cj dF/dy' (cj = " + std::to_string(cj) +
+                         "), sample " + std::to_string(s));
+    }
+  }
+}
+
+TEST_P(DaeJacobian, SparseSinkEqualsDenseSinkAndStaysInPattern) {
+  const System sys = makeEverythingSystem();
+  const DaeSystem dae(sys, GetParam());
+  const SparsePattern& P = dae.pattern();
+  const int n = dae.layout().size;
+  ASSERT_EQ(P.size(), n);
+  Random rnd(kSeed + 40 + static_cast<unsigned>(GetParam()));
+  for (int s = 0; s < kSamples / 2; ++s) {
+    VecX y, yp;
+    randomDaeState(rnd, sys, dae, y, yp);
+    const double t = rnd.uniform(0.0, 2.0);
+    const double cj = 7.3;
+    const std::string at = toString(GetParam()) + ", sample " + std::to_string(s);
+
+    // every entry the assembly writes at this state is in the pattern
+    std::vector<std::pair<int, int>> written;
+    JacobianSink recorder = JacobianSink::recorder(&written);
+    dae.jacobian(t, y.data(), yp.data(), cj, recorder);
+    EXPECT_FALSE(written.empty());
+    for (const auto& [r, c] : written) {
+      EXPECT_GE(P.find(r, c), 0) << at << ": entry (" << r << ", " << c << ") not in the pattern";
+    }
+
+    MatX Jd = MatX::Zero(n, n);
+    JacobianSink dense = JacobianSink::dense(Jd.data(), n);
+    dae.jacobian(t, y.data(), yp.data(), cj, dense);
+
+    std::vector<double> values(static_cast<size_t>(P.nonZeros()), 0.0);
+    JacobianSink sparse = JacobianSink::sparse(values.data(), P);
+    ASSERT_NO_THROW(dae.jacobian(t, y.data(), yp.data(), cj, sparse)) << at;
+    MatX Js = MatX::Zero(n, n);
+    for (int c = 0; c < n; ++c) {
+      for (int64_t k = P.colStart()[c]; k < P.colStart()[c + 1]; ++k) {
+        Js(static_cast<int>(P.rowIndex()[k]), c) = values[static_cast<size_t>(k)];
+      }
+    }
+    int mismatches = 0;
+    for (int c = 0; c < n; ++c) {
+      for (int r = 0; r < n; ++r) {
+        if (Js(r, c) != Jd(r, c) && mismatches++ < 10) {
+          ADD_FAILURE() << at << ": (" << r << ", " << c << ") sparse " << Js(r, c) << " dense "
+                        << Jd(r, c);
+        }
+      }
+    }
+    EXPECT_EQ(mismatches, 0) << at;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Formulations, DaeJacobian,
+                         ::testing::Values(Formulation::Ggl, Formulation::Index3, Formulation::Index1),
+                         [](const ::testing::TestParamInfo<Formulation>& info) {
+                           return toString(info.param);
+                         });
+
+}  // namespace
+}  // namespace flexmbd
