@@ -1,5 +1,6 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]
+//   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "app/kinematics_command.hpp"
 #include "core/errors.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
@@ -35,6 +37,8 @@ constexpr int kExitInputError = 2;
 
 const char* const kUsage =
     "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]\n"
+    "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
+    "                          [--corrector newton|modified_newton]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -50,8 +54,15 @@ const char* const kUsage =
     "  --quiet, -q  no progress display\n"
     "  --help, -h   this text\n"
     "\n"
-    "exit status: 0 success; 1 solver failure during the run (results up to the failure\n"
-    "are kept); 2 invalid command line, scene or model (nothing is integrated).\n";
+    "kinematics analyses the linkage of SCENE.json (see docs/kinematics.md) step by step in\n"
+    "its input and writes DIR/kinematics.csv (positions, transfer functions, velocities,\n"
+    "accelerations, corrector iterations and residual per step) and DIR/summary.json.\n"
+    "options of kinematics: --out DIR (required); --steps N, --tolerance T, --corrector C\n"
+    "override analysis.steps, .tolerance, .corrector of the scene.\n"
+    "\n"
+    "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
+    "singular position (results up to there are kept); 2 invalid command line, scene or\n"
+    "model (nothing is integrated).\n";
 
 /// A bad command line (exit status 2).
 struct UsageError : std::runtime_error {
@@ -119,7 +130,7 @@ Options parseCommandLine(int argc, char** argv) {
     return o;
   }
   if (args[0] != "run") {
-    throw UsageError("unknown command '" + args[0] + "' (expected 'run', '--help' or '--version')");
+    throw UsageError("unknown command '" + args[0] + "' (expected 'run', 'kinematics', '--help' or '--version')");
   }
   std::vector<std::string> positional;
   for (std::size_t k = 1; k < args.size(); ++k) {
@@ -267,6 +278,12 @@ int runCommand(const Options& o) {
 }
 
 int mainImpl(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "kinematics") {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return runKinematicsCommand(rest);  // same exit statuses 0/1/2
+  }
   Options o;
   try {
     o = parseCommandLine(argc, argv);

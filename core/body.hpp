@@ -38,6 +38,10 @@ class Body {
   virtual int numCoordinates() const = 0;
   /// Names of the coordinates, as they appear in results files ("x", "y", "theta").
   virtual std::vector<std::string> coordinateNames() const = 0;
+  /// The first numFrameCoordinates() coordinates describe the reference (rigid) motion;
+  /// the rest are elastic. Consistent initialisation keeps the given elastic values and
+  /// moves the frame coordinates (a body is not deformed to assemble the mechanism).
+  virtual int numFrameCoordinates() const { return numCoordinates(); }
   /// Coordinates and velocities given at construction (initial guess).
   virtual VecX initialCoordinates() const = 0;
   virtual VecX initialVelocities() const = 0;

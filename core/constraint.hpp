@@ -36,6 +36,9 @@ class Constraint {
   /// The bodies whose coordinates enter h (ground included where it takes part).
   const std::vector<BodyIndex>& bodies() const { return bodies_; }
 
+  /// Body points the constraint attaches to (checked by System::finalize()).
+  virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
+
   virtual int numEquations() const = 0;
   /// "revolute", "prismatic", "fixed", "body_coordinate", "joint_angle", ...
   virtual std::string typeName() const = 0;

@@ -21,6 +21,8 @@ class Force {
   const std::string& name() const { return name_; }
   const std::vector<BodyIndex>& bodies() const { return bodies_; }
   virtual std::string typeName() const = 0;
+  /// Body points the force attaches to (checked by System::finalize()).
+  virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
 
   /// Q += generalised force; if dQdq / dQdv are given, they receive += its derivatives.
   virtual void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v,

@@ -207,6 +207,14 @@ ConstraintIndex System::findConstraint(const std::string& name) const {
 
 void System::finalize() {
   requireBuildPhase("finalize twice");
+  for (const auto& c : constraints_) {
+    for (const auto& [b, p] : c->attachments()) {
+      body(b).checkAttachmentPoint(p, (c->isDriver() ? "driver '" : "joint '") + c->name() + "'");
+    }
+  }
+  for (const auto& f : forces_) {
+    for (const auto& [b, p] : f->attachments()) body(b).checkAttachmentPoint(p, "force '" + f->name() + "'");
+  }
   bodyOffset_.clear();
   nq_ = 0;
   for (const auto& b : bodies_) {
@@ -256,6 +264,15 @@ std::vector<BodyState> System::bodyStates(const std::vector<BodyIndex>& bs, cons
   out.reserve(bs.size());
   for (BodyIndex b : bs) out.emplace_back(body(b), q + bodyOffset_[b.value]);
   return out;
+}
+
+std::vector<int> System::frameCoordinates() const {
+  requireFinalized("frameCoordinates");
+  std::vector<int> idx;
+  for (int b = 0; b < numBodies(); ++b) {
+    for (int k = 0; k < bodies_[b]->numFrameCoordinates(); ++k) idx.push_back(bodyOffset_[b] + k);
+  }
+  return idx;
 }
 
 std::vector<std::string> System::coordinateNames() const {

@@ -86,6 +86,8 @@ class System {
   VecX initialVelocities() const;
   /// Views of the given bodies at the global coordinates q (size nq).
   std::vector<BodyState> bodyStates(const std::vector<BodyIndex>& bodies, const double* q) const;
+  /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
+  std::vector<int> frameCoordinates() const;
   /// "crank.x", ... for every coordinate, in order.
   std::vector<std::string> coordinateNames() const;
 

@@ -15,6 +15,7 @@ class AppliedLoad final : public Force {
   void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
                 MatX* dQdq, MatX* dQdv) const override;
   bool isConservative() const override { return false; }
+  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override { return {{bodies()[0], point_}}; }
 
  private:
   Vec2 point_;

@@ -17,6 +17,9 @@ class RotationalSpringDamper final : public Force {
                 MatX* dQdq, MatX* dQdv) const override;
   double potentialEnergy(const std::vector<BodyState>& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0; }
+  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
+    return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
+  }
 
  private:
   Vec2 pointI_, pointJ_;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
 
 namespace flexmbd {
@@ -29,37 +30,18 @@ std::string constraintOfRow(const System& sys, int row) {
 }
 
 void throwIfRedundant(const System& sys, const MatX& G) {
-  const std::vector<int> rows = dependentConstraintRows(G);
+  const std::vector<int> rows = dependentRows(G);
   if (rows.empty()) return;
   std::ostringstream os;
   os << "redundant or conflicting constraints: ";
   for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << constraintOfRow(sys, rows[k]);
   os << (rows.size() == 1 ? " depends" : " depend")
-     << " on the joints and drivers defined before (the constraint Jacobian loses rank); remove "
-        "it or free a coordinate";
+     << " on the joints and drivers defined before (the constraint Jacobian loses rank at the given "
+        "positions); remove it or free a coordinate, or start away from a singular position";
   throw ModelError(os.str());
 }
 
 }  // namespace
-
-std::vector<int> dependentConstraintRows(const MatX& G, double rankTolerance) {
-  // Modified Gram-Schmidt on the rows, in order: a row whose component orthogonal to
-  // the earlier rows is below rankTolerance times its own norm is dependent.
-  std::vector<int> dependent;
-  std::vector<VecX> basis;
-  for (int i = 0; i < G.rows(); ++i) {
-    VecX r = G.row(i).transpose();
-    const double norm0 = r.norm();
-    for (const VecX& b : basis) r -= b.dot(r) * b;
-    const double rn = r.norm();
-    if (norm0 == 0.0 || rn <= rankTolerance * norm0) {
-      dependent.push_back(i);
-    } else {
-      basis.push_back(r / rn);
-    }
-  }
-  return dependent;
-}
 
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
   const int n = static_cast<int>(M.rows()), m = static_cast<int>(G.rows());
@@ -116,15 +98,28 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
   evaluateConstraints(sys, s.q, t0, &g, &G);
   // Redundancy is a property of the model: check it where the user put it.
   throwIfRedundant(sys, G);
+  // Elastic coordinates keep their given values when the frame coordinates alone can
+  // satisfy the constraints (a body is not deformed, nor set vibrating, to assemble the
+  // mechanism); otherwise every coordinate takes part.
+  std::vector<int> cols = sys.frameCoordinates();
+  const auto restrictCols = [&](const MatX& A) {
+    MatX B(A.rows(), cols.size());
+    for (size_t k = 0; k < cols.size(); ++k) B.col(k) = A.col(cols[k]);
+    return B;
+  };
+  if (static_cast<int>(cols.size()) < nq && dependentRows(restrictCols(G)).size() > 0) {
+    cols.resize(nq);
+    for (int k = 0; k < nq; ++k) cols[k] = k;
+  }
   // 1. Newton with minimum-norm corrections: dq = -G^+ g.
   const double scale = 1.0 + s.q.lpNorm<Eigen::Infinity>();
   const double tol = 1e-13 * scale;
   int it = 0;
   for (; it < kMaxProjectionIterations && m > 0 && g.lpNorm<Eigen::Infinity>() > tol; ++it) {
-    const Eigen::CompleteOrthogonalDecomposition<MatX> cod(G);
+    const Eigen::CompleteOrthogonalDecomposition<MatX> cod(restrictCols(G));
     const VecX dq = -cod.solve(g);
     if (!dq.allFinite()) break;
-    s.q += dq;
+    for (size_t k = 0; k < cols.size(); ++k) s.q[cols[k]] += dq[k];
     evaluateConstraints(sys, s.q, t0, &g, &G);
   }
   s.positionIterations = it;
@@ -145,11 +140,24 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
   }
   // The rank may drop on the way (a singular position): check again where we arrived.
   throwIfRedundant(sys, G);
-  // 2. Velocities: min (v - v0)^T M (v - v0) subject to G v = f'(t0).
+  // 2. Velocities: min (v - v0)^T M (v - v0) subject to G v = f'(t0), over the same
+  //    coordinates as the positions (elastic velocities kept at their given values).
   const MatX M = massMatrix(sys, s.q);
   const VecX df = -velocityConstraintResidual(sys, s.q, VecX::Zero(nq), t0);  // = f'(t0)
-  VecX nu;
-  solveAugmented(M, G, M * v0, df, s.v, nu);
+  s.v = v0;
+  {
+    MatX Mr(cols.size(), cols.size());
+    VecX v0r(cols.size());
+    for (size_t i = 0; i < cols.size(); ++i) {
+      v0r[i] = v0[cols[i]];
+      for (size_t j = 0; j < cols.size(); ++j) Mr(i, j) = M(cols[i], cols[j]);
+    }
+    VecX vr, nu;
+    VecX keptVelocities = v0;  // contribution of the coordinates that stay fixed
+    for (int c : cols) keptVelocities[c] = 0.0;
+    solveAugmented(Mr, restrictCols(G), Mr * v0r, df - G * keptVelocities, vr, nu);
+    for (size_t k = 0; k < cols.size(); ++k) s.v[cols[k]] = vr[k];
+  }
   // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v.
   computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
   return s;

@@ -1,6 +1,7 @@
 // Consistent initial values for the constrained equations of motion.
 #pragma once
 
+#include "core/linear_algebra.hpp"
 #include "core/system.hpp"
 
 namespace flexmbd {
@@ -19,10 +20,6 @@ struct ConsistentState {
 /// be assembled (remaining residual and the joints that carry it).
 ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0,
                                        const VecX& v0);
-
-/// Indices of the constraint equations that are linearly dependent on earlier ones
-/// (modified Gram-Schmidt on the rows of G, relative tolerance rankTolerance).
-std::vector<int> dependentConstraintRows(const MatX& G, double rankTolerance = 1e-9);
 
 /// Solves [M G^T; G 0][x; y] = [r1; r2]. @throws ModelError if it is singular.
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);

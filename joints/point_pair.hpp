@@ -45,6 +45,9 @@ class TwoPointConstraint : public Constraint {
                      const Vec2& pointJ);
   const Vec2& pointI() const { return pointI_; }
   const Vec2& pointJ() const { return pointJ_; }
+  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
+    return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
+  }
 
  protected:
   PointPair pair(const std::vector<BodyState>& bodies) const;

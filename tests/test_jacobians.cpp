@@ -11,6 +11,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <ostream>
 #include <random>
 #include <sstream>
 #include <string>
@@ -238,12 +239,6 @@ TEST(RigidBodyJacobians, GravityJacobianAndPotential) {
 // =====================================================================================
 // 2. Constraints
 // =====================================================================================
-
-/// A system with two free rigid bodies "a" and "b" and the given constraints.
-struct ConstraintCase {
-  System sys;
-  BodyIndex a, b;
-};
 
 /// Checks h, G and the Hessians of constraint ci at the global coordinates q.
 void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const VecX& q,

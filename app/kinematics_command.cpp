@@ -1,0 +1,272 @@
+#include "app/kinematics_command.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "integrators/kinematic_analysis.hpp"
+#include "io/kinematics_scene.hpp"
+
+namespace flexmbd {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kExitOk = 0;
+constexpr int kExitStopped = 1;
+constexpr int kExitInputError = 2;
+
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  std::string scenePath, outDir;
+  std::optional<long> steps;
+  std::optional<double> tolerance;
+  std::optional<std::string> corrector;
+};
+
+std::string oneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+void printError(const std::string& m) { std::cerr << "flexmbd: error: " << oneLine(m) << std::endl; }
+
+Options parseOptions(const std::vector<std::string>& args) {
+  Options o;
+  std::vector<std::string> positional;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (a.size() < 2 || a[0] != '-') {
+      positional.push_back(a);
+      continue;
+    }
+    std::string name = a, value;
+    bool haveValue = false;
+    if (const auto eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = a.substr(0, eq);
+      value = a.substr(eq + 1);
+      haveValue = true;
+    }
+    if (name != "--out" && name != "--steps" && name != "--tolerance" && name != "--corrector") {
+      throw UsageError("kinematics: unknown option '" + name +
+                       "' (known options: --out, --steps, --tolerance, --corrector, --help)");
+    }
+    if (!haveValue) {
+      if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
+      value = args[++k];
+    }
+    if (name == "--out") {
+      if (value.empty()) throw UsageError("option --out needs a directory");
+      o.outDir = value;
+    } else if (name == "--corrector") {
+      if (value != "newton" && value != "modified_newton") {
+        throw UsageError("option --corrector expects 'newton' or 'modified_newton', got '" + value + "'");
+      }
+      o.corrector = value;
+    } else {
+      char* end = nullptr;
+      const double x = std::strtod(value.c_str(), &end);
+      if (value.empty() || *end != '\0' || !std::isfinite(x)) {
+        throw UsageError("option " + name + " expects a finite number, got '" + value + "'");
+      }
+      if (name == "--steps") {
+        if (x != std::floor(x) || x < 1 || x > 1e8) throw UsageError("option --steps expects an integer >= 1, got '" + value + "'");
+        o.steps = static_cast<long>(x);
+      } else {
+        if (!(x > 0)) throw UsageError("option --tolerance must be > 0, got '" + value + "'");
+        o.tolerance = x;
+      }
+    }
+  }
+  if (positional.empty()) throw UsageError("kinematics: missing the scene file (flexmbd kinematics SCENE.json --out DIR)");
+  if (positional.size() > 1) {
+    throw UsageError("kinematics: expected one scene file, got " + std::to_string(positional.size()) + " arguments ('" +
+                     positional[0] + "', '" + positional[1] + "', ...)");
+  }
+  o.scenePath = positional[0];
+  if (o.outDir.empty()) throw UsageError("kinematics: missing --out DIR (the output directory)");
+  return o;
+}
+
+/// DIR/kinematics.csv, one row per input step, flushed row by row (kept on a stop).
+class KinematicsWriter {
+ public:
+  KinematicsWriter(const fs::path& path, const Linkage2d& linkage) : linkage_(linkage), out_(path) {
+    if (!out_) throw std::runtime_error("cannot write '" + path.string() + "'");
+    out_.precision(17);
+    out_ << "step,alpha,iterations,residual,rcond";
+    for (int i = 0; i < linkage.numInputs(); ++i) out_ << ',' << linkage.input(InputIndex(i)).name;
+    for (int i = 0; i < linkage.numNodes(); ++i) {
+      const std::string& n = linkage.node(NodeIndex(i)).name;
+      for (const char* c : {".x", ".y", ".dx_da", ".dy_da", ".d2x_da2", ".d2y_da2", ".vx", ".vy", ".ax", ".ay"}) {
+        out_ << ',' << n << c;
+      }
+    }
+    for (int k = 0; k < linkage.numLinks(); ++k) {
+      const std::string& n = linkage.link(LinkIndex(k)).name;
+      for (const char* c : {".angle", ".dangle_da", ".d2angle_da2", ".omega", ".omega_dot"}) out_ << ',' << n << c;
+    }
+    out_ << '\n';
+  }
+
+  void write(const KinematicState& s) {
+    out_ << s.step << ',' << s.alpha << ',' << s.iterations << ',' << s.residual << ',' << s.rcond;
+    for (int i = 0; i < linkage_.numInputs(); ++i) out_ << ',' << s.x[linkage_.input(InputIndex(i)).coordinate];
+    for (int i = 0; i < linkage_.numNodes(); ++i) {
+      const NodeIndex n(i);
+      const Vec2 r = linkage_.nodePosition(n, s.x), rp = linkage_.nodeDerivative(n, s.xp),
+                 rpp = linkage_.nodeDerivative(n, s.xpp), v = linkage_.nodeDerivative(n, s.v),
+                 a = linkage_.nodeDerivative(n, s.a);
+      for (const Vec2* p : {&r, &rp, &rpp, &v, &a}) out_ << ',' << p->x() << ',' << p->y();
+    }
+    for (int k = 0; k < linkage_.numLinks(); ++k) {
+      const int c = linkage_.link(LinkIndex(k)).offset;  // beta1: the link's angle when rigid
+      out_ << ',' << s.x[c] << ',' << s.xp[c] << ',' << s.xpp[c] << ',' << s.v[c] << ',' << s.a[c];
+    }
+    out_ << '\n';
+    out_.flush();
+    if (!out_) throw std::runtime_error("cannot write the kinematics results");
+  }
+
+ private:
+  const Linkage2d& linkage_;
+  std::ofstream out_;
+};
+
+void writeJson(const fs::path& dir, const nlohmann::json& j) {
+  const fs::path tmp = dir / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << j.dump(2) << '\n';
+    if (!out) throw std::runtime_error("cannot write '" + tmp.string() + "'");
+  }
+  fs::rename(tmp, dir / "summary.json");
+}
+
+void removeStale(const fs::path& dir) {
+  std::error_code ec;
+  fs::remove(dir / "kinematics.csv", ec);
+  fs::remove(dir / "summary.json", ec);
+}
+
+int reportInputError(const fs::path& outDir, const std::string& message) {
+  try {
+    fs::create_directories(outDir);
+    removeStale(outDir);
+    writeJson(outDir, {{"status", "failed"}, {"error", "input"}, {"message", oneLine(message)}});
+  } catch (...) {
+  }
+  printError(message);
+  return kExitInputError;
+}
+
+}  // namespace
+
+int runKinematicsCommand(const std::vector<std::string>& args) {
+  Options o;
+  try {
+    o = parseOptions(args);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
+  const fs::path outDir(o.outDir);
+  std::error_code ec;
+  if (fs::exists(outDir, ec) && !fs::is_directory(outDir, ec)) {
+    printError("--out '" + o.outDir + "' exists and is not a directory");
+    return kExitInputError;
+  }
+
+  std::optional<KinematicsScene> scene;
+  std::optional<KinematicAnalysis> analysis;
+  try {
+    scene.emplace(loadKinematicsScene(o.scenePath));
+    if (o.steps) scene->settings.steps = static_cast<int>(*o.steps);
+    if (o.tolerance) scene->settings.tolerance = *o.tolerance;
+    if (o.corrector) {
+      scene->settings.corrector = *o.corrector == "newton" ? CorrectorKind::Newton : CorrectorKind::ModifiedNewton;
+    }
+    analysis.emplace(scene->linkage, scene->settings);  // assembly at alpha = start
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    return reportInputError(outDir, m.rfind(o.scenePath, 0) == 0 ? m : o.scenePath + ": " + m);
+  }
+
+  std::optional<KinematicsWriter> writer;
+  try {
+    fs::create_directories(outDir);
+    removeStale(outDir);
+    writer.emplace(outDir / "kinematics.csv", scene->linkage);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
+
+  KinematicSummary summary;
+  int minIt = 0, maxIt = 0;
+  summary = analysis->run([&](const KinematicState& s) { writer->write(s); });
+  minIt = summary.minIterations;
+  maxIt = summary.maxIterations;
+
+  const KinematicSettings& st = scene->settings;
+  nlohmann::json j;
+  j["status"] = summary.ok ? "ok" : "failed";
+  j["message"] = summary.message;
+  j["scene"] = scene->name;
+  j["mobility"] = scene->linkage.mobility();
+  j["coordinates"] = scene->linkage.numCoordinates();
+  j["steps"] = st.steps;
+  j["steps_completed"] = summary.stepsCompleted - 1;
+  j["alpha_start"] = st.start;
+  j["alpha_end"] = st.end;
+  j["alpha_reached"] = summary.alphaReached;
+  j["speed"] = st.speed;
+  j["acceleration"] = st.acceleration;
+  j["tolerance"] = st.tolerance;
+  j["corrector"] = st.corrector == CorrectorKind::Newton ? "newton" : "modified_newton";
+  j["assembly_iterations"] = summary.assemblyIterations;
+  j["iterations_min"] = minIt;
+  j["iterations_max"] = maxIt;
+  j["iterations_mean"] = summary.meanIterations;
+  j["max_residual"] = summary.maxResidual;
+  j["wall_seconds"] = summary.wallSeconds;
+  j["seconds_per_step"] = summary.stepsCompleted > 0 ? summary.wallSeconds / summary.stepsCompleted : 0.0;
+  if (summary.singular) {
+    const SingularPosition& s = *summary.singular;
+    j["singular"] = {{"kind", s.kind},       {"alpha", s.alpha}, {"alpha_regular", s.alphaRegular},
+                     {"alpha_beyond", s.alphaBeyond}, {"nodes", s.nodes}, {"links", s.links}};
+  } else {
+    j["singular"] = nullptr;
+  }
+  try {
+    writeJson(outDir, j);
+  } catch (const std::exception& e) {
+    printError(std::string("cannot write the summary: ") + e.what());
+    return kExitStopped;
+  }
+  const fs::path csv = outDir / "kinematics.csv";
+  if (!summary.ok) {
+    printError(o.scenePath + ": " + summary.message + " (" + csv.string() + ")");
+    return kExitStopped;
+  }
+  std::cout << "flexmbd: ok: alpha = " << summary.alphaReached << " reached in " << st.steps << " steps, iterations "
+            << minIt << "-" << maxIt << " per step, max residual " << summary.maxResidual << "; results in "
+            << csv.string() << std::endl;
+  return kExitOk;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,273 @@
+#include "bodies/ffr_beam_model.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <numeric>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
+
+namespace flexmbd {
+namespace {
+
+int dof(int node, int k) { return 3 * node + k; }
+
+std::string nodeDofName(int row) {
+  static const char* names[3] = {"u_x", "u_y", "psi"};
+  return std::string(names[row % 3]) + " of node " + std::to_string(row / 3);
+}
+
+}  // namespace
+
+BeamMesh2d BeamMesh2d::straight(double length, int numElements, const BeamSection& section,
+                                const Vec2& origin) {
+  if (numElements < 1) throw InputError("beam mesh: elements must be >= 1, got " + std::to_string(numElements));
+  requirePositive(length, "beam mesh: length");
+  BeamMesh2d m;
+  for (int i = 0; i <= numElements; ++i) m.nodes.push_back(origin + Vec2(length * i / numElements, 0.0));
+  for (int i = 0; i < numElements; ++i) m.elements.push_back({i, i + 1, section});
+  return m;
+}
+
+FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const std::string& owner)
+    : mesh_(std::move(mesh)), options_(options) {
+  const int nn = static_cast<int>(mesh_.nodes.size());
+  if (mesh_.elements.empty()) throw InputError(owner + ": the beam mesh has no elements");
+  // every node used, the mesh connected (union-find)
+  std::vector<int> parent(nn);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::vector<bool> used(nn, false);
+  for (size_t e = 0; e < mesh_.elements.size(); ++e) {
+    const auto& el = mesh_.elements[e];
+    const std::string who = owner + ": element " + std::to_string(e);
+    for (int n : {el.node1, el.node2}) {
+      if (n < 0 || n >= nn) {
+        throw InputError(who + ": node " + std::to_string(n) + " does not exist (nodes 0.." + std::to_string(nn - 1) + ")");
+      }
+      used[n] = true;
+    }
+    if (el.node1 == el.node2) throw InputError(who + ": both ends are node " + std::to_string(el.node1));
+    parent[find(el.node1)] = find(el.node2);
+    elements_.emplace_back(mesh_.nodes[el.node1], mesh_.nodes[el.node2], el.section, who);
+  }
+  for (int n = 0; n < nn; ++n) {
+    if (!used[n]) throw InputError(owner + ": node " + std::to_string(n) + " belongs to no element");
+    if (find(n) != find(0)) throw InputError(owner + ": the mesh is not connected (node " + std::to_string(n) + " is cut off from node 0)");
+  }
+
+  // ----- nodal invariants (3 coordinates per node) --------------------------------
+  const int nd = 3 * nn;
+  FfrInvariants nodal;
+  nodal.sBar = Mat2X::Zero(2, nd);
+  nodal.i1 = VecX::Zero(nd);
+  nodal.j0 = VecX::Zero(nd);
+  nodal.mff = MatX::Zero(nd, nd);
+  nodal.sTilde = MatX::Zero(nd, nd);
+  nodal.kff = MatX::Zero(nd, nd);
+  nodal.dff = MatX::Zero(nd, nd);
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const BeamElement2d& el = elements_[e];
+    const auto& T = el.transformation();
+    const Mat2 R = rotation(el.angle());
+    const Vec2 XA = el.start();
+    const Vec2 RtX = R.transpose() * XA;
+    const double l = el.length(), rhoA = el.section().massPerLength();
+    nodal.mass += el.mass();
+    nodal.firstMoment += el.mass() * (XA + R * Vec2(0.5 * l, 0.0));
+    // int rho |X_A + R [x, 0]|^2 dx
+    nodal.polarMoment += rhoA * (l * XA.squaredNorm() + l * l * XA.dot(R.col(0)) + l * l * l / 3.0);
+    const int idx[6] = {dof(mesh_.elements[e].node1, 0), dof(mesh_.elements[e].node1, 1), dof(mesh_.elements[e].node1, 2),
+                        dof(mesh_.elements[e].node2, 0), dof(mesh_.elements[e].node2, 1), dof(mesh_.elements[e].node2, 2)};
+    const Eigen::Matrix<double, 2, 6> sb = R * el.sBar() * T;  // int rho N dV, N = R S T
+    // int rho N^T u0 = T^T (S-bar^T R^T X_A + int rho x S_x^T dx)
+    const BeamElement2d::Vec6 i1 = T.transpose() * (el.sBar().transpose() * RtX + el.sX().row(0).transpose());
+    // int rho N^T S u0 = T^T (S-bar^T S R^T X_A + int rho x S_y^T dx)
+    const BeamElement2d::Vec6 j0 = T.transpose() * (el.sBar().transpose() * perp(RtX) + el.sX().row(1).transpose());
+    const BeamElement2d::Mat6 m = T.transpose() * (el.sXX() + el.sYY()) * T;
+    const BeamElement2d::Mat6 st = T.transpose() * (el.sXY() - el.sXY().transpose()) * T;
+    const BeamElement2d::Mat6 k = T.transpose() * el.stiffness() * T;
+    for (int a = 0; a < 6; ++a) {
+      nodal.sBar.col(idx[a]) += sb.col(a);
+      nodal.i1[idx[a]] += i1[a];
+      nodal.j0[idx[a]] += j0[a];
+      for (int b = 0; b < 6; ++b) {
+        nodal.mff(idx[a], idx[b]) += m(a, b);
+        nodal.sTilde(idx[a], idx[b]) += st(a, b);
+        nodal.kff(idx[a], idx[b]) += k(a, b);
+        nodal.dff(idx[a], idx[b]) += el.section().damping * k(a, b);
+      }
+    }
+  }
+
+  // ----- reference conditions: rows C of C q_n = 0, then B2 = null(C) -------------
+  const ReferenceConditions& rc = options_.reference;
+  auto checkNode = [&](int n, const char* which) {
+    if (n < 0 || n >= nn) {
+      throw InputError(owner + ": reference " + which + " " + std::to_string(n) + " does not exist (nodes 0.." +
+                       std::to_string(nn - 1) + ")");
+    }
+  };
+  MatX C;
+  std::vector<std::string> rowNames;
+  switch (rc.type) {
+    case ReferenceConditions::Type::PinnedPinned: {
+      const int a = rc.nodeA, b = rc.nodeB < 0 ? nn - 1 : rc.nodeB;
+      checkNode(a, "node");
+      checkNode(b, "node");
+      if (a == b) throw InputError(owner + ": pinned_pinned reference needs two different nodes");
+      const Vec2 chord = mesh_.nodes[b] - mesh_.nodes[a];
+      const Vec2 n = perp(chord.normalized());
+      C = MatX::Zero(3, nd);
+      C(0, dof(a, 0)) = 1.0;
+      C(1, dof(a, 1)) = 1.0;
+      C(2, dof(b, 0)) = n.x();
+      C(2, dof(b, 1)) = n.y();
+      rowNames = {"u_x of node " + std::to_string(a), "u_y of node " + std::to_string(a),
+                  "transverse displacement of node " + std::to_string(b)};
+      break;
+    }
+    case ReferenceConditions::Type::Clamped: {
+      checkNode(rc.nodeA, "node");
+      C = MatX::Zero(3, nd);
+      for (int k = 0; k < 3; ++k) {
+        C(k, dof(rc.nodeA, k)) = 1.0;
+        rowNames.push_back(nodeDofName(dof(rc.nodeA, k)));
+      }
+      break;
+    }
+    case ReferenceConditions::Type::FreeFree: {
+      C = MatX::Zero(3, nd);
+      C.topRows(2) = nodal.sBar;           // int rho u_f dV = 0
+      C.row(2) = nodal.j0.transpose();     // int rho u0 x u_f dV = 0 (mean axis)
+      rowNames = {"mean-axis x", "mean-axis y", "mean-axis rotation"};
+      break;
+    }
+  }
+  const std::vector<int> dep = dependentRows(C);
+  if (!dep.empty()) {
+    throw InputError(owner + ": the reference conditions over-constrain the body: condition '" + rowNames[dep[0]] +
+                     "' repeats the others");
+  }
+  MatX B = nullSpaceBasis(C);
+
+  // ----- modal reduction -----------------------------------------------------------
+  FfrInvariants reduced = nodal.transformed(B);
+  if (options_.modes > 0 || !options_.modeSet.empty()) {
+    if (Eigen::LLT<MatX>(reduced.kff).info() != Eigen::Success) reduced.validate(owner);  // names the rigid mode
+    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(reduced.kff, reduced.mff);
+    const int available = static_cast<int>(eig.eigenvalues().size());
+    std::vector<int> keep;
+    if (!options_.modeSet.empty()) {
+      keep = options_.modeSet;
+    } else {
+      for (int k = 1; k <= options_.modes; ++k) keep.push_back(k);
+    }
+    MatX Phi(B.cols(), keep.size());
+    for (size_t k = 0; k < keep.size(); ++k) {
+      if (keep[k] < 1 || keep[k] > available) {
+        throw InputError(owner + ": mode " + std::to_string(keep[k]) + " does not exist (the mesh has modes 1.." +
+                         std::to_string(available) + ")");
+      }
+      Phi.col(k) = eig.eigenvectors().col(keep[k] - 1);  // mass-normalised
+    }
+    B = B * Phi;
+  }
+  basis_ = B;
+  invariants_ = nodal.transformed(B);
+  invariants_.points.clear();
+  for (int n = 0; n < nn; ++n) {
+    FfrPoint p;
+    p.position = mesh_.nodes[n];
+    p.shape = basis_.middleRows(dof(n, 0), 2);
+    p.rotationShape = basis_.row(dof(n, 2));
+    invariants_.points.push_back(p);
+  }
+  invariants_.validate(owner);
+}
+
+VecX FfrBeamModel::naturalFrequencies() const {
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(invariants_.kff, invariants_.mff,
+                                                           Eigen::EigenvaluesOnly);
+  return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+}
+
+Eigen::Matrix<double, 6, Eigen::Dynamic> FfrBeamModel::elementBasis(int e) const {
+  const auto& el = mesh_.elements[e];
+  Eigen::Matrix<double, 6, Eigen::Dynamic> Be(6, basis_.cols());
+  Be.topRows(3) = basis_.middleRows(dof(el.node1, 0), 3);
+  Be.bottomRows(3) = basis_.middleRows(dof(el.node2, 0), 3);
+  return Be;
+}
+
+double FfrBeamModel::strainEnergy(const VecX& qf) const {
+  if (!options_.geometricStiffening) return 0.5 * qf.dot(invariants_.kff * qf);
+  double U = 0.0;
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const BeamElement2d::Vec6 ee = elements_[e].transformation() * (elementBasis(e) * qf);
+    U += elements_[e].strainEnergy(ee, true);
+  }
+  return U;
+}
+
+VecX FfrBeamModel::strainEnergyGradient(const VecX& qf) const {
+  if (!options_.geometricStiffening) return invariants_.kff * qf;
+  VecX g = VecX::Zero(qf.size());
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const auto Be = elementBasis(e);
+    const auto& T = elements_[e].transformation();
+    const BeamElement2d::Vec6 ee = T * (Be * qf);
+    g += Be.transpose() * (T.transpose() * elements_[e].strainEnergyGradient(ee, true));
+  }
+  return g;
+}
+
+MatX FfrBeamModel::strainEnergyHessian(const VecX& qf) const {
+  if (!options_.geometricStiffening) return invariants_.kff;
+  MatX H = MatX::Zero(qf.size(), qf.size());
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const auto Be = elementBasis(e);
+    const auto& T = elements_[e].transformation();
+    const BeamElement2d::Vec6 ee = T * (Be * qf);
+    const Eigen::Matrix<double, 6, Eigen::Dynamic> TB = T * Be;
+    H += TB.transpose() * elements_[e].strainEnergyHessian(ee, true) * TB;
+  }
+  return H;
+}
+
+bool FfrBeamModel::locate(const Vec2& point, int& element, double& xi) const {
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const auto& el = elements_[e];
+    const Vec2 local = rotation(el.angle()).transpose() * (point - el.start());
+    const double tol = 1e-9 * el.length();
+    if (std::abs(local.y()) <= tol && local.x() >= -tol && local.x() <= el.length() + tol) {
+      element = static_cast<int>(e);
+      xi = std::clamp(local.x() / el.length(), 0.0, 1.0);
+      return true;
+    }
+  }
+  return false;
+}
+
+FfrPoint FfrBeamModel::materialPoint(int e, double xi) const {
+  const BeamElement2d& el = elements_.at(e);
+  const Mat2 R = rotation(el.angle());
+  const Eigen::Matrix<double, 6, Eigen::Dynamic> TB = el.transformation() * elementBasis(e);
+  FfrPoint p;
+  p.position = el.start() + R * Vec2(xi * el.length(), 0.0);
+  p.shape = R * BeamElement2d::shape(xi, el.length()) * TB;
+  p.rotationShape = BeamElement2d::slopeShape(xi, el.length()) * TB;
+  return p;
+}
+
+Vec2 FfrBeamModel::sectionForces(const VecX& qf, int e, double xi) const {
+  const BeamElement2d& el = elements_.at(e);
+  const BeamElement2d::Vec6 ee = el.transformation() * (elementBasis(e) * qf);
+  return el.sectionForces(ee, xi, options_.geometricStiffening);
+}
+
+}  // namespace flexmbd

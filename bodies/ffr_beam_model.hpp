@@ -1,0 +1,91 @@
+// A beam finite-element mesh as the generator of a flexible body's invariants:
+// nodal inertia shape integrals summed from the elements, reference conditions (B2),
+// optional modal reduction, and the (optionally geometrically nonlinear) strain energy.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bodies/ffr_invariants.hpp"
+#include "elements/beam_element_2d.hpp"
+
+namespace flexmbd {
+
+/// Nodes (body frame, undeformed) and two-node beam elements.
+struct BeamMesh2d {
+  struct Element {
+    int node1 = 0, node2 = 0;
+    BeamSection section;
+  };
+  std::vector<Vec2> nodes;
+  std::vector<Element> elements;
+  /// A straight beam of `length` along the body x axis from `origin`, n equal elements.
+  static BeamMesh2d straight(double length, int numElements, const BeamSection& section,
+                             const Vec2& origin = Vec2::Zero());
+};
+
+/// Reference conditions (document 003): what fixes the body frame in the body.
+struct ReferenceConditions {
+  enum class Type {
+    PinnedPinned,  ///< node A fixed in the frame, node B on the chord A-B (the frame's x axis)
+    Clamped,       ///< node A fixed in the frame, its cross-section rotation zero (tangent frame)
+    FreeFree,      ///< mean-axis conditions: int rho u_f dV = 0, int rho u0 x u_f dV = 0
+  };
+  Type type = Type::PinnedPinned;
+  int nodeA = 0;
+  int nodeB = -1;  ///< pinned-pinned only; -1: the last node
+};
+
+struct FfrBeamOptions {
+  ReferenceConditions reference;
+  /// Modal reduction: 0 keeps every nodal coordinate; n > 0 keeps the first n modes
+  /// (under the reference conditions); `modeSet` (1-based) keeps a chosen set instead.
+  int modes = 0;
+  std::vector<int> modeSet;
+  /// Second-order axial strain eps = u' + v'^2/2 in the strain energy (stiffening by
+  /// axial load); off: the linear FFR model (docs/flexible-bodies.md).
+  bool geometricStiffening = false;
+};
+
+class FfrBeamModel {
+ public:
+  /// @throws InputError naming `owner`: empty or disconnected meshes, zero-length
+  /// elements, bad sections, bad reference nodes, reference conditions that leave a
+  /// rigid mode or over-constrain the body, bad mode choices.
+  FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const std::string& owner);
+
+  const FfrInvariants& invariants() const { return invariants_; }
+  const BeamMesh2d& mesh() const { return mesh_; }
+  const std::vector<BeamElement2d>& elements() const { return elements_; }
+  bool geometricStiffening() const { return options_.geometricStiffening; }
+  /// Nodal displacements (ux, uy, psi per node, body frame) = basis() * q_f.
+  const MatX& basis() const { return basis_; }
+  int numElastic() const { return static_cast<int>(basis_.cols()); }
+  /// Natural frequencies (rad/s) of the body with its frame held fixed, ascending:
+  /// K_ff phi = omega^2 m_ff phi.
+  VecX naturalFrequencies() const;
+
+  double strainEnergy(const VecX& qf) const;
+  VecX strainEnergyGradient(const VecX& qf) const;
+  MatX strainEnergyHessian(const VecX& qf) const;
+
+  /// Element and local coordinate xi in [0, 1] of a body-frame point on the beam axis.
+  /// @return false if no element passes within 1e-9 (relative) of the point.
+  bool locate(const Vec2& point, int& element, double& xi) const;
+  /// Shape of an arbitrary material point on element `element` at xi.
+  FfrPoint materialPoint(int element, double xi) const;
+  /// Axial force and bending moment at (element, xi) for the elastic coordinates q_f.
+  Vec2 sectionForces(const VecX& qf, int element, double xi) const;
+
+ private:
+  Eigen::Matrix<double, 6, Eigen::Dynamic> elementBasis(int element) const;
+
+  BeamMesh2d mesh_;
+  FfrBeamOptions options_;
+  std::vector<BeamElement2d> elements_;
+  MatX basis_;
+  FfrInvariants invariants_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,67 @@
+// Planar flexible body in the floating frame of reference formulation.
+#pragma once
+
+#include <memory>
+
+#include "bodies/ffr_beam_model.hpp"
+#include "bodies/ffr_invariants.hpp"
+#include "bodies/rigid_body_2d.hpp"
+#include "core/body.hpp"
+
+namespace flexmbd {
+
+/// Coordinates q = (x, y, theta, q_1..q_nf): frame position, frame angle, elastic
+/// coordinates. A material point is at r = R + A(theta) (u0 + N q_f). The mass matrix,
+/// quadratic velocity vector and gravity force come from the constant invariants and
+/// the current q_f (docs/flexible-bodies.md; document 003; Shabana ch. 5):
+///   M = [ m I    S A s          A S-bar                 ]   s = int rho u dV
+///       [        I0 + 2 I1.qf + qf^T m_ff qf   J0^T + qf^T S~ ]       = first moment + S-bar qf
+///       [ sym.                                m_ff        ]
+class FfrBody2d final : public Body {
+ public:
+  /// From invariants given directly (reduced models from other FE tools).
+  /// @throws InputError naming the body if the invariants are invalid.
+  FfrBody2d(std::string name, FfrInvariants invariants, const FrameState2d& initial);
+  /// From a beam mesh (the model also supplies the strain energy, so geometric
+  /// stiffening is available, and section forces for outputs).
+  FfrBody2d(std::string name, std::shared_ptr<const FfrBeamModel> model, const FrameState2d& initial);
+
+  const FfrInvariants& invariants() const { return inv_; }
+  /// The generating mesh model, or null if the body was given by its invariants.
+  const FfrBeamModel* beamModel() const { return model_.get(); }
+  int numElastic() const { return inv_.numElastic(); }
+
+  int numCoordinates() const override { return 3 + inv_.numElastic(); }
+  int numFrameCoordinates() const override { return 3; }
+  std::vector<std::string> coordinateNames() const override;
+  VecX initialCoordinates() const override;
+  VecX initialVelocities() const override;
+  double mass() const override { return inv_.mass; }
+  MatX massMatrix(const ConstVecRef& q) const override;
+  void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, MatX& K) const override;
+  void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
+  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, MatX& dQdq,
+                                 MatX& dQdv) const override;
+  void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const override;
+  double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
+  double internalPotential(const ConstVecRef& q) const override;
+  bool isDissipative() const override { return inv_.dff.cwiseAbs().maxCoeff() > 0.0; }
+  /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
+  /// phi = theta + Nphi q_f.
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point) const override;
+  void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
+  Vec2 centreOfMass(const ConstVecRef& q) const override;
+  /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
+  PointKinematics pointKinematics(const ConstVecRef& q, const FfrPoint& p) const;
+
+ private:
+  int findPoint(const Vec2& point) const;
+  VecX elasticGradient(const VecX& qf) const;
+
+  FfrInvariants inv_;
+  std::shared_ptr<const FfrBeamModel> model_;
+  FrameState2d initial_;
+};
+
+}  // namespace flexmbd

@@ -1,0 +1,100 @@
+#include "bodies/ffr_invariants.hpp"
+
+#include <Eigen/Dense>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace flexmbd {
+namespace {
+
+void requireSize(bool ok, const std::string& owner, const std::string& what, const std::string& expected) {
+  if (!ok) throw InputError(owner + ": invariant " + what + " has the wrong size; expected " + expected);
+}
+
+void requireSymmetric(const MatX& A, const std::string& owner, const std::string& what) {
+  const double scale = A.cwiseAbs().maxCoeff() + 1e-300;
+  if ((A - A.transpose()).cwiseAbs().maxCoeff() > 1e-10 * scale) {
+    throw InputError(owner + ": invariant " + what + " is not symmetric; expected a symmetric matrix");
+  }
+}
+
+void requireFiniteAll(const MatX& A, const std::string& owner, const std::string& what) {
+  if (!A.allFinite()) throw InputError(owner + ": invariant " + what + " has non-finite entries");
+}
+
+}  // namespace
+
+void FfrInvariants::validate(const std::string& owner) const {
+  const int n = numElastic();
+  requirePositive(mass, owner + ": invariant mass");
+  requireFinite(firstMoment.x(), owner + ": invariant first_moment");
+  requireFinite(firstMoment.y(), owner + ": invariant first_moment");
+  requireFinite(polarMoment, owner + ": invariant polar_moment");
+  const std::string sz = std::to_string(n);
+  requireSize(mff.cols() == n, owner, "m_ff", sz + " x " + sz);
+  requireSize(sBar.cols() == n, owner, "s_bar", "2 x " + sz);
+  requireSize(i1.size() == n, owner, "i1", sz);
+  requireSize(j0.size() == n, owner, "j0", sz);
+  requireSize(sTilde.rows() == n && sTilde.cols() == n, owner, "s_tilde", sz + " x " + sz);
+  requireSize(kff.rows() == n && kff.cols() == n, owner, "k_ff", sz + " x " + sz);
+  requireSize(dff.rows() == n && dff.cols() == n, owner, "d_ff", sz + " x " + sz);
+  for (auto [A, name] : {std::pair<const MatX*, const char*>{&mff, "m_ff"}, {&kff, "k_ff"}, {&dff, "d_ff"},
+                         {&sTilde, "s_tilde"}}) {
+    requireFiniteAll(*A, owner, name);
+  }
+  requireFiniteAll(sBar, owner, "s_bar");
+  requireFiniteAll(i1, owner, "i1");
+  requireFiniteAll(j0, owner, "j0");
+  requireSymmetric(mff, owner, "m_ff");
+  requireSymmetric(kff, owner, "k_ff");
+  requireSymmetric(dff, owner, "d_ff");
+  if (n > 0) {
+    const double scale = sTilde.cwiseAbs().maxCoeff() + mff.cwiseAbs().maxCoeff();
+    if ((sTilde + sTilde.transpose()).cwiseAbs().maxCoeff() > 1e-10 * scale) {
+      throw InputError(owner + ": invariant s_tilde is not skew-symmetric; expected S~ = -S~^T");
+    }
+    if (Eigen::LLT<MatX>(mff).info() != Eigen::Success) {
+      throw InputError(owner + ": invariant m_ff is not positive definite; expected a positive definite mass matrix");
+    }
+    if (Eigen::LLT<MatX>(kff).info() != Eigen::Success) {
+      throw InputError(owner +
+                       ": the stiffness matrix k_ff is not positive definite: the reference conditions leave a "
+                       "rigid-body mode (expected conditions that fix the body frame: pinned_pinned, clamped or "
+                       "free_free)");
+    }
+    const Eigen::SelfAdjointEigenSolver<MatX> ed(dff, Eigen::EigenvaluesOnly);
+    if (ed.eigenvalues().minCoeff() < -1e-10 * (dff.cwiseAbs().maxCoeff() + 1e-300)) {
+      throw InputError(owner + ": invariant d_ff is not positive semi-definite; damping would add energy");
+    }
+  }
+  if (polarMoment < firstMoment.squaredNorm() / mass * (1.0 - 1e-12)) {
+    std::ostringstream os;
+    os << owner << ": invariant polar_moment " << polarMoment
+       << " is smaller than |first_moment|^2 / mass = " << firstMoment.squaredNorm() / mass
+       << " (negative inertia about the centre of mass)";
+    throw InputError(os.str());
+  }
+  for (size_t k = 0; k < points.size(); ++k) {
+    requireSize(points[k].shape.cols() == n && points[k].rotationShape.size() == n, owner,
+                "shape of point " + std::to_string(k), "2 x " + sz + " and 1 x " + sz);
+  }
+}
+
+FfrInvariants FfrInvariants::transformed(const MatX& P) const {
+  FfrInvariants r;
+  r.mass = mass;
+  r.firstMoment = firstMoment;
+  r.polarMoment = polarMoment;
+  r.sBar = sBar * P;
+  r.i1 = P.transpose() * i1;
+  r.j0 = P.transpose() * j0;
+  r.mff = P.transpose() * mff * P;
+  r.sTilde = P.transpose() * sTilde * P;
+  r.kff = P.transpose() * kff * P;
+  r.dff = P.transpose() * dff * P;
+  for (const FfrPoint& p : points) r.points.push_back({p.position, p.shape * P, p.rotationShape * P});
+  return r;
+}
+
+}  // namespace flexmbd

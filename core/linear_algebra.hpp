@@ -1,0 +1,22 @@
+// Small dense linear-algebra helpers shared by the model set-up and the integrators.
+#pragma once
+
+#include <vector>
+
+#include "core/types.hpp"
+
+namespace flexmbd {
+
+/// Indices of the rows of A that are linearly dependent on earlier rows (modified
+/// Gram-Schmidt in row order; a row whose remainder is below rankTolerance times its
+/// own norm is dependent). Reports the later of two conflicting rows, so errors can
+/// name the constraint the user added last.
+std::vector<int> dependentRows(const MatX& A, double rankTolerance = 1e-9);
+
+/// Basis B of the null space of the full-row-rank matrix C (r x n), chosen so that
+/// B keeps as many unit columns as possible: C = [C_d C_i] (d: r pivot columns of
+/// a full-pivoting LU), q_d = -C_d^{-1} C_i q_i, B = P [-C_d^{-1} C_i; I].
+/// `independent` receives the kept coordinates (the columns of B are unit vectors there).
+MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent = nullptr);
+
+}  // namespace flexmbd

@@ -1,0 +1,77 @@
+// Planar Euler-Bernoulli beam element of the floating frame of reference formulation
+// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 6-7).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "core/types.hpp"
+#include "elements/beam_section.hpp"
+
+namespace flexmbd {
+
+/// Two nodes; per node three coordinates in the element frame: axial displacement,
+/// transverse displacement, slope. The element lies along its own x axis from `start`
+/// to `end` (body frame); its intermediate element frame is parallel to it, so the
+/// constant transformation from body-frame nodal displacements (ux, uy, psi) to element
+/// coordinates is T = diag(R(beta)^T, 1, R(beta)^T, 1) (document 003, C^ij).
+///
+/// Everything constant is computed once, at construction, by 5-point Gauss-Legendre
+/// quadrature, exact for polynomials up to degree 9 (the integrands here reach 8).
+class BeamElement2d {
+ public:
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Row6 = Eigen::Matrix<double, 1, 6>;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  using Mat26 = Eigen::Matrix<double, 2, 6>;
+
+  /// @throws InputError naming `owner` if the element has zero length or the section
+  /// is invalid.
+  BeamElement2d(const Vec2& start, const Vec2& end, const BeamSection& section,
+                const std::string& owner);
+
+  double length() const { return l_; }
+  double angle() const { return beta_; }  ///< of the element axis in the body frame
+  const Vec2& start() const { return start_; }
+  const BeamSection& section() const { return section_; }
+  /// Body-frame nodal displacements -> element coordinates (6 x 6, constant).
+  const Mat6& transformation() const { return T_; }
+
+  /// Shape functions S(xi), xi = x / l (document 003):
+  ///   w_x = [1-xi, 0, 0, xi, 0, 0] e,
+  ///   w_y = [0, 1-3xi^2+2xi^3, l(xi-2xi^2+xi^3), 0, 3xi^2-2xi^3, l(xi^3-xi^2)] e.
+  static Mat26 shape(double xi, double l);
+  /// d w_y / dx (slope), d2 w_y / dx2 (curvature), d w_x / dx (axial strain) rows.
+  static Row6 slopeShape(double xi, double l);
+  static Row6 curvatureShape(double xi, double l);
+  static Row6 axialStrainShape(double l);
+
+  // ----- inertia shape integrals, element frame (document 003) -------------------
+  double mass() const { return mass_; }           ///< rho A l
+  const Mat26& sBar() const { return sBar_; }     ///< S-bar = int rho S dV
+  const Mat26& sX() const { return sX_; }         ///< int rho x S dV (x along the element)
+  const Mat6& sXX() const { return sXX_; }        ///< S_xx = int rho S_x^T S_x dV
+  const Mat6& sYY() const { return sYY_; }        ///< S_yy = int rho S_y^T S_y dV
+  const Mat6& sXY() const { return sXY_; }        ///< S_xy = int rho S_x^T S_y dV
+  /// Linear stiffness (axial EA/l and Hermite bending EI/l^3 blocks), element frame.
+  const Mat6& stiffness() const { return K_; }
+
+  /// Strain energy U(e) = int (EA eps^2 / 2 + EI kappa^2 / 2) dx with eps = u' (linear)
+  /// or eps = u' + v'^2 / 2 (second-order axial strain: geometric stiffening).
+  double strainEnergy(const Vec6& e, bool stiffening) const;
+  /// dU/de and d2U/de2 (for the linear model: K e and K).
+  Vec6 strainEnergyGradient(const Vec6& e, bool stiffening) const;
+  Mat6 strainEnergyHessian(const Vec6& e, bool stiffening) const;
+  /// Axial force N = EA eps and bending moment M = EI kappa at xi.
+  Vec2 sectionForces(const Vec6& e, double xi, bool stiffening) const;
+
+ private:
+  Vec2 start_;
+  double l_ = 0.0, beta_ = 0.0;
+  BeamSection section_;
+  Mat6 T_;
+  double mass_ = 0.0;
+  Mat26 sBar_, sX_;
+  Mat6 sXX_, sYY_, sXY_, K_;
+};
+
+}  // namespace flexmbd

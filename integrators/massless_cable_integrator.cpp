@@ -1,0 +1,183 @@
+#include "integrators/massless_cable_integrator.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <optional>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "integrators/member_contact_detector.hpp"
+
+namespace flexmbd {
+
+namespace {
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+/// y = [u_free, v_free]; y' = [v_free, M^-1 (f - g)].
+class TensegrityOde : public OdeSystem {
+ public:
+  explicit TensegrityOde(const TensegrityStructure& s)
+      : s_(s), nf_(s.numFreeCoordinates()), ldlt_(s.massMatrix()), x0_(s.initialPositions()) {}
+
+  int size() const override { return 2 * nf_; }
+  int numRoots() const override { return s_.numCables(); }
+
+  VecX fullPositions(const double* y) const { return s_.expand(Eigen::Map<const VecX>(y, nf_), x0_); }
+  VecX fullVelocities(const double* y) const {
+    return s_.expand(Eigen::Map<const VecX>(y + nf_, nf_), VecX::Zero(s_.numCoordinates()));
+  }
+
+  void rhs(double t, const double* y, double* ydot) const override {
+    const VecX x = fullPositions(y);
+    // internalForces includes the struts and the elastic cables' tension-only law.
+    const VecX f = s_.restrict(s_.externalForces(t) - s_.internalForces(x));
+    Eigen::Map<VecX>(ydot, nf_) = Eigen::Map<const VecX>(y + nf_, nf_);
+    Eigen::Map<VecX>(ydot + nf_, nf_) = ldlt_.solve(f);
+  }
+
+  /// g_c = (l_c - l0_c)/l0_c: positive when taut, negative when slack.
+  void roots(double, const double* y, double* g) const override {
+    const VecX l = s_.cableLengths(fullPositions(y));
+    for (int c = 0; c < s_.numCables(); ++c) g[c] = (l[c] - s_.cable(c).naturalLength) / s_.cable(c).naturalLength;
+  }
+
+ private:
+  const TensegrityStructure& s_;
+  int nf_;
+  Eigen::LDLT<MatX> ldlt_;
+  VecX x0_;
+};
+
+}  // namespace
+
+MasslessCableIntegrator::MasslessCableIntegrator(const TensegrityStructure& s, const MasslessCableSettings& o)
+    : s_(s), settings_(o) {
+  if (!s_.finalized()) throw InputError("massless cables: the tensegrity structure is not finalized");
+  for (int c = 0; c < s_.numCables(); ++c) {
+    if (s_.cable(c).inextensible) {
+      throw InputError("cable \"" + s_.cable(c).name +
+                       "\": inextensible, but method \"massless_cables\" needs every cable elastic (give it EA, or "
+                       "use method \"time_stepping\")");
+    }
+  }
+  if (!(o.tEnd > o.tStart)) throw InputError("solver.t_end must be > t_start, got " + num(o.tEnd));
+  if (!(o.outputStep > 0.0)) throw InputError("solver.output_step must be > 0, got " + num(o.outputStep));
+  if (s_.numFreeCoordinates() == 0) throw InputError("massless cables: every node coordinate is fixed");
+}
+
+TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& observer) const {
+  const MasslessCableSettings& o = settings_;
+  const std::clock_t cpuStart = std::clock();
+  const int nc = s_.numCables();
+  const int nf = s_.numFreeCoordinates();
+  TensegrityOde ode(s_);
+  TensegrityRunSummary sum;
+  sum.method = "massless_cables";
+
+  VecX y(2 * nf);
+  y << s_.restrict(s_.initialPositions()), s_.restrict(s_.initialVelocities());
+  double t = o.tStart;
+  VecX x = ode.fullPositions(y.data()), v = ode.fullVelocities(y.data());
+  sum.energyStart = s_.kineticEnergy(v) + s_.potentialEnergy(x);
+
+  std::optional<MemberContactDetector> contacts;
+  std::vector<TensegrityEvent> pending;
+  auto emit = [&](const TensegrityEvent& e) {
+    switch (e.type) {
+      case TensegrityEvent::Type::Snap: ++sum.snaps; break;
+      case TensegrityEvent::Type::Taut: ++sum.tautTransitions; break;
+      case TensegrityEvent::Type::Slack: ++sum.slackTransitions; break;
+      case TensegrityEvent::Type::Contact: ++sum.contacts; break;
+    }
+    if (observer.onEvent) observer.onEvent(e);
+  };
+  if (o.detectContacts) {
+    contacts.emplace(s_);
+    contacts->start(t, x, pending);
+    for (const auto& e : pending) emit(e);
+    pending.clear();
+  }
+  auto sample = [&]() {
+    if (!observer.onSample) return;
+    TensegritySample smp;
+    smp.t = t;
+    smp.x = x;
+    smp.v = v;
+    smp.cableLength = s_.cableLengths(x);
+    smp.cableTension = s_.elasticCableTensions(x);
+    smp.cableImpulse = VecX::Zero(nc);  // massless cables: no impulse at a snap
+    smp.slack.resize(nc);
+    for (int c = 0; c < nc; ++c) {
+      smp.slack[c] = smp.cableLength[c] < s_.cable(c).naturalLength * (1.0 - o.slackTolerance);
+    }
+    smp.kineticEnergy = s_.kineticEnergy(v);
+    smp.potentialEnergy = s_.potentialEnergy(x);
+    observer.onSample(smp);
+  };
+  sample();
+
+  try {
+    CvodeSolver solver(ode, t, y, o.cvode);
+    const long nOut = std::max(1L, static_cast<long>(std::ceil((o.tEnd - o.tStart) / o.outputStep - 1e-9)));
+    for (long k = 1; k <= nOut; ++k) {
+      const double tout = k == nOut ? o.tEnd : o.tStart + k * o.outputStep;
+      while (true) {
+        const double tPrev = t;
+        const VecX xPrev = x;
+        t = solver.advance(tout);
+        x = ode.fullPositions(solver.y().data());
+        v = ode.fullVelocities(solver.y().data());
+        if (contacts) {
+          contacts->advance(tPrev, xPrev, t, x, pending);
+          std::sort(pending.begin(), pending.end(),
+                    [](const TensegrityEvent& a, const TensegrityEvent& b) { return a.t < b.t; });
+          for (auto& e : pending) {
+            e.step = solver.stats().steps;
+            emit(e);
+          }
+          pending.clear();
+        }
+        if (!solver.rootFound()) break;
+        for (int c = 0; c < nc; ++c) {
+          const int dir = solver.rootsFound()[c];
+          if (dir == 0) continue;
+          TensegrityEvent e;
+          e.type = dir > 0 ? TensegrityEvent::Type::Taut : TensegrityEvent::Type::Slack;
+          e.t = t;
+          e.step = solver.stats().steps;
+          e.member = s_.cable(c).name;
+          emit(e);
+        }
+        // The cable force is only C0 at a switch: restart the multistep method there.
+        solver.reinit(t, solver.y());
+        if (t >= tout) break;
+      }
+      sample();
+    }
+    const CvodeStats st = solver.stats();
+    sum.steps = st.steps;
+    sum.rhsEvals = st.rhsEvals;
+    sum.rootEvals = st.rootEvals;
+    sum.errorTestFailures = st.errorTestFailures;
+    sum.nonlinearConvFailures = st.nonlinearConvFailures;
+    sum.ok = true;
+    sum.message = "ok";
+  } catch (const SolverError& e) {
+    sum.ok = false;
+    sum.message = e.what();
+  }
+  sum.tReached = t;
+  sum.energyEnd = s_.kineticEnergy(v) + s_.potentialEnergy(x);
+  sum.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
+  return sum;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,317 @@
+#include "integrators/tensegrity_time_stepper.hpp"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <optional>
+#include <sstream>
+
+#include "core/errors.hpp"
+#include "integrators/member_contact_detector.hpp"
+
+namespace flexmbd {
+
+std::string toString(TensegrityEvent::Type type) {
+  switch (type) {
+    case TensegrityEvent::Type::Snap: return "snap";
+    case TensegrityEvent::Type::Taut: return "taut";
+    case TensegrityEvent::Type::Slack: return "slack";
+    case TensegrityEvent::Type::Contact: return "contact";
+  }
+  return "?";
+}
+
+namespace {
+
+using Row = std::vector<std::pair<int, double>>;
+
+/// W = B Minv B^T for sparse rows B (each at most 6 entries).
+MatX delassus(const std::vector<Row>& B, const MatX& Minv) {
+  const int n = static_cast<int>(B.size());
+  MatX W(n, n);
+  for (int a = 0; a < n; ++a) {
+    for (int b = a; b < n; ++b) {
+      double w = 0.0;
+      for (const auto& [k, bk] : B[a]) {
+        for (const auto& [l, bl] : B[b]) w += bk * Minv(k, l) * bl;
+      }
+      W(a, b) = W(b, a) = w;
+    }
+  }
+  return W;
+}
+
+/// Minv B^T p.
+VecX impulseResponse(const std::vector<Row>& B, const VecX& p, const MatX& Minv) {
+  VecX r = VecX::Zero(Minv.rows());
+  for (std::size_t a = 0; a < B.size(); ++a) {
+    if (p[a] == 0.0) continue;
+    for (const auto& [k, bk] : B[a]) r += Minv.col(k) * (bk * p[a]);
+  }
+  return r;
+}
+
+double rowDot(const Row& b, const VecX& v) {
+  double s = 0.0;
+  for (const auto& [k, bk] : b) s += bk * v[k];
+  return s;
+}
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(6);
+  os << x;
+  return os.str();
+}
+
+}  // namespace
+
+TensegrityTimeStepper::TensegrityTimeStepper(const TensegrityStructure& structure,
+                                             const TimeSteppingSettings& settings)
+    : s_(structure), settings_(settings) {
+  const TimeSteppingSettings& o = settings_;
+  if (!s_.finalized()) throw InputError("time stepping: the tensegrity structure is not finalized");
+  if (!(o.timeStep > 0.0) || !std::isfinite(o.timeStep)) {
+    throw InputError("solver.time_step must be > 0, got " + num(o.timeStep));
+  }
+  if (!(o.tEnd > o.tStart)) throw InputError("solver.t_end must be > t_start, got " + num(o.tEnd));
+  if (!(o.outputStep >= 0.0)) throw InputError("solver.output_step must be >= 0, got " + num(o.outputStep));
+  if (!(o.projectionTolerance > 0.0)) throw InputError("solver.projection_tolerance must be > 0");
+  if (!(o.slackTolerance >= 0.0)) throw InputError("solver.slack_tolerance must be >= 0");
+  if (o.maxProjectionIterations < 1) throw InputError("solver.max_projection_iterations must be >= 1");
+  LcpSolver check(o.lcp);  // validates the LCP options
+}
+
+TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observer) const {
+  const TimeSteppingSettings& o = settings_;
+  const std::clock_t cpuStart = std::clock();
+  const LcpSolver lcp(o.lcp);
+  const int nc = s_.numCables();
+  const int nf = s_.numFreeCoordinates();
+  const MatX Minv = s_.massMatrix().ldlt().solve(MatX::Identity(nf, nf));
+
+  TensegrityRunSummary sum;
+  sum.method = "time_stepping";
+  sum.lcpSolver = toString(o.lcp.method);
+
+  VecX x = s_.initialPositions(), v = s_.initialVelocities();
+  double t = o.tStart;
+  auto energy = [&](const VecX& xx, const VecX& vv) { return s_.kineticEnergy(vv) + s_.potentialEnergy(xx); };
+  sum.energyStart = energy(x, v);
+
+  std::vector<bool> slack(nc, false), carried(nc, false);
+  {
+    const VecX l = s_.cableLengths(x);
+    for (int c = 0; c < nc; ++c) slack[c] = l[c] < s_.cable(c).naturalLength * (1.0 - o.slackTolerance);
+  }
+  VecX lastImpulse = VecX::Zero(nc), snapImpulse = VecX::Zero(nc);
+  double lastDt = o.timeStep;
+
+  std::optional<MemberContactDetector> contacts;
+  std::vector<TensegrityEvent> pending;
+  auto emit = [&](TensegrityEvent e) {
+    switch (e.type) {
+      case TensegrityEvent::Type::Snap: ++sum.snaps; break;
+      case TensegrityEvent::Type::Taut: ++sum.tautTransitions; break;
+      case TensegrityEvent::Type::Slack: ++sum.slackTransitions; break;
+      case TensegrityEvent::Type::Contact: ++sum.contacts; break;
+    }
+    if (observer.onEvent) observer.onEvent(e);
+  };
+  if (o.detectContacts) {
+    contacts.emplace(s_);
+    contacts->start(t, x, pending);
+    for (auto& e : pending) emit(e);
+    pending.clear();
+  }
+
+  auto sample = [&]() {
+    if (!observer.onSample) return;
+    TensegritySample smp;
+    smp.t = t;
+    smp.x = x;
+    smp.v = v;
+    smp.cableLength = s_.cableLengths(x);
+    smp.cableTension = s_.elasticCableTensions(x);
+    for (int c = 0; c < nc; ++c) {
+      if (s_.cable(c).inextensible) smp.cableTension[c] = lastImpulse[c] / lastDt;
+    }
+    smp.cableImpulse = snapImpulse;
+    smp.slack = slack;
+    smp.kineticEnergy = s_.kineticEnergy(v);
+    smp.potentialEnergy = s_.potentialEnergy(x);
+    observer.onSample(smp);
+    snapImpulse.setZero();
+  };
+  sample();
+
+  const double span = o.tEnd - o.tStart;
+  const long nSteps = std::max(1L, static_cast<long>(std::ceil(span / o.timeStep - 1e-9)));
+  const long outEvery = o.outputStep > 0.0 ? std::max(1L, std::lround(o.outputStep / o.timeStep)) : 1L;
+
+  try {
+    for (long step = 1; step <= nSteps; ++step) {
+      const double dt = step == nSteps ? o.tEnd - t : o.timeStep;
+      const double tm = t + 0.5 * dt;
+      const VecX xi = x, vi = v;
+      const double Ei = energy(xi, vi);
+      const VecX vFreeI = s_.restrict(vi);
+      // Midpoint u_m = u_i + v_i dt/2 (doc. 001, sec. 3.2).
+      const VecX xm = xi + 0.5 * dt * vi;
+      // v_free = v_i + M^-1 (f(t_m) - g(u_m)) dt
+      const VecX force = s_.restrict(s_.externalForces(tm) - s_.internalForces(xm));
+      VecX vf = vFreeI + Minv * (force * dt);
+      // Active set: inextensible cables at or beyond their natural length at u_m.
+      const VecX lm = s_.cableLengths(xm);
+      std::vector<int> active;
+      std::vector<Row> B;
+      for (int c = 0; c < nc; ++c) {
+        const TensegrityCable& cb = s_.cable(c);
+        if (!cb.inextensible) continue;
+        if (lm[c] >= cb.naturalLength * (1.0 - o.slackTolerance)) {
+          active.push_back(c);
+          B.push_back(s_.cableGradientEntries(xm, c));
+        }
+      }
+      VecX p = VecX::Zero(static_cast<int>(active.size()));
+      if (!active.empty()) {
+        const MatX W = delassus(B, Minv);
+        VecX q(static_cast<int>(active.size()));
+        for (std::size_t a = 0; a < active.size(); ++a) q[a] = -rowDot(B[a], vf);
+        const LcpSolution sol = lcp.solve(W, q);
+        sum.maxLcpResidual = std::max(sum.maxLcpResidual, sol.residual);
+        sum.maxLcpSize = std::max(sum.maxLcpSize, static_cast<int>(active.size()));
+        sum.lcpIterations += sol.iterations;
+        if (!sol.ok) {
+          throw SolverError("LCP (" + toString(o.lcp.method) + ") of the cable impulses failed at step " +
+                                std::to_string(step) + " (t = " + num(t) + ", dt = " + num(dt) + ", " +
+                                std::to_string(active.size()) + " active cables): residual " + num(sol.residual) +
+                                " > tolerance " + num(o.lcp.tolerance) + " after " + std::to_string(sol.iterations) +
+                                " iterations (Siconos info " + std::to_string(sol.info) + ")",
+                            t, dt);
+        }
+        p = sol.z;
+        vf -= impulseResponse(B, p, Minv);
+      }
+      VecX xf = xm + 0.5 * dt * s_.expand(vf, VecX::Zero(s_.numCoordinates()));
+      // Drift of inextensible cables and its projection.
+      auto drift = [&](const VecX& xx) {
+        const VecX l = s_.cableLengths(xx);
+        double d = 0.0;
+        for (int c = 0; c < nc; ++c) {
+          if (s_.cable(c).inextensible) d = std::max(d, (l[c] - s_.cable(c).naturalLength) / s_.cable(c).naturalLength);
+        }
+        return d;
+      };
+      double d = drift(xf);
+      sum.maxDriftBeforeProjection = std::max(sum.maxDriftBeforeProjection, d);
+      if (o.projectPositions) {
+        for (int it = 0; it < o.maxProjectionIterations && d > o.projectionTolerance; ++it) {
+          ++sum.projectionIterations;
+          const VecX l = s_.cableLengths(xf);
+          std::vector<Row> Bp;
+          VecX g;
+          std::vector<double> gs;
+          for (int c = 0; c < nc; ++c) {
+            const TensegrityCable& cb = s_.cable(c);
+            if (cb.inextensible && l[c] >= cb.naturalLength * (1.0 - o.slackTolerance)) {
+              Bp.push_back(s_.cableGradientEntries(xf, c));
+              gs.push_back(l[c] - cb.naturalLength);
+            }
+          }
+          g = Eigen::Map<const VecX>(gs.data(), static_cast<int>(gs.size()));
+          const LcpSolution sol = lcp.solve(delassus(Bp, Minv), -g);
+          if (!sol.ok) {
+            throw SolverError("LCP (" + toString(o.lcp.method) + ") of the position projection failed at step " +
+                                  std::to_string(step) + " (t = " + num(t) + "): residual " + num(sol.residual) +
+                                  " > tolerance " + num(o.lcp.tolerance),
+                              t, dt);
+          }
+          xf -= s_.expand(impulseResponse(Bp, sol.z, Minv), VecX::Zero(s_.numCoordinates()));
+          d = drift(xf);
+        }
+        sum.maxDriftAfterProjection = std::max(sum.maxDriftAfterProjection, d);
+      } else {
+        sum.maxDriftAfterProjection = sum.maxDriftBeforeProjection;
+      }
+
+      // Commit the step.
+      const double tf = t + dt;
+      x = xf;
+      v = s_.expand(vf, VecX::Zero(s_.numCoordinates()));
+      const double Ef = energy(x, v);
+      lastImpulse.setZero();
+      for (std::size_t a = 0; a < active.size(); ++a) lastImpulse[active[a]] = p[a];
+      // Events: snaps (impulse on a cable that was not carrying tension and was
+      // lengthening), taut and slack transitions. Times: where the gap l - l0 crosses
+      // zero, interpolated linearly between u_i and u_f.
+      const VecX li = s_.cableLengths(xi), lf = s_.cableLengths(x);
+      bool snapped = false;
+      for (int c = 0; c < nc; ++c) {
+        const double l0 = s_.cable(c).naturalLength;
+        const bool nowSlack = lf[c] < l0 * (1.0 - o.slackTolerance);
+        const double gi = li[c] - l0, gf = lf[c] - l0;
+        const double crossing = (gi < 0.0 && gf >= 0.0) || (gi >= 0.0 && gf < 0.0) ? t + dt * gi / (gi - gf) : tm;
+        const double pc = lastImpulse[c];
+        double rate = 0.0;
+        if (pc > 0.0) {
+          const auto ai = std::find(active.begin(), active.end(), c) - active.begin();
+          rate = rowDot(B[ai], vFreeI);
+        }
+        TensegrityEvent e;
+        e.step = step;
+        e.member = s_.cable(c).name;
+        if (pc > 0.0 && !carried[c] && rate > o.snapRateTolerance) {
+          e.type = TensegrityEvent::Type::Snap;
+          e.t = std::clamp(crossing, t, tf);
+          e.impulse = pc;
+          e.elongationRate = rate;
+          e.energyChange = Ef - Ei;
+          snapImpulse[c] += pc;
+          snapped = true;
+          emit(e);
+        } else if (slack[c] && !nowSlack) {
+          e.type = TensegrityEvent::Type::Taut;
+          e.t = std::clamp(crossing, t, tf);
+          emit(e);
+        }
+        if (!slack[c] && nowSlack) {
+          e.type = TensegrityEvent::Type::Slack;
+          e.t = std::clamp(crossing, t, tf);
+          e.impulse = 0.0;
+          emit(e);
+        }
+        slack[c] = nowSlack;
+        carried[c] = pc > 0.0;
+      }
+      if (snapped) sum.maxEnergyIncreaseAtSnap = std::max(sum.maxEnergyIncreaseAtSnap, Ef - Ei);
+      if (contacts) {
+        contacts->advance(t, xi, tf, x, pending);
+        std::sort(pending.begin(), pending.end(),
+                  [](const TensegrityEvent& a, const TensegrityEvent& b) { return a.t < b.t; });
+        for (auto& e : pending) {
+          e.step = step;
+          emit(e);
+        }
+        pending.clear();
+      }
+      t = tf;
+      lastDt = dt;
+      sum.steps = step;
+      sum.tReached = t;
+      if (step % outEvery == 0 || step == nSteps) sample();
+    }
+    sum.ok = true;
+    sum.message = "ok";
+  } catch (const SolverError& e) {
+    sum.ok = false;
+    sum.message = e.what();
+    sum.tReached = t;
+  }
+  sum.energyEnd = energy(x, v);
+  sum.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
+  return sum;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,303 @@
+// Strict reader of kinematics scene files (docs/kinematics.md). Same conventions as
+// io/scene.cpp: unknown keys first, then types and ranges; one-line errors
+// "<location>: <what is wrong>, got <what was found>".
+#include "io/kinematics_scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+
+namespace flexmbd {
+namespace {
+
+using nlohmann::json;
+
+std::string fmt(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[40];
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+std::string describe(const json& v) {
+  std::string d = v.dump();
+  if (d.size() > 60) d = d.substr(0, 57) + "...";
+  switch (v.type()) {
+    case json::value_t::string: return "string " + d;
+    case json::value_t::boolean: return "boolean " + d;
+    case json::value_t::array: return "array " + d;
+    case json::value_t::object: return "object " + d;
+    case json::value_t::null: return "null";
+    default: return "number " + d;
+  }
+}
+
+std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+
+/// Typed, checked access to one JSON object; failures throw "<location>: <message>".
+class Reader {
+ public:
+  Reader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
+    if (!j_.is_object()) fail("expected an object {...}, got " + describe(j_));
+    const auto it = j_.find("name");
+    if (it != j_.end() && it->is_string()) where_ += " (" + inQuotes(it->get<std::string>()) + ")";
+  }
+  [[noreturn]] void fail(const std::string& m) const { throw InputError(where_ + ": " + m); }
+  const std::string& where() const { return where_; }
+
+  void allowOnly(const std::vector<std::string>& allowed, const std::string& what = "") const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail("unknown key " + inQuotes(it.key()) + " (allowed keys" + what + ": " + list + ")");
+      }
+    }
+  }
+  bool has(const std::string& key) const { return j_.contains(key); }
+  const json& required(const std::string& key) const {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail("missing required key " + inQuotes(key));
+    return *it;
+  }
+  double number(const std::string& key) const { return toNumber(required(key), key); }
+  double number(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
+  double positive(const std::string& key, double fallback) const {
+    const double x = number(key, fallback);
+    if (!(x > 0.0)) fail("key " + inQuotes(key) + " must be > 0, got " + fmt(x));
+    return x;
+  }
+  long integer(const std::string& key, long fallback, long minimum) const {
+    if (!has(key)) return fallback;
+    const json& v = required(key);
+    const double d = toNumber(v, key);
+    if (d != std::floor(d) || std::fabs(d) > 1e9) fail("key " + inQuotes(key) + " must be an integer, got " + describe(v));
+    if (d < minimum) fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + fmt(d));
+    return static_cast<long>(d);
+  }
+  std::string string(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_string()) fail("key " + inQuotes(key) + " must be a string, got " + describe(v));
+    return v.get<std::string>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+  std::string name(const std::string& key) const {
+    std::string s = string(key);
+    if (s.empty()) fail("key " + inQuotes(key) + " must not be empty");
+    return s;
+  }
+  Vec2 vec2(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.size() != 2) fail("key " + inQuotes(key) + " must be an array of 2 numbers [x, y], got " + describe(v));
+    return Vec2(toNumber(v[0], key + "[0]"), toNumber(v[1], key + "[1]"));
+  }
+  const json& array(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array [...], got " + describe(v));
+    return v;
+  }
+
+ private:
+  double toNumber(const json& v, const std::string& label) const {
+    if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail("key " + inQuotes(label) + " must be a finite number, got " + fmt(x));
+    return x;
+  }
+  const json& j_;
+  std::string where_;
+};
+
+/// Runs a Linkage2d call and puts the location in front of its message.
+template <class F>
+auto located(const std::string& where, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+void parseNode(const json& j, const std::string& at, Linkage2d& linkage) {
+  Reader r(j, at);
+  const std::string type = r.string("type");
+  if (type == "slider") {
+    r.allowOnly({"name", "type", "position", "direction"}, " for a slider node");
+  } else if (type == "fixed" || type == "free") {
+    r.allowOnly({"name", "type", "position"}, " for a " + type + " node");
+  } else {
+    r.fail("key \"type\" must be \"fixed\", \"free\" or \"slider\", got " + inQuotes(type));
+  }
+  const std::string name = r.name("name");
+  const Vec2 position = r.vec2("position");
+  const Vec2 direction = type == "slider" ? r.vec2("direction") : Vec2::UnitX();
+  located(r.where(), [&] {
+    if (type == "fixed") {
+      linkage.addFixedNode(name, position);
+    } else if (type == "free") {
+      linkage.addFreeNode(name, position);
+    } else {
+      linkage.addSliderNode(name, position, direction);
+    }
+  });
+}
+
+void parseLink(const json& j, const std::string& at, Linkage2d& linkage) {
+  Reader r(j, at);
+  r.allowOnly({"name", "nodes", "length"});
+  const std::string name = r.name("name");
+  const json& nodes = r.required("nodes");
+  if (!nodes.is_array() || nodes.size() != 2 || !nodes[0].is_string() || !nodes[1].is_string()) {
+    r.fail("key \"nodes\" must be two node names [\"node1\", \"node2\"], got " + describe(nodes));
+  }
+  const double length = r.has("length") ? r.positive("length", 0.0) : 0.0;
+  located(r.where(), [&] { linkage.addLink(name, nodes[0].get<std::string>(), nodes[1].get<std::string>(), length); });
+}
+
+void parseInput(const json& j, const std::string& at, Linkage2d& linkage) {
+  Reader r(j, at);
+  const std::string type = r.string("type");
+  const std::string name = r.name("name");
+  if (type == "link_angle") {
+    r.allowOnly({"name", "type", "link", "node", "ratio"}, " for a link_angle input");
+    const std::string link = r.name("link");
+    const std::string node = r.has("node") ? r.name("node") : "";
+    const double ratio = r.number("ratio", 1.0);
+    located(r.where(), [&] { linkage.addLinkAngleInput(name, link, node, ratio); });
+  } else if (type == "slider_position" || type == "node_x" || type == "node_y") {
+    r.allowOnly({"name", "type", "node", "ratio"}, " for a " + type + " input");
+    const std::string node = r.name("node");
+    const double ratio = r.number("ratio", 1.0);
+    located(r.where(), [&] {
+      if (type == "slider_position") {
+        linkage.addSliderInput(name, node, ratio);
+      } else {
+        linkage.addNodeCoordinateInput(name, node, type == "node_x" ? 0 : 1, ratio);
+      }
+    });
+  } else {
+    r.fail("key \"type\" must be \"link_angle\", \"slider_position\", \"node_x\" or \"node_y\", got " + inQuotes(type));
+  }
+}
+
+KinematicSettings parseAnalysis(const json& j) {
+  Reader r(j, "analysis");
+  r.allowOnly({"start", "end", "steps", "speed", "acceleration", "tolerance", "max_iterations", "corrector",
+               "singular_tolerance", "locate_tolerance"});
+  KinematicSettings s;
+  s.start = r.number("start", s.start);
+  s.end = r.number("end", s.end);
+  s.steps = static_cast<int>(r.integer("steps", s.steps, 1));
+  s.speed = r.number("speed", s.speed);
+  s.acceleration = r.number("acceleration", s.acceleration);
+  s.tolerance = r.positive("tolerance", s.tolerance);
+  s.maxIterations = static_cast<int>(r.integer("max_iterations", s.maxIterations, 1));
+  const std::string corrector = r.string("corrector", "newton");
+  if (corrector == "newton") {
+    s.corrector = CorrectorKind::Newton;
+  } else if (corrector == "modified_newton") {
+    s.corrector = CorrectorKind::ModifiedNewton;
+  } else {
+    r.fail("key \"corrector\" must be \"newton\" or \"modified_newton\", got " + inQuotes(corrector));
+  }
+  s.singularTolerance = r.positive("singular_tolerance", s.singularTolerance);
+  s.locateTolerance = r.positive("locate_tolerance", s.locateTolerance);
+  located("analysis", [&] { s.validate(); });
+  return s;
+}
+
+/// Duplicate keys are errors (nlohmann would keep the last one silently).
+class DuplicateKeyCheck {
+ public:
+  bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+    if (event == json::parse_event_t::object_start) keys_.emplace_back();
+    if (event == json::parse_event_t::object_end && !keys_.empty()) keys_.pop_back();
+    if (event == json::parse_event_t::key && !keys_.empty()) {
+      const std::string k = parsed.get<std::string>();
+      if (!keys_.back().insert(k).second) throw InputError("duplicate key " + inQuotes(k) + " (each key may appear once)");
+    }
+    return true;
+  }
+
+ private:
+  std::vector<std::set<std::string>> keys_;
+};
+
+std::string plainMessage(const json::exception& e) {
+  std::string m = e.what();
+  if (!m.empty() && m[0] == '[') {
+    const auto close = m.find("] ");
+    if (close != std::string::npos) m = m.substr(close + 2);
+  }
+  return m;
+}
+
+}  // namespace
+
+KinematicsScene parseKinematicsScene(const json& j) {
+  Reader top(j, "top level");
+  top.allowOnly({"name", "nodes", "links", "inputs", "analysis"});
+  KinematicsScene scene;
+  scene.name = top.string("name", "");
+  Linkage2d& linkage = scene.linkage;
+  const json& nodes = top.array("nodes");
+  if (nodes.empty()) top.fail("key \"nodes\" must list at least one node");
+  for (std::size_t i = 0; i < nodes.size(); ++i) parseNode(nodes[i], "nodes[" + std::to_string(i) + "]", linkage);
+  const json& links = top.array("links");
+  if (links.empty()) top.fail("key \"links\" must list at least one link");
+  for (std::size_t i = 0; i < links.size(); ++i) parseLink(links[i], "links[" + std::to_string(i) + "]", linkage);
+  const json& inputs = top.array("inputs");
+  for (std::size_t i = 0; i < inputs.size(); ++i) parseInput(inputs[i], "inputs[" + std::to_string(i) + "]", linkage);
+  scene.settings = top.has("analysis") ? parseAnalysis(top.required("analysis")) : KinematicSettings{};
+  located("linkage", [&] { linkage.finalize(); });
+  return scene;
+}
+
+KinematicsScene parseKinematicsSceneText(const std::string& text, const std::string& source) {
+  json j;
+  try {
+    j = json::parse(text, DuplicateKeyCheck{}, /*allow_exceptions=*/true);
+  } catch (const json::parse_error& e) {
+    throw InputError(source + ": invalid JSON at byte " + std::to_string(e.byte) + ": " + plainMessage(e));
+  } catch (const json::out_of_range& e) {
+    throw InputError(source + ": " + plainMessage(e) + " (the number is too large for a double; numbers must be finite)");
+  } catch (const json::exception& e) {
+    throw InputError(source + ": invalid JSON: " + plainMessage(e));
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+  try {
+    return parseKinematicsScene(j);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+}
+
+KinematicsScene loadKinematicsScene(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
+  if (std::filesystem::is_directory(path, ec)) throw InputError("cannot read scene file '" + path + "': it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open scene file '" + path + "' for reading");
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  return parseKinematicsSceneText(buf.str(), path);
+}
+
+}  // namespace flexmbd
