@@ -1,5 +1,6 @@
 #include "integrators/self_equilibrium.hpp"
 
+#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <sstream>
 
@@ -24,7 +25,18 @@ MatX equilibriumMatrix(const TensegrityStructure& s, const VecX& x) {
 
 SelfStressStates computeSelfStress(const TensegrityStructure& s, const VecX& x, double relativeTolerance) {
   const MatX A = equilibriumMatrix(s, x);
-  Eigen::BDCSVD<MatX> svd(A, Eigen::ComputeFullV);
+  // Square the problem first (same null space): R of A = QR when A has more rows than
+  // columns, A padded with zero rows otherwise; then a two-sided Jacobi SVD without
+  // its own QR preconditioner (whose instantiation GCC 12 flags -Wmaybe-uninitialized).
+  const int m = static_cast<int>(A.cols());
+  MatX square = MatX::Zero(m, m);
+  if (A.rows() >= m) {
+    const Eigen::HouseholderQR<MatX> qr(A);
+    square = qr.matrixQR().topRows(m).triangularView<Eigen::Upper>();
+  } else {
+    square.topRows(A.rows()) = A;
+  }
+  Eigen::JacobiSVD<MatX, Eigen::NoQRPreconditioner> svd(square, Eigen::ComputeFullV);
   SelfStressStates out;
   out.singularValues = svd.singularValues();
   const double smax = out.singularValues.size() > 0 ? out.singularValues[0] : 0.0;
@@ -34,7 +46,6 @@ SelfStressStates computeSelfStress(const TensegrityStructure& s, const VecX& x, 
   }
   out.rank = rank;
   out.mechanisms = s.numFreeCoordinates() - rank;
-  const int m = static_cast<int>(A.cols());
   out.forceDensities = svd.matrixV().rightCols(m - rank);
   return out;
 }

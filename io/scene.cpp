@@ -20,6 +20,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
@@ -205,6 +206,38 @@ class ObjectReader {
     return out;
   }
 
+  /// A matrix written as an array of rows of numbers (all rows the same length).
+  MatX matrix(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array of rows [[...], ...], got " + describe(v));
+    if (v.empty()) return MatX(0, 0);
+    const std::size_t cols = v[0].is_array() ? v[0].size() : 0;
+    MatX m(v.size(), cols);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const std::string row = key + "[" + std::to_string(i) + "]";
+      if (!v[i].is_array() || v[i].size() != cols) {
+        fail("key " + inQuotes(row) + " must be a row of " + std::to_string(cols) + " numbers, got " + describe(v[i]));
+      }
+      for (std::size_t k = 0; k < cols; ++k) m(i, k) = toNumber(v[i][k], row + "[" + std::to_string(k) + "]");
+    }
+    return m;
+  }
+  /// A vector of numbers (possibly empty).
+  VecX vector(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array of numbers, got " + describe(v));
+    VecX out(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) out[k] = toNumber(v[k], key + "[" + std::to_string(k) + "]");
+    return out;
+  }
+  /// A non-negative integer from an arbitrary JSON value (array entries).
+  int index(const json& v, const std::string& label) const {
+    if (!v.is_number_integer() || v.get<long>() < 0) {
+      fail("key " + inQuotes(label) + " must be a non-negative integer, got " + describe(v));
+    }
+    return static_cast<int>(v.get<long>());
+  }
+
   const json& object(const std::string& key) const {
     const json& v = required(key);
     if (!v.is_object()) fail("key " + inQuotes(key) + " must be an object {...}, got " + describe(v));
@@ -351,25 +384,162 @@ TimeLawPtr parseLaw(const json& j, const std::string& where) {
   return located(where, [&] { return makeTabulatedLaw(std::move(times), std::move(values)); });
 }
 
-void parseBody(const json& j, const std::string& where, System& sys) {
-  ObjectReader r(j, where);
-  r.peekName();
-  readType(r, "body", {"rigid"});
-  r.allowOnly({"name", "type", "mass", "inertia", "com", "position", "angle", "velocity", "angular_velocity"});
-  const std::string name = r.name("name");
-  if (name == "ground") {
-    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
-           "in joints, do not define it)");
-  }
-  RigidBodyProperties props;
-  props.mass = r.positive("mass");
-  props.inertia = r.positive("inertia");
-  props.com = r.vec2("com", Vec2::Zero());
+FrameState2d parseFrameState(const ObjectReader& r) {
   FrameState2d init;
   init.position = r.vec2("position", Vec2::Zero());
   init.angle = r.number("angle", 0.0);
   init.velocity = r.vec2("velocity", Vec2::Zero());
   init.angularVelocity = r.number("angular_velocity", 0.0);
+  return init;
+}
+
+BeamSection parseSection(const json& j, const std::string& where) {
+  ObjectReader r(j, where);
+  r.allowOnly({"area", "inertia", "width", "height", "youngs_modulus", "density", "damping"});
+  BeamSection s;
+  if (r.has("width") || r.has("height")) {
+    if (r.has("area") || r.has("inertia")) r.fail("give either width and height, or area and inertia, not both");
+    s = rectangularSection(r.positive("width"), r.positive("height"), 1.0, 1.0);
+  } else {
+    s.area = r.positive("area");
+    s.inertia = r.positive("inertia");
+  }
+  s.youngsModulus = r.positive("youngs_modulus");
+  s.density = r.positive("density");
+  s.damping = r.nonNegative("damping", 0.0);
+  return s;
+}
+
+FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
+  FfrBeamOptions o;
+  const ObjectReader ref(r.object("reference"), r.where() + ": reference");
+  const std::string type = ref.string("type");
+  if (type == "pinned_pinned") {
+    ref.allowOnly({"type", "nodes"}, " for pinned_pinned");
+    o.reference.type = ReferenceConditions::Type::PinnedPinned;
+    o.reference.nodeA = 0;
+    o.reference.nodeB = numNodes - 1;
+    if (ref.has("nodes")) {
+      const json& n = ref.required("nodes");
+      if (!n.is_array() || n.size() != 2) ref.fail("key \"nodes\" must be two node indices [A, B], got " + describe(n));
+      o.reference.nodeA = ref.index(n[0], "nodes[0]");
+      o.reference.nodeB = ref.index(n[1], "nodes[1]");
+    }
+  } else if (type == "clamped") {
+    ref.allowOnly({"type", "node"}, " for clamped");
+    o.reference.type = ReferenceConditions::Type::Clamped;
+    o.reference.nodeA = static_cast<int>(ref.integer("node", 0, 0));
+  } else if (type == "free_free") {
+    ref.allowOnly({"type"}, " for free_free");
+    o.reference.type = ReferenceConditions::Type::FreeFree;
+  } else {
+    ref.fail("unknown reference type " + inQuotes(type) + " (expected one of: pinned_pinned, clamped, free_free)");
+  }
+  if (r.has("modes")) {
+    const json& m = r.required("modes");
+    if (m.is_array()) {
+      for (std::size_t k = 0; k < m.size(); ++k) o.modeSet.push_back(r.index(m[k], "modes[" + std::to_string(k) + "]"));
+      if (o.modeSet.empty()) r.fail("key \"modes\" must list at least one mode");
+    } else {
+      o.modes = static_cast<int>(r.integer("modes", 0, 1));
+    }
+  }
+  o.geometricStiffening = r.boolean("geometric_stiffening", false);
+  return o;
+}
+
+void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
+  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "section", "beam", "nodes",
+               "elements", "reference", "modes", "geometric_stiffening"}, " for a flexible body");
+  const BeamSection section = parseSection(r.object("section"), r.where() + ": section");
+  BeamMesh2d mesh;
+  if (r.has("beam")) {
+    if (r.has("nodes") || r.has("elements")) r.fail("give either \"beam\" or \"nodes\" and \"elements\", not both");
+    const ObjectReader b(r.object("beam"), r.where() + ": beam");
+    b.allowOnly({"length", "elements", "origin"});
+    const double length = b.positive("length");
+    const int n = static_cast<int>(b.integer("elements", 1, 1));
+    mesh = located(b.where(), [&] { return BeamMesh2d::straight(length, n, section, b.vec2("origin", Vec2::Zero())); });
+  } else {
+    const MatX nodes = r.matrix("nodes");
+    if (nodes.cols() != 2 || nodes.rows() < 2) r.fail("key \"nodes\" must list at least two points [[x, y], ...]");
+    for (int i = 0; i < nodes.rows(); ++i) mesh.nodes.push_back(nodes.row(i).transpose());
+    const json& els = r.required("elements");
+    if (!els.is_array() || els.empty()) r.fail("key \"elements\" must be a non-empty array of node pairs [[i, j], ...]");
+    for (std::size_t e = 0; e < els.size(); ++e) {
+      const std::string label = "elements[" + std::to_string(e) + "]";
+      if (!els[e].is_array() || els[e].size() != 2) r.fail("key " + inQuotes(label) + " must be a node pair [i, j], got " + describe(els[e]));
+      mesh.elements.push_back({r.index(els[e][0], label + "[0]"), r.index(els[e][1], label + "[1]"), section});
+    }
+  }
+  const FfrBeamOptions options = parseBeamOptions(r, static_cast<int>(mesh.nodes.size()));
+  const FrameState2d init = parseFrameState(r);
+  located(r.where(), [&] {
+    auto model = std::make_shared<FfrBeamModel>(std::move(mesh), options, "body '" + name + "'");
+    return sys.addBody(std::make_unique<FfrBody2d>(name, model, init));
+  });
+}
+
+void parseInvariantBody(const ObjectReader& r, const std::string& name, System& sys) {
+  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "invariants"},
+              " for a flexible_invariants body");
+  const ObjectReader iv(r.object("invariants"), r.where() + ": invariants");
+  iv.allowOnly({"mass", "first_moment", "polar_moment", "s_bar", "i1", "j0", "m_ff", "s_tilde", "k_ff", "d_ff", "points"});
+  FfrInvariants inv;
+  inv.mass = iv.positive("mass");
+  inv.firstMoment = iv.vec2("first_moment");
+  inv.polarMoment = iv.positive("polar_moment");
+  inv.mff = iv.matrix("m_ff");
+  const int nf = static_cast<int>(inv.mff.rows());
+  const auto sized = [&](MatX m, const char* key, int rows, int cols) {
+    if (m.rows() != rows || m.cols() != cols) {
+      iv.fail("key " + inQuotes(key) + " must be a " + std::to_string(rows) + " x " + std::to_string(cols) +
+              " matrix (" + std::to_string(nf) + " elastic coordinates, from m_ff), got " + std::to_string(m.rows()) +
+              " x " + std::to_string(m.cols()));
+    }
+    return m;
+  };
+  inv.mff = sized(inv.mff, "m_ff", nf, nf);
+  inv.sBar = sized(iv.matrix("s_bar"), "s_bar", 2, nf);
+  inv.i1 = sized(iv.vector("i1"), "i1", nf, 1);
+  inv.j0 = sized(iv.vector("j0"), "j0", nf, 1);
+  inv.sTilde = sized(iv.matrix("s_tilde"), "s_tilde", nf, nf);
+  inv.kff = sized(iv.matrix("k_ff"), "k_ff", nf, nf);
+  inv.dff = iv.has("d_ff") ? sized(iv.matrix("d_ff"), "d_ff", nf, nf) : MatX::Zero(nf, nf);
+  const json& pts = iv.array("points");
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const ObjectReader p(pts[k], iv.where() + ": points[" + std::to_string(k) + "]");
+    p.allowOnly({"position", "shape", "rotation_shape"});
+    FfrPoint fp;
+    fp.position = p.vec2("position");
+    fp.shape = p.matrix("shape");
+    fp.rotationShape = p.vector("rotation_shape").transpose();
+    if (fp.shape.rows() != 2 || fp.shape.cols() != nf || fp.rotationShape.size() != nf) {
+      p.fail("\"shape\" must be 2 x " + std::to_string(nf) + " and \"rotation_shape\" " + std::to_string(nf) + " numbers");
+    }
+    inv.points.push_back(fp);
+  }
+  const FrameState2d init = parseFrameState(r);
+  located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody2d>(name, std::move(inv), init)); });
+}
+
+void parseBody(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants"});
+  const std::string name = r.name("name");
+  if (name == "ground") {
+    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
+           "in joints, do not define it)");
+  }
+  if (type == "flexible") return parseFlexibleBody(r, name, sys);
+  if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
+  r.allowOnly({"name", "type", "mass", "inertia", "com", "position", "angle", "velocity", "angular_velocity"});
+  RigidBodyProperties props;
+  props.mass = r.positive("mass");
+  props.inertia = r.positive("inertia");
+  props.com = r.vec2("com", Vec2::Zero());
+  const FrameState2d init = parseFrameState(r);
   located(r.where(), [&] { return sys.addRigidBody(name, props, init); });
 }
 
@@ -495,7 +665,7 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
                           const std::vector<OutputRequest>& earlier) {
   ObjectReader r(j, where);
   r.peekName();
-  const std::string type = readType(r, "output", {"point", "energy"});
+  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
   OutputRequest out;
   if (type == "energy") {
     r.allowOnly({"type"}, " for an energy output");
@@ -505,8 +675,8 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
     out.type = OutputRequest::Type::Energy;
     return out;
   }
-  r.allowOnly({"type", "name", "body", "point"}, " for a point output");
-  out.type = OutputRequest::Type::Point;
+  r.allowOnly({"type", "name", "body", "point"}, " for a " + type + " output");
+  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
   out.name = r.name("name");
   // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
   // "<joint>.fx" or with another output's columns.
@@ -522,13 +692,24 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
     }
   }
   for (const auto& o : earlier) {
-    if (o.type == OutputRequest::Type::Point && o.name == out.name) {
+    if (o.type != OutputRequest::Type::Energy && o.name == out.name) {
       r.fail("duplicate output name " + inQuotes(out.name));
     }
   }
   out.bodyName = r.name("body");
   out.body = lookupBody(sys, out.bodyName, r);
   out.point = r.vec2("point", Vec2::Zero());
+  if (out.type == OutputRequest::Type::Deflection) {
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
+    if (!fb || !fb->beamModel()) {
+      r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
+    }
+    if (!fb->beamModel()->locate(out.point, out.element, out.xi)) {
+      r.fail("point [" + fmt(out.point.x()) + ", " + fmt(out.point.y()) + "] is not on the axis of any element of body " +
+             inQuotes(out.bodyName) + " (undeformed, body frame)");
+    }
+    return out;
+  }
   located(r.where(), [&] { sys.body(out.body).checkAttachmentPoint(out.point, "output " + inQuotes(out.name)); });
   return out;
 }
@@ -646,6 +827,7 @@ std::string plainMessage(const json::exception& e) {
 
 std::vector<std::string> OutputRequest::columnNames() const {
   if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
+  if (type == Type::Deflection) return {name + ".ux", name + ".uy", name + ".N", name + ".M"};
   return {name + ".x", name + ".y", name + ".vx", name + ".vy"};
 }
 
@@ -657,6 +839,13 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
   }
   const Body& b = sys.body(body);
   const int off = sys.coordinateOffset(body);
+  if (type == Type::Deflection) {
+    const FfrBeamModel& model = *static_cast<const FfrBody2d&>(b).beamModel();
+    const VecX qf = q.segment(off + 3, model.numElastic());
+    const Vec2 u = model.materialPoint(element, xi).shape * qf;
+    const Vec2 f = model.sectionForces(qf, element, xi);
+    return {u.x(), u.y(), f.x(), f.y()};
+  }
   const int n = b.numCoordinates();
   const PointKinematics pk = b.pointKinematics(q.segment(off, n), point);
   const Vec2 vel = n > 0 ? Vec2(pk.Jr * v.segment(off, n)) : Vec2::Zero();

@@ -18,14 +18,19 @@ struct OutputRequest {
   enum class Type {
     Point,   ///< world position and velocity of a body point
     Energy,  ///< kinetic, potential and total energy of the system
+    Deflection,  ///< elastic displacement (body frame) and section forces at a beam point
   };
   Type type = Type::Point;
   std::string name;            ///< Point: prefix of the columns
   std::string bodyName;        ///< Point: the body the point belongs to
   BodyIndex body;              ///< Point: index of that body in the System
-  Vec2 point = Vec2::Zero();   ///< Point: body-frame coordinates of the point
+  Vec2 point = Vec2::Zero();   ///< Point, Deflection: body-frame coordinates of the point
+  int element = 0;             ///< Deflection: element of the beam mesh holding the point
+  double xi = 0.0;             ///< Deflection: its local coordinate in [0, 1]
 
   /// Point: "<name>.x", "<name>.y", "<name>.vx", "<name>.vy";
+  /// Deflection: "<name>.ux", "<name>.uy" (elastic displacement in the body frame),
+  /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there);
   /// Energy: "energy.kinetic", "energy.potential", "energy.total".
   std::vector<std::string> columnNames() const;
   /// Values matching columnNames() at global coordinates q and velocities v (size nq).
