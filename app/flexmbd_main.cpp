@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "app/kinematics_command.hpp"
+#include "app/tensegrity_command.hpp"
 #include "core/errors.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
@@ -198,6 +199,9 @@ double cpuSecondsSince(std::clock_t start) {
 }
 
 int runCommand(const Options& o) {
+  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
+    return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet});
+  }
   const std::filesystem::path outDir(o.outDir);
   std::error_code ec;
   if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec)) {

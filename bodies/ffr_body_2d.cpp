@@ -37,9 +37,23 @@ std::vector<std::string> FfrBody2d::coordinateNames() const {
   return n;
 }
 
+FfrBody2d& FfrBody2d::setInitialElasticState(const VecX& qf, const VecX& qfDot) {
+  const std::string who = "body '" + name() + "'";
+  if (qf.size() != numElastic() || qfDot.size() != numElastic()) {
+    throw InputError(who + ": initial elastic state must have " + std::to_string(numElastic()) + " entries, got " +
+                     std::to_string(qf.size()) + " and " + std::to_string(qfDot.size()));
+  }
+  if (!qf.allFinite() || !qfDot.allFinite()) throw InputError(who + ": initial elastic state is not finite");
+  initialQf_ = qf;
+  initialQfDot_ = qfDot;
+  return *this;
+}
+
 VecX FfrBody2d::initialCoordinates() const {
   VecX q = VecX::Zero(numCoordinates());
-  q << initial_.position, initial_.angle, VecX::Zero(numElastic());
+  q.head<2>() = initial_.position;
+  q[2] = initial_.angle;
+  if (initialQf_.size() == numElastic()) q.tail(numElastic()) = initialQf_;
   return q;
 }
 
@@ -47,6 +61,7 @@ VecX FfrBody2d::initialVelocities() const {
   VecX v = VecX::Zero(numCoordinates());
   v.head<2>() = initial_.velocity;
   v[2] = initial_.angularVelocity;
+  if (initialQfDot_.size() == numElastic()) v.tail(numElastic()) = initialQfDot_;
   return v;
 }
 

@@ -26,6 +26,11 @@ class FfrBody2d final : public Body {
   /// stiffening is available, and section forces for outputs).
   FfrBody2d(std::string name, std::shared_ptr<const FfrBeamModel> model, const FrameState2d& initial);
 
+  /// Initial elastic coordinates and velocities (default zero: undeformed, at rest
+  /// relative to the frame). Call before adding the body to a System.
+  /// @throws InputError if the sizes are not numElastic() or values are not finite.
+  FfrBody2d& setInitialElasticState(const VecX& qf, const VecX& qfDot);
+
   const FfrInvariants& invariants() const { return inv_; }
   /// The generating mesh model, or null if the body was given by its invariants.
   const FfrBeamModel* beamModel() const { return model_.get(); }
@@ -62,6 +67,7 @@ class FfrBody2d final : public Body {
   FfrInvariants inv_;
   std::shared_ptr<const FfrBeamModel> model_;
   FrameState2d initial_;
+  VecX initialQf_, initialQfDot_;
 };
 
 }  // namespace flexmbd

@@ -1,6 +1,10 @@
+// GCC 12 flags Eigen's triangular matrix-vector kernel, instantiated by the QR
+// preconditioner of JacobiSVD, with a false -Wmaybe-uninitialized; silenced for this
+// file only (the pragma must precede the first inclusion of Eigen).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include "integrators/self_equilibrium.hpp"
 
-#include <Eigen/QR>
 #include <Eigen/SVD>
 #include <sstream>
 
@@ -25,18 +29,8 @@ MatX equilibriumMatrix(const TensegrityStructure& s, const VecX& x) {
 
 SelfStressStates computeSelfStress(const TensegrityStructure& s, const VecX& x, double relativeTolerance) {
   const MatX A = equilibriumMatrix(s, x);
-  // Square the problem first (same null space): R of A = QR when A has more rows than
-  // columns, A padded with zero rows otherwise; then a two-sided Jacobi SVD without
-  // its own QR preconditioner (whose instantiation GCC 12 flags -Wmaybe-uninitialized).
   const int m = static_cast<int>(A.cols());
-  MatX square = MatX::Zero(m, m);
-  if (A.rows() >= m) {
-    const Eigen::HouseholderQR<MatX> qr(A);
-    square = qr.matrixQR().topRows(m).triangularView<Eigen::Upper>();
-  } else {
-    square.topRows(A.rows()) = A;
-  }
-  Eigen::JacobiSVD<MatX, Eigen::NoQRPreconditioner> svd(square, Eigen::ComputeFullV);
+  Eigen::JacobiSVD<MatX> svd(A, Eigen::ComputeFullV);
   SelfStressStates out;
   out.singularValues = svd.singularValues();
   const double smax = out.singularValues.size() > 0 ? out.singularValues[0] : 0.0;
@@ -80,3 +74,5 @@ void applyPrestress(TensegrityStructure& s, const VecX& q, double scale) {
 }
 
 }  // namespace flexmbd
+
+#pragma GCC diagnostic pop

@@ -142,6 +142,13 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     summary.ok = false;
     summary.message = e.what();
     summary.failureTime = e.time();
+  } catch (const std::exception& e) {
+    // post-processing of an output state failed (e.g. a singular mass matrix after the
+    // solution blew up): a failure of the run, reported like a solver failure
+    summary.ok = false;
+    summary.failureTime = ida.stats().currentTime;
+    summary.message = "evaluating the outputs at t = " + std::to_string(summary.failureTime) +
+                      " failed: " + e.what();
   }
   summary.stats = ida.stats();
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;

@@ -254,7 +254,7 @@ TEST_F(KinematicsCli, SliderCrankExitsZeroAndWritesOneRowPerStep) {
   EXPECT_NE(r.out.find("flexmbd: ok"), std::string::npos);
   const std::string csv = readFile(dir_ / "out" / "kinematics.csv");
   EXPECT_EQ(countLines(csv), 62);  // header + steps 0..60
-  EXPECT_EQ(csv.rfind("step,alpha,iterations,residual,rcond,alpha,O1.x,", 0), 0u) << csv.substr(0, 80);
+  EXPECT_EQ(csv.rfind("step,alpha,iterations,residual,rcond,crank_angle,O1.x,", 0), 0u) << csv.substr(0, 80);
   EXPECT_NE(csv.find("O3.d2x_da2"), std::string::npos);
   EXPECT_NE(csv.find("rod.omega_dot"), std::string::npos);
   const json s = json::parse(readFile(dir_ / "out" / "summary.json"));

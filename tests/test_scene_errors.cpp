@@ -331,8 +331,8 @@ TEST(SceneErrors, SolverRanges) {
 
 TEST(SceneErrors, UnknownTypes) {
   json j = baseScene();
-  j["bodies"][0]["type"] = "flexible";
-  EXPECT_TRUE(Mentions(errorOf(j), {"bodies[0] (\"crank\")", "unknown body type \"flexible\"", "rigid"}));
+  j["bodies"][0]["type"] = "elastic";
+  EXPECT_TRUE(Mentions(errorOf(j), {"bodies[0] (\"crank\")", "unknown body type \"elastic\"", "rigid", "flexible"}));
   j = baseScene();
   j["joints"][0]["type"] = "hinge";
   EXPECT_TRUE(Mentions(errorOf(j), {"joints[0] (\"O1\")", "unknown joint type \"hinge\"", "revolute"}));

@@ -1,0 +1,227 @@
+#include "app/tensegrity_command.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "io/results_writer.hpp"
+#include "io/tensegrity_scene.hpp"
+
+namespace flexmbd {
+
+namespace {
+
+constexpr int kExitOk = 0;
+constexpr int kExitSolverFailure = 1;
+constexpr int kExitInputError = 2;
+
+std::string oneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+void printError(const std::string& m) { std::cerr << "flexmbd: error: " << oneLine(m) << std::endl; }
+
+std::string num(double x) {
+  std::ostringstream os;
+  os.precision(17);
+  os << x;
+  return os.str();
+}
+
+/// Writes results.csv and events.csv as the run goes (each row flushed).
+class TensegrityResults {
+ public:
+  TensegrityResults(const std::filesystem::path& dir, const TensegrityStructure& s) : s_(s) {
+    results_.open(dir / "results.csv");
+    events_.open(dir / "events.csv");
+    if (!results_ || !events_) throw std::runtime_error("cannot write in " + dir.string());
+    const char* axes[3] = {"x", "y", "z"};
+    results_ << "t";
+    for (int i = 0; i < s.numNodes(); ++i) {
+      for (int a = 0; a < s.dimension(); ++a) results_ << "," << s.node(i).name << "." << axes[a];
+    }
+    for (int i = 0; i < s.numNodes(); ++i) {
+      for (int a = 0; a < s.dimension(); ++a) results_ << "," << s.node(i).name << ".v" << axes[a];
+    }
+    for (int c = 0; c < s.numCables(); ++c) {
+      const std::string& n = s.cable(c).name;
+      results_ << "," << n << ".tension," << n << ".slack," << n << ".impulse," << n << ".length";
+    }
+    results_ << ",energy.kinetic,energy.potential,energy.total\n";
+    events_ << "t,step,type,member,other,impulse,elongation_rate,energy_change,x,y,z\n";
+  }
+  void sample(const TensegritySample& smp) {
+    results_ << num(smp.t);
+    for (int k = 0; k < smp.x.size(); ++k) results_ << "," << num(smp.x[k]);
+    for (int k = 0; k < smp.v.size(); ++k) results_ << "," << num(smp.v[k]);
+    for (int c = 0; c < s_.numCables(); ++c) {
+      results_ << "," << num(smp.cableTension[c]) << "," << (smp.slack[c] ? 1 : 0) << "," << num(smp.cableImpulse[c])
+               << "," << num(smp.cableLength[c]);
+    }
+    results_ << "," << num(smp.kineticEnergy) << "," << num(smp.potentialEnergy) << ","
+             << num(smp.kineticEnergy + smp.potentialEnergy) << "\n";
+    results_.flush();
+    ++rows_;
+    lastTime_ = smp.t;
+  }
+  void event(const TensegrityEvent& e) {
+    events_ << num(e.t) << "," << e.step << "," << toString(e.type) << "," << e.member << "," << e.other << ","
+            << num(e.impulse) << "," << num(e.elongationRate) << "," << num(e.energyChange) << "," << num(e.point[0])
+            << "," << num(e.point[1]) << "," << num(e.point[2]) << "\n";
+    events_.flush();
+  }
+  long rows() const { return rows_; }
+  double lastTime() const { return lastTime_; }
+
+ private:
+  const TensegrityStructure& s_;
+  std::ofstream results_, events_;
+  long rows_ = 0;
+  double lastTime_ = NAN;
+};
+
+void writeTensegritySummary(const std::filesystem::path& dir, const TensegrityRunSummary& s,
+                            const TensegrityScene& scene) {
+  nlohmann::json j;
+  j["status"] = s.ok ? "ok" : "failed";
+  j["message"] = s.message;
+  j["model"] = "tensegrity";
+  j["scene"] = scene.name;
+  j["method"] = s.method;
+  j["t_reached"] = s.tReached;
+  j["steps"] = s.steps;
+  j["cpu_seconds"] = s.cpuSeconds;
+  j["snaps"] = s.snaps;
+  j["taut_transitions"] = s.tautTransitions;
+  j["slack_transitions"] = s.slackTransitions;
+  j["contacts"] = s.contacts;
+  j["energy_start"] = s.energyStart;
+  j["energy_end"] = s.energyEnd;
+  if (s.method == "time_stepping") {
+    j["lcp_solver"] = s.lcpSolver;
+    j["max_lcp_residual"] = s.maxLcpResidual;
+    j["max_lcp_size"] = s.maxLcpSize;
+    j["lcp_iterations"] = s.lcpIterations;
+    j["max_drift_before_projection"] = s.maxDriftBeforeProjection;
+    j["max_drift_after_projection"] = s.maxDriftAfterProjection;
+    j["projection_iterations"] = s.projectionIterations;
+    j["max_energy_increase_at_snap"] = s.snaps > 0 ? nlohmann::json(s.maxEnergyIncreaseAtSnap) : nlohmann::json();
+    j["time_step"] = scene.timeStepping.timeStep;
+  } else {
+    j["rhs_evals"] = s.rhsEvals;
+    j["root_evals"] = s.rootEvals;
+    j["error_test_failures"] = s.errorTestFailures;
+    j["nonlinear_conv_failures"] = s.nonlinearConvFailures;
+    j["rtol"] = scene.massless.cvode.rtol;
+    j["atol"] = scene.massless.cvode.atol;
+  }
+  const std::filesystem::path tmp = dir / "summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << j.dump(2) << "\n";
+  }
+  std::filesystem::rename(tmp, dir / "summary.json");
+}
+
+int reportInputError(const std::filesystem::path& outDir, const std::string& message) {
+  try {
+    removeStaleResults(outDir);
+    std::filesystem::remove(outDir / "events.csv");
+    writeInputErrorSummary(outDir, oneLine(message));
+  } catch (...) {
+  }
+  printError(message);
+  return kExitInputError;
+}
+
+}  // namespace
+
+bool isTensegrityScene(const std::string& scenePath) { return isTensegritySceneFile(scenePath); }
+
+int runTensegrityCommand(const TensegrityRunOptions& o) {
+  const std::filesystem::path outDir(o.outDir);
+  std::error_code ec;
+  if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec)) {
+    printError("--out '" + o.outDir + "' exists and is not a directory");
+    return kExitInputError;
+  }
+  TensegrityScene scene;
+  try {
+    scene = loadTensegrityScene(o.scenePath);
+    if (scene.method == TensegrityScene::Method::TimeStepping) {
+      if (o.rtol || o.atol) throw InputError("options --rtol and --atol apply to method \"massless_cables\" only");
+      if (o.tEnd) {
+        if (!(*o.tEnd > scene.timeStepping.tStart)) throw InputError("option --t-end must be > t_start");
+        scene.timeStepping.tEnd = *o.tEnd;
+      }
+    } else {
+      if (o.tEnd) {
+        if (!(*o.tEnd > scene.massless.tStart)) throw InputError("option --t-end must be > t_start");
+        scene.massless.tEnd = *o.tEnd;
+      }
+      if (o.rtol) scene.massless.cvode.rtol = *o.rtol;
+      if (o.atol) scene.massless.cvode.atol = *o.atol;
+    }
+  } catch (const std::exception& e) {
+    return reportInputError(outDir, e.what());
+  }
+
+  std::optional<TensegrityResults> results;
+  try {
+    std::filesystem::create_directories(outDir);
+    removeStaleResults(outDir);
+    results.emplace(outDir, *scene.structure);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
+  const TensegrityObserver observer{[&](const TensegritySample& s) { results->sample(s); },
+                                    [&](const TensegrityEvent& e) { results->event(e); }};
+  TensegrityRunSummary summary;
+  try {
+    if (scene.method == TensegrityScene::Method::TimeStepping) {
+      summary = TensegrityTimeStepper(*scene.structure, scene.timeStepping).run(observer);
+    } else {
+      summary = MasslessCableIntegrator(*scene.structure, scene.massless).run(observer);
+    }
+  } catch (const InputError& e) {
+    return reportInputError(outDir, o.scenePath + ": " + e.what());
+  } catch (const std::exception& e) {
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = results->lastTime();
+  }
+  try {
+    writeTensegritySummary(outDir, summary, scene);
+  } catch (const std::exception& e) {
+    printError(std::string("cannot write the summary: ") + e.what());
+    return kExitSolverFailure;
+  }
+  if (!summary.ok) {
+    printError("solver failure: " + summary.message + " (" +
+               (results->rows() > 0 ? "results up to t = " + num(results->lastTime()) + " kept in " +
+                                          (outDir / "results.csv").string()
+                                    : std::string("no results were written")) +
+               ")");
+    return kExitSolverFailure;
+  }
+  {  // the one-line report of `run` (--quiet only silences progress, as for `run`)
+    std::cout << "flexmbd: ok: t = " << summary.tReached << " reached, " << summary.steps << " steps, "
+              << summary.snaps << " snaps, " << summary.slackTransitions << " slack, " << summary.contacts
+              << " contacts, " << summary.cpuSeconds << " s CPU; results in " << (outDir / "results.csv").string()
+              << std::endl;
+  }
+  return kExitOk;
+}
+
+}  // namespace flexmbd

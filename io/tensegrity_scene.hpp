@@ -1,0 +1,33 @@
+// Tensegrity scene files: JSON with top-level "model": "tensegrity", read strictly
+// (unknown keys, missing keys, wrong types and out-of-range numbers are errors naming
+// their location). Format: docs/tensegrity.md.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "bodies/tensegrity_structure.hpp"
+#include "integrators/massless_cable_integrator.hpp"
+#include "integrators/tensegrity_time_stepper.hpp"
+
+namespace flexmbd {
+
+struct TensegrityScene {
+  std::string name;
+  std::unique_ptr<TensegrityStructure> structure;  ///< finalized (and prestressed if asked)
+  enum class Method { TimeStepping, MasslessCables } method = Method::TimeStepping;
+  TimeSteppingSettings timeStepping;   ///< method 1 ("time_stepping")
+  MasslessCableSettings massless;      ///< method 2 ("massless_cables")
+};
+
+/// True if the file is a JSON object whose "model" is "tensegrity" (false if it cannot
+/// be read or parsed: the ordinary scene reader then reports the error).
+bool isTensegritySceneFile(const std::string& path);
+
+/// @throws InputError (one line, starting with the file and the location).
+TensegrityScene loadTensegrityScene(const std::string& path);
+TensegrityScene parseTensegrityScene(const nlohmann::json& j);
+
+}  // namespace flexmbd
