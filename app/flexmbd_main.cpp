@@ -23,6 +23,7 @@
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "io/vtk_writer.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -37,7 +38,7 @@ constexpr int kExitSolverFailure = 1;
 constexpr int kExitInputError = 2;
 
 const char* const kUsage =
-    "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]\n"
+    "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--vtk] [--quiet]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
     "                          [--corrector newton|modified_newton]\n"
     "       flexmbd --help\n"
@@ -52,6 +53,7 @@ const char* const kUsage =
     "  --rtol R     relative tolerance, overrides solver.rtol\n"
     "  --atol A     absolute tolerance of positions, overrides solver.atol (and of\n"
     "               velocities too unless the scene sets solver.atol_velocity)\n"
+    "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView)\n"
     "  --quiet, -q  no progress display\n"
     "  --help, -h   this text\n"
     "\n"
@@ -77,6 +79,7 @@ struct Options {
   std::string outDir;
   std::optional<double> tEnd, rtol, atol;
   bool quiet = false;
+  bool vtk = false;  ///< also write DIR/vtk/bodies_*.vtu and bodies.pvd
 };
 
 /// Messages go to the terminal on one line.
@@ -144,6 +147,10 @@ Options parseCommandLine(int argc, char** argv) {
       o.quiet = true;
       continue;
     }
+    if (a == "--vtk") {
+      o.vtk = true;
+      continue;
+    }
     // --name VALUE or --name=VALUE
     std::string name = a, value;
     bool haveValue = false;
@@ -153,7 +160,8 @@ Options parseCommandLine(int argc, char** argv) {
       haveValue = true;
     }
     if (name != "--out" && name != "--t-end" && name != "--rtol" && name != "--atol") {
-      throw UsageError("unknown option '" + name + "' (known options: --out, --t-end, --rtol, --atol, --quiet, --help)");
+      throw UsageError("unknown option '" + name +
+                       "' (known options: --out, --t-end, --rtol, --atol, --vtk, --quiet, --help)");
     }
     if (!haveValue) {
       if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
@@ -229,8 +237,10 @@ int runCommand(const Options& o) {
   }
 
   std::optional<ResultsWriter> writer;
+  std::optional<VtkWriter> vtk;
   try {
     writer.emplace(outDir, *scene);
+    if (o.vtk) vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;
@@ -241,7 +251,10 @@ int runCommand(const Options& o) {
   SimulationSummary summary;
   try {
     summary = simulate(scene->system, scene->solver,
-                       [&](const OutputSample& sample) { writer->write(sample); });
+                       [&](const OutputSample& sample) {
+                         writer->write(sample);
+                         if (vtk) vtk->write(sample);
+                       });
   } catch (const InputError& e) {
     // Includes ModelError: the model cannot be set up (assembly, redundant or
     // conflicting constraints). Nothing was integrated.
