@@ -111,6 +111,8 @@ void writeTensegritySummary(const std::filesystem::path& dir, const TensegrityRu
     j["max_lcp_residual"] = s.maxLcpResidual;
     j["max_lcp_size"] = s.maxLcpSize;
     j["lcp_iterations"] = s.lcpIterations;
+    j["lcp_solves"] = s.lcpSolves;
+    j["contact_impulse_sum"] = s.contactImpulseSum;
     j["max_drift_before_projection"] = s.maxDriftBeforeProjection;
     j["max_drift_after_projection"] = s.maxDriftAfterProjection;
     j["projection_iterations"] = s.projectionIterations;

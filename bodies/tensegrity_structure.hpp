@@ -112,6 +112,8 @@ class TensegrityStructure {
   int numFreeCoordinates() const { return static_cast<int>(free_.size()); }
   /// Full-vector indices of the free coordinates.
   const std::vector<int>& freeCoordinates() const { return free_; }
+  /// Free index of a full coordinate index, -1 if that coordinate is fixed.
+  int freeIndexOf(int fullIndex) const { return freeIndexOf_.at(fullIndex); }
   VecX initialPositions() const;   ///< full
   VecX initialVelocities() const;  ///< full
   /// Full vector from the free part, fixed coordinates from `fullTemplate`.

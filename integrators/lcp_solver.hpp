@@ -31,7 +31,7 @@ struct LcpSolution {
   double residual = 0.0;
   int iterations = 0;  ///< pivots (Lemke) or sweeps (PGS) reported by Siconos
   int info = 0;        ///< Siconos' return code (0: converged)
-  bool ok = true;      ///< info == 0 and residual <= tolerance
+  bool ok = true;      ///< residual <= tolerance (Siconos' info is reported, not used)
 };
 
 class LcpSolver {

@@ -57,6 +57,9 @@ struct TensegrityRunSummary {
   double maxLcpResidual = 0.0;
   int maxLcpSize = 0;
   long lcpIterations = 0;
+  double contactImpulseSum = 0.0;  ///< method 1 with contact constraints: sum of contact impulses
+  long lcpSolves = 0;   ///< method 1: LCPs of the impulses solved (projection LCPs not counted)
+  long lcpSizeSum = 0;  ///< method 1: sum of their sizes (mean size = lcpSizeSum / lcpSolves)
   std::string lcpSolver;
   /// Method 2: CVODE statistics.
   long rhsEvals = 0, rootEvals = 0, errorTestFailures = 0, nonlinearConvFailures = 0;

@@ -1,6 +1,7 @@
 #include "integrators/tensegrity_time_stepper.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <ctime>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "elements/segment_closest_points.hpp"
 #include "integrators/member_contact_detector.hpp"
 
 namespace flexmbd {
@@ -58,6 +60,53 @@ double rowDot(const Row& b, const VecX& v) {
   return s;
 }
 
+/// A pair of members that may touch (contact constraints): node indices, r_a + r_b and
+/// the length scale L of the relative penetration (mean initial length of the two).
+struct ContactPair {
+  int ai, aj, bi, bj;
+  double reach, scale;
+};
+
+struct ContactRow {
+  double gap = 0.0;  ///< d - (r_a + r_b)
+  Row b;             ///< -d gap/du on the free coordinates (the cables' sign: w = -b v)
+};
+
+/// Gap and its gradient at x, closest points frozen (their derivative does not enter:
+/// d is stationary in the segment parameters, or they sit at a clamped end).
+ContactRow contactRow(const TensegrityStructure& s, const VecX& x, const ContactPair& p) {
+  const int dim = s.dimension();
+  auto pt = [&](int n) {
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    r.head(dim) = x.segment(dim * n, dim);
+    return r;
+  };
+  const Eigen::Vector3d a0 = pt(p.ai), a1 = pt(p.aj), b0 = pt(p.bi), b1 = pt(p.bj);
+  const SegmentClosestPoints cp = closestPointsOfSegments(a0, a1, b0, b1);
+  Eigen::Vector3d n = cp.c1 - cp.c2;  // from member b to member a
+  if (cp.distance > 1e-14 * p.scale) {
+    n /= cp.distance;
+  } else {  // axes intersect: the normal of the two axes (undefined if parallel)
+    n = (a1 - a0).cross(b1 - b0);
+    if (dim == 2 || n.norm() <= 1e-14 * p.scale * p.scale) {
+      throw SolverError("contact constraint: the axes of two members intersect, the contact normal is undefined", 0.0,
+                        0.0);
+    }
+    n.normalize();
+  }
+  ContactRow out;
+  out.gap = cp.distance - p.reach;
+  const double w[4] = {1.0 - cp.s, cp.s, -(1.0 - cp.t), -cp.t};
+  const int nodes[4] = {p.ai, p.aj, p.bi, p.bj};
+  for (int k = 0; k < 4; ++k) {
+    for (int c = 0; c < dim; ++c) {
+      const int f = s.freeIndexOf(dim * nodes[k] + c);
+      if (f >= 0 && w[k] * n[c] != 0.0) out.b.emplace_back(f, -w[k] * n[c]);
+    }
+  }
+  return out;
+}
+
 std::string num(double x) {
   std::ostringstream os;
   os.precision(6);
@@ -90,6 +139,21 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
   const int nc = s_.numCables();
   const int nf = s_.numFreeCoordinates();
   const MatX Minv = s_.massMatrix().ldlt().solve(MatX::Identity(nf, nf));
+  std::vector<ContactPair> cpairs;
+  if (o.contactConstraints) {
+    const std::vector<MemberRef> mem = s_.members();
+    const VecX x0 = s_.initialPositions();
+    auto length = [&](int i, int j) { return (x0.segment(s_.dimension() * j, s_.dimension()) - x0.segment(s_.dimension() * i, s_.dimension())).norm(); };
+    for (std::size_t a = 0; a < mem.size(); ++a) {
+      for (std::size_t b = a + 1; b < mem.size(); ++b) {
+        const auto [ai, aj] = s_.memberNodes(mem[a]);
+        const auto [bi, bj] = s_.memberNodes(mem[b]);
+        if (ai == bi || ai == bj || aj == bi || aj == bj) continue;
+        cpairs.push_back({ai, aj, bi, bj, s_.memberRadius(mem[a]) + s_.memberRadius(mem[b]),
+                          0.5 * (length(ai, aj) + length(bi, bj))});
+      }
+    }
+  }
 
   TensegrityRunSummary sum;
   sum.method = "time_stepping";
@@ -174,24 +238,33 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
           B.push_back(s_.cableGradientEntries(xm, c));
         }
       }
-      VecX p = VecX::Zero(static_cast<int>(active.size()));
-      if (!active.empty()) {
+      // Contact constraints (option): rows after the cables' ones.
+      for (const ContactPair& cp : cpairs) {
+        ContactRow r = contactRow(s_, xm, cp);
+        if (r.gap <= o.slackTolerance * cp.scale) B.push_back(std::move(r.b));
+      }
+      VecX p = VecX::Zero(static_cast<int>(B.size()));
+      if (!B.empty()) {
         const MatX W = delassus(B, Minv);
-        VecX q(static_cast<int>(active.size()));
-        for (std::size_t a = 0; a < active.size(); ++a) q[a] = -rowDot(B[a], vf);
+        VecX q(static_cast<int>(B.size()));
+        for (std::size_t a = 0; a < B.size(); ++a) q[a] = -rowDot(B[a], vf);
         const LcpSolution sol = lcp.solve(W, q);
         sum.maxLcpResidual = std::max(sum.maxLcpResidual, sol.residual);
         sum.maxLcpSize = std::max(sum.maxLcpSize, static_cast<int>(active.size()));
         sum.lcpIterations += sol.iterations;
+        ++sum.lcpSolves;
+        sum.lcpSizeSum += static_cast<long>(B.size());
         if (!sol.ok) {
           throw SolverError("LCP (" + toString(o.lcp.method) + ") of the cable impulses failed at step " +
                                 std::to_string(step) + " (t = " + num(t) + ", dt = " + num(dt) + ", " +
-                                std::to_string(active.size()) + " active cables): residual " + num(sol.residual) +
+                                std::to_string(active.size()) + " active cables, " +
+                                std::to_string(B.size() - active.size()) + " contacts): residual " + num(sol.residual) +
                                 " > tolerance " + num(o.lcp.tolerance) + " after " + std::to_string(sol.iterations) +
                                 " iterations (Siconos info " + std::to_string(sol.info) + ")",
                             t, dt);
         }
         p = sol.z;
+        for (std::size_t a = active.size(); a < B.size(); ++a) sum.contactImpulseSum += p[a];
         vf -= impulseResponse(B, p, Minv);
       }
       VecX xf = xm + 0.5 * dt * s_.expand(vf, VecX::Zero(s_.numCoordinates()));
@@ -202,6 +275,7 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
         for (int c = 0; c < nc; ++c) {
           if (s_.cable(c).inextensible) d = std::max(d, (l[c] - s_.cable(c).naturalLength) / s_.cable(c).naturalLength);
         }
+        for (const ContactPair& cp : cpairs) d = std::max(d, -contactRow(s_, xx, cp).gap / cp.scale);
         return d;
       };
       double d = drift(xf);
@@ -218,6 +292,13 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
             if (cb.inextensible && l[c] >= cb.naturalLength * (1.0 - o.slackTolerance)) {
               Bp.push_back(s_.cableGradientEntries(xf, c));
               gs.push_back(l[c] - cb.naturalLength);
+            }
+          }
+          for (const ContactPair& cp : cpairs) {
+            ContactRow r = contactRow(s_, xf, cp);
+            if (r.gap <= o.slackTolerance * cp.scale) {
+              Bp.push_back(std::move(r.b));
+              gs.push_back(-r.gap);
             }
           }
           g = Eigen::Map<const VecX>(gs.data(), static_cast<int>(gs.size()));

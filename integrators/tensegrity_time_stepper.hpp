@@ -38,6 +38,13 @@ struct TimeSteppingSettings {
   /// A snap needs a pre-step elongation rate above this (length/time).
   double snapRateTolerance = 1e-8;
   bool detectContacts = false;
+  /// Contact as a unilateral constraint (scene key solver.contact_constraints): every pair
+  /// of members sharing no node whose gap d - (r_a + r_b) at u_m is <= slackTolerance * L
+  /// (L: mean initial length of the two members) enters the same LCP as the cables, in
+  /// rate form: w = (d gap/du) v_f >= 0, impulse p >= 0 along the normal of the closest
+  /// points (inelastic: the normal relative velocity is zero after the contact step);
+  /// penetration -gap/L is removed by the same projection as the cable drift.
+  bool contactConstraints = false;
 };
 
 class TensegrityTimeStepper {

@@ -330,7 +330,8 @@ TensegrityScene parseTensegrityScene(const json& j) {
   const std::string method = sv.string("method");
   if (method == "time_stepping") {
     sv.allowOnly({"method", "t_start", "t_end", "time_step", "output_step", "lcp", "lcp_tolerance",
-                  "lcp_max_iterations", "projection", "projection_tolerance", "slack_tolerance", "contacts"});
+                  "lcp_max_iterations", "projection", "projection_tolerance", "slack_tolerance", "contacts",
+                  "contact_constraints"});
     scene.method = TensegrityScene::Method::TimeStepping;
     TimeSteppingSettings& o = scene.timeStepping;
     o.tStart = sv.number("t_start", 0.0);
@@ -344,6 +345,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
     o.projectionTolerance = sv.positive("projection_tolerance", 1e-12);
     o.slackTolerance = sv.nonNegative("slack_tolerance", 1e-9);
     o.detectContacts = sv.boolean("contacts", false);
+    o.contactConstraints = sv.boolean("contact_constraints", false);
     if (!(o.tEnd > o.tStart)) sv.fail("key \"t_end\" must be > t_start, got " + fmt(o.tEnd));
     located(sv.where(), [&] { return TensegrityTimeStepper(s, o), 0; });
   } else if (method == "massless_cables") {

@@ -298,3 +298,22 @@ TEST(FfrSliderCrank, MidpointDeflectionConvergesWithMeshAndModalAgrees) {
     EXPECT_LT(rel, kModalAgreement);
   }
 }
+
+TEST(FfrSliderCrank, MidpointDeflectionConvergesWithTolerance) {
+  // 8 elements reduced to 2 modes; the reference is the run at rtol 1e-11.
+  Scene ref = testmodels::elasticSliderCrank(8, 1.0, 2, 1.0, 1e-11, 1e-13);
+  const CrankRun r0 = runCrank(ref);
+  ASSERT_TRUE(r0.summary.ok);
+  double previous = INFINITY;
+  for (double rtol : {1e-4, 1e-6, 1e-8}) {
+    Scene s = testmodels::elasticSliderCrank(8, 1.0, 2, 1.0, rtol, rtol * 1e-2);
+    const CrankRun r = runCrank(s);
+    ASSERT_TRUE(r.summary.ok) << r.summary.message;
+    const double err = std::abs(r.peakDeflection - r0.peakDeflection) / r0.peakDeflection;
+    std::printf("[ measured ] rtol %.0e: peak %.6e m (error %.2e against rtol 1e-11), %ld steps\n", rtol,
+                r.peakDeflection, err, r.summary.stats.steps);
+    EXPECT_LT(err, previous);    // converges
+    EXPECT_LT(err, 1e3 * rtol);  // and at the rate of the tolerance (global error ~ 10-1000 rtol)
+    previous = err;
+  }
+}
