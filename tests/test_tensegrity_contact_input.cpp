@@ -126,9 +126,8 @@ TEST(TensegrityInput, UnknownKeyAndUnknownNode) {
 }
 
 // Three masses, two inextensible cables snapping at once, solved with Siconos' projected
-// Gauss-Seidel limited to one sweep and a 1e-14 tolerance: it does not converge (and in
-// this build lcp_pgs returns info 2 on these matrices, see docs/tensegrity.md); what is
-// tested is that the failure is reported with the step and the residual.
+// Gauss-Seidel limited to one sweep and a 1e-14 tolerance: it does not converge (Siconos
+// info 1); what is tested is that the failure is reported with the step and the residual.
 TEST(TensegrityInput, LcpFailureReportsResidualAndStep) {
   TensegrityStructure s(2);
   s.addNode("a", Eigen::Vector2d(0, 0), 1.0, {}, Eigen::Vector2d(-1, 0));
