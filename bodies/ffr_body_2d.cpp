@@ -206,13 +206,13 @@ void FfrBody2d::checkAttachmentPoint(const Vec2& point, const std::string& user)
   throw InputError(os.str());
 }
 
-PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point) const {
+PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, bool withHessians) const {
   const int k = findPoint(point);
   if (k < 0) checkAttachmentPoint(point, "attachment");
-  return pointKinematics(q, inv_.points[k]);
+  return pointKinematics(q, inv_.points[k], withHessians);
 }
 
-PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint& pt) const {
+PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint& pt, bool withHessians) const {
   // r = R + A u,  u = u0 + N qf;  dr/dtheta = S A u;  dr/dqf = A N;
   // d2r/dtheta2 = -A u;  d2r/dtheta dqf = S A N;  phi = theta + Nphi qf.
   const int nf = numElastic(), n = 3 + nf;
@@ -229,6 +229,7 @@ PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint&
   p.Jphi = RowVecX::Zero(n);
   p.Jphi[2] = 1.0;
   p.Jphi.tail(nf) = pt.rotationShape;
+  if (!withHessians) return p;
   p.Hrx = MatX::Zero(n, n);
   p.Hry = MatX::Zero(n, n);
   p.Hrx(2, 2) = -Au.x();

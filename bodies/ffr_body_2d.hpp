@@ -54,11 +54,12 @@ class FfrBody2d final : public Body {
   bool isDissipative() const override { return inv_.dff.cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
   /// phi = theta + Nphi q_f.
-  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point) const override;
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
+                                  bool withHessians = true) const override;
   void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;
   /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
-  PointKinematics pointKinematics(const ConstVecRef& q, const FfrPoint& p) const;
+  PointKinematics pointKinematics(const ConstVecRef& q, const FfrPoint& p, bool withHessians = true) const;
 
  private:
   int findPoint(const Vec2& point) const;

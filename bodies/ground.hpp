@@ -21,7 +21,7 @@ class Ground final : public Body {
   void addGravityForce(const ConstVecRef&, const Vec2&, VecX&) const override {}
   void addGravityJacobian(const ConstVecRef&, const Vec2&, MatX&) const override {}
   double gravityPotential(const ConstVecRef&, const Vec2&) const override { return 0.0; }
-  PointKinematics pointKinematics(const ConstVecRef&, const Vec2& point) const override {
+  PointKinematics pointKinematics(const ConstVecRef&, const Vec2& point, bool = true) const override {
     PointKinematics p;
     p.r = point;
     p.phi = 0.0;

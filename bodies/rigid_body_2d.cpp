@@ -77,7 +77,8 @@ double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const 
   return -props_.mass * g.dot(centreOfMass(q));
 }
 
-PointKinematics RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point) const {
+PointKinematics RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point,
+                                             bool withHessians) const {
   // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta.
   const Vec2 au = rotation(q[2]) * point;
   PointKinematics p;
@@ -86,6 +87,7 @@ PointKinematics RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& p
   p.Jr.resize(2, 3);
   p.Jr << 1.0, 0.0, -au.y(), 0.0, 1.0, au.x();
   p.Jphi = Eigen::RowVector3d(0.0, 0.0, 1.0);
+  if (!withHessians) return p;
   p.Hrx = MatX::Zero(3, 3);
   p.Hry = MatX::Zero(3, 3);
   p.Hrx(2, 2) = -au.x();

@@ -47,7 +47,8 @@ class RigidBody2d final : public Body {
   void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
   void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const override;
   double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
-  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point) const override;
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
+                                  bool withHessians = true) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;
 
  private:

@@ -69,9 +69,11 @@ class Body {
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 
-  /// Kinematics of the material point with body-frame coordinates `point`.
+  /// Kinematics of the material point with body-frame coordinates `point`; the
+  /// Hessians (Hrx, Hry, Hphi) only if withHessians (Jacobian assembly), else left empty.
   /// @throws InputError if the body has no material point there.
-  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point) const = 0;
+  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
+                                          bool withHessians = true) const = 0;
   /// Checks at model build time that `point` is a valid attachment point.
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
     (void)point; (void)user;

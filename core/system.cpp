@@ -95,7 +95,7 @@ double System::initialRelativeAngle(BodyIndex bodyI, const Vec2& pointI, BodyInd
                                     const Vec2& pointJ) const {
   const VecX qi = body(bodyI).initialCoordinates();
   const VecX qj = body(bodyJ).initialCoordinates();
-  return body(bodyJ).pointKinematics(qj, pointJ).phi - body(bodyI).pointKinematics(qi, pointI).phi;
+  return body(bodyJ).pointKinematics(qj, pointJ, false).phi - body(bodyI).pointKinematics(qi, pointI, false).phi;
 }
 
 ConstraintIndex System::addRevoluteJoint(const std::string& name, BodyIndex bodyI,

@@ -25,20 +25,23 @@ RotationalSpringDamper::RotationalSpringDamper(std::string name, BodyIndex bodyI
 
 void RotationalSpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v,
                                       VecX& Q, MatX* dQdq, MatX* dQdv) const {
-  const PointPair p = makePointPair(b[0].body.pointKinematics(b[0].q, pointI_),
-                                    b[1].body.pointKinematics(b[1].q, pointJ_));
+  const bool withHessians = dQdq != nullptr;
+  const PointPair p = makePointPair(b[0].body.pointKinematics(b[0].q, pointI_, withHessians),
+                                    b[1].body.pointKinematics(b[1].q, pointJ_, withHessians), withHessians);
   const RowVecX J = p.JphiJ - p.JphiI;
-  const MatX H = p.HphiJ - p.HphiI;
   const double phi = p.phiJ - p.phiI;
   const double tau = stiffness_ * (phi - freeAngle_) + damping_ * J.dot(v);
   Q -= tau * J.transpose();
-  if (dQdq) *dQdq -= J.transpose() * (stiffness_ * J + damping_ * v.transpose() * H) + tau * H;
+  if (dQdq) {
+    const MatX H = p.HphiJ - p.HphiI;
+    *dQdq -= J.transpose() * (stiffness_ * J + damping_ * v.transpose() * H) + tau * H;
+  }
   if (dQdv) *dQdv -= damping_ * J.transpose() * J;
 }
 
 double RotationalSpringDamper::potentialEnergy(const std::vector<BodyState>& b) const {
-  const double phi = b[1].body.pointKinematics(b[1].q, pointJ_).phi -
-                     b[0].body.pointKinematics(b[0].q, pointI_).phi;
+  const double phi = b[1].body.pointKinematics(b[1].q, pointJ_, false).phi -
+                     b[0].body.pointKinematics(b[0].q, pointI_, false).phi;
   return 0.5 * stiffness_ * (phi - freeAngle_) * (phi - freeAngle_);
 }
 

@@ -3,6 +3,8 @@
 // "<location>: <what is wrong>, got <what was found>".
 #include "io/kinematics_scene.hpp"
 
+#include "io/json_reader.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,117 +24,13 @@ namespace {
 
 using nlohmann::json;
 
-std::string fmt(double x) {
-  if (std::isnan(x)) return "nan";
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  char buf[40];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
+using namespace jsonread;
 
-std::string describe(const json& v) {
-  std::string d = v.dump();
-  if (d.size() > 60) d = d.substr(0, 57) + "...";
-  switch (v.type()) {
-    case json::value_t::string: return "string " + d;
-    case json::value_t::boolean: return "boolean " + d;
-    case json::value_t::array: return "array " + d;
-    case json::value_t::object: return "object " + d;
-    case json::value_t::null: return "null";
-    default: return "number " + d;
-  }
-}
-
-std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
-
-/// Typed, checked access to one JSON object; failures throw "<location>: <message>".
-class Reader {
+/// Objects of kinematics scenes carry their name in error locations.
+class Reader : public ObjectReader {
  public:
-  Reader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
-    if (!j_.is_object()) fail("expected an object {...}, got " + describe(j_));
-    const auto it = j_.find("name");
-    if (it != j_.end() && it->is_string()) where_ += " (" + inQuotes(it->get<std::string>()) + ")";
-  }
-  [[noreturn]] void fail(const std::string& m) const { throw InputError(where_ + ": " + m); }
-  const std::string& where() const { return where_; }
-
-  void allowOnly(const std::vector<std::string>& allowed, const std::string& what = "") const {
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail("unknown key " + inQuotes(it.key()) + " (allowed keys" + what + ": " + list + ")");
-      }
-    }
-  }
-  bool has(const std::string& key) const { return j_.contains(key); }
-  const json& required(const std::string& key) const {
-    const auto it = j_.find(key);
-    if (it == j_.end()) fail("missing required key " + inQuotes(key));
-    return *it;
-  }
-  double number(const std::string& key) const { return toNumber(required(key), key); }
-  double number(const std::string& key, double fallback) const { return has(key) ? number(key) : fallback; }
-  double positive(const std::string& key, double fallback) const {
-    const double x = number(key, fallback);
-    if (!(x > 0.0)) fail("key " + inQuotes(key) + " must be > 0, got " + fmt(x));
-    return x;
-  }
-  long integer(const std::string& key, long fallback, long minimum) const {
-    if (!has(key)) return fallback;
-    const json& v = required(key);
-    const double d = toNumber(v, key);
-    if (d != std::floor(d) || std::fabs(d) > 1e9) fail("key " + inQuotes(key) + " must be an integer, got " + describe(v));
-    if (d < minimum) fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + fmt(d));
-    return static_cast<long>(d);
-  }
-  std::string string(const std::string& key) const {
-    const json& v = required(key);
-    if (!v.is_string()) fail("key " + inQuotes(key) + " must be a string, got " + describe(v));
-    return v.get<std::string>();
-  }
-  std::string string(const std::string& key, const std::string& fallback) const {
-    return has(key) ? string(key) : fallback;
-  }
-  std::string name(const std::string& key) const {
-    std::string s = string(key);
-    if (s.empty()) fail("key " + inQuotes(key) + " must not be empty");
-    return s;
-  }
-  Vec2 vec2(const std::string& key) const {
-    const json& v = required(key);
-    if (!v.is_array() || v.size() != 2) fail("key " + inQuotes(key) + " must be an array of 2 numbers [x, y], got " + describe(v));
-    return Vec2(toNumber(v[0], key + "[0]"), toNumber(v[1], key + "[1]"));
-  }
-  const json& array(const std::string& key) const {
-    const json& v = required(key);
-    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array [...], got " + describe(v));
-    return v;
-  }
-
- private:
-  double toNumber(const json& v, const std::string& label) const {
-    if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) fail("key " + inQuotes(label) + " must be a finite number, got " + fmt(x));
-    return x;
-  }
-  const json& j_;
-  std::string where_;
+  Reader(const json& j, std::string where) : ObjectReader(j, std::move(where)) { peekName(); }
 };
-
-/// Runs a Linkage2d call and puts the location in front of its message.
-template <class F>
-auto located(const std::string& where, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    throw InputError(where + ": " + e.what());
-  }
-}
 
 void parseNode(const json& j, const std::string& at, Linkage2d& linkage) {
   Reader r(j, at);
@@ -256,13 +154,13 @@ KinematicsScene parseKinematicsScene(const json& j) {
   KinematicsScene scene;
   scene.name = top.string("name", "");
   Linkage2d& linkage = scene.linkage;
-  const json& nodes = top.array("nodes");
+  const json& nodes = top.requiredArray("nodes");
   if (nodes.empty()) top.fail("key \"nodes\" must list at least one node");
   for (std::size_t i = 0; i < nodes.size(); ++i) parseNode(nodes[i], "nodes[" + std::to_string(i) + "]", linkage);
-  const json& links = top.array("links");
+  const json& links = top.requiredArray("links");
   if (links.empty()) top.fail("key \"links\" must list at least one link");
   for (std::size_t i = 0; i < links.size(); ++i) parseLink(links[i], "links[" + std::to_string(i) + "]", linkage);
-  const json& inputs = top.array("inputs");
+  const json& inputs = top.requiredArray("inputs");
   for (std::size_t i = 0; i < inputs.size(); ++i) parseInput(inputs[i], "inputs[" + std::to_string(i) + "]", linkage);
   scene.settings = top.has("analysis") ? parseAnalysis(top.required("analysis")) : KinematicSettings{};
   located("linkage", [&] { linkage.finalize(); });

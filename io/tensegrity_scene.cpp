@@ -3,6 +3,8 @@
 // finiteness, every node name against the nodes defined.
 #include "io/tensegrity_scene.hpp"
 
+#include "io/json_reader.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -19,166 +21,26 @@ namespace {
 
 using nlohmann::json;
 
-std::string fmt(double x) {
-  std::ostringstream os;
-  os.precision(17);
-  os << x;
-  return os.str();
-}
+using namespace jsonread;
 
-std::string describe(const json& v) {
-  std::string d = v.dump();
-  if (d.size() > 60) d = d.substr(0, 57) + "...";
-  return d;
-}
-
-std::string q(const std::string& s) { return "\"" + s + "\""; }
-
-class Reader {
+/// Objects of tensegrity scenes carry their name in error locations and take
+/// non-empty strings only.
+class Reader : public ObjectReader {
  public:
-  Reader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
-    if (!j_.is_object()) fail("expected an object {...}, got " + describe(j_));
-    const auto it = j_.find("name");
-    if (it != j_.end() && it->is_string()) where_ += " (" + q(it->get<std::string>()) + ")";
-  }
-  [[noreturn]] void fail(const std::string& m) const { throw InputError(where_ + ": " + m); }
-  const std::string& where() const { return where_; }
-  void allowOnly(const std::vector<std::string>& keys) const {
-    for (auto it = j_.begin(); it != j_.end(); ++it) {
-      if (std::find(keys.begin(), keys.end(), it.key()) == keys.end()) {
-        std::string list;
-        for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
-        fail("unknown key " + q(it.key()) + " (allowed keys: " + list + ")");
-      }
-    }
-  }
-  bool has(const std::string& k) const { return j_.contains(k); }
-  const json& at(const std::string& k) const {
-    if (!has(k)) fail("missing required key " + q(k));
-    return j_.at(k);
-  }
-  double number(const std::string& k) const { return toNumber(at(k), k); }
-  double number(const std::string& k, double fallback) const { return has(k) ? number(k) : fallback; }
-  double positive(const std::string& k, std::optional<double> fallback = std::nullopt) const {
-    if (!has(k) && fallback) return *fallback;
-    const double x = number(k);
-    if (!(x > 0.0)) fail("key " + q(k) + " must be > 0, got " + fmt(x));
-    return x;
-  }
-  double nonNegative(const std::string& k, double fallback) const {
-    if (!has(k)) return fallback;
-    const double x = number(k);
-    if (!(x >= 0.0)) fail("key " + q(k) + " must be >= 0, got " + fmt(x));
-    return x;
-  }
-  std::string string(const std::string& k) const {
-    const json& v = at(k);
-    if (!v.is_string() || v.get<std::string>().empty()) fail("key " + q(k) + " must be a non-empty string, got " + describe(v));
-    return v.get<std::string>();
-  }
-  std::string string(const std::string& k, const std::string& fallback) const { return has(k) ? string(k) : fallback; }
-  bool boolean(const std::string& k, bool fallback) const {
-    if (!has(k)) return fallback;
-    const json& v = at(k);
-    if (!v.is_boolean()) fail("key " + q(k) + " must be true or false, got " + describe(v));
-    return v.get<bool>();
-  }
-  long integer(const std::string& k, long fallback, long minimum) const {
-    if (!has(k)) return fallback;
-    const json& v = at(k);
-    if (!v.is_number_integer() || v.get<long>() < minimum) {
-      fail("key " + q(k) + " must be an integer >= " + std::to_string(minimum) + ", got " + describe(v));
-    }
-    return v.get<long>();
-  }
-  VecX vector(const std::string& k, int n) const {
-    const json& v = at(k);
-    if (!v.is_array() || static_cast<int>(v.size()) != n) {
-      fail("key " + q(k) + " must be an array of " + std::to_string(n) + " numbers, got " + describe(v));
-    }
-    VecX out(n);
-    for (int i = 0; i < n; ++i) out[i] = toNumber(v[i], k + "[" + std::to_string(i) + "]");
-    return out;
-  }
-  const json& array(const std::string& k) const {
-    static const json kEmpty = json::array();
-    if (!has(k)) return kEmpty;
-    const json& v = at(k);
-    if (!v.is_array()) fail("key " + q(k) + " must be an array [...], got " + describe(v));
-    return v;
-  }
-
- private:
-  double toNumber(const json& v, const std::string& k) const {
-    if (!v.is_number()) fail("key " + q(k) + " must be a number, got " + describe(v));
-    const double x = v.get<double>();
-    if (!std::isfinite(x)) fail("key " + q(k) + " must be a finite number, got " + fmt(x));
-    return x;
-  }
-  const json& j_;
-  std::string where_;
+  Reader(const json& j, std::string where) : ObjectReader(j, std::move(where)) { peekName(); }
+  std::string string(const std::string& k) const { return name(k); }
+  std::string string(const std::string& k, const std::string& fallback) const { return has(k) ? name(k) : fallback; }
 };
 
-template <class F>
-auto located(const std::string& where, F&& f) -> decltype(f()) {
-  try {
-    return f();
-  } catch (const InputError& e) {
-    throw InputError(where + ": " + e.what());
-  }
-}
-
-TimeLawPtr parseLaw(const json& j, const std::string& where) {
-  Reader r(j, where);
-  const std::string type = r.string("type");
-  if (type == "constant") {
-    r.allowOnly({"type", "value"});
-    const double v = r.number("value");
-    return located(where, [&] { return makeConstantLaw(v); });
-  }
-  if (type == "constant_speed") {
-    r.allowOnly({"type", "speed", "initial"});
-    const double s = r.number("speed"), i = r.number("initial", 0.0);
-    return located(where, [&] { return makeConstantSpeedLaw(s, i); });
-  }
-  if (type == "polynomial") {
-    r.allowOnly({"type", "coefficients"});
-    std::vector<double> c;
-    for (const json& x : r.array("coefficients")) {
-      if (!x.is_number()) r.fail("key \"coefficients\" must hold numbers, got " + describe(x));
-      c.push_back(x.get<double>());
-    }
-    return located(where, [&] { return makePolynomialLaw(c); });
-  }
-  if (type == "harmonic") {
-    r.allowOnly({"type", "amplitude", "omega", "phase", "offset"});
-    const double a = r.number("amplitude"), w = r.number("omega"), p = r.number("phase", 0.0), o = r.number("offset", 0.0);
-    return located(where, [&] { return makeHarmonicLaw(a, w, p, o); });
-  }
-  if (type == "spin_up") {
-    r.allowOnly({"type", "speed", "ramp_time", "initial"});
-    const double s = r.number("speed"), T = r.number("ramp_time"), i = r.number("initial", 0.0);
-    return located(where, [&] { return makeSpinUpLaw(s, T, i); });
-  }
-  if (type == "tabulated") {
-    r.allowOnly({"type", "times", "values"});
-    std::vector<double> t, v;
-    for (const json& x : r.array("times")) t.push_back(x.is_number() ? x.get<double>() : NAN);
-    for (const json& x : r.array("values")) v.push_back(x.is_number() ? x.get<double>() : NAN);
-    return located(where, [&] { return makeTabulatedLaw(t, v); });
-  }
-  r.fail("unknown law type " + q(type) +
-         " (expected one of: constant, constant_speed, polynomial, harmonic, spin_up, tabulated)");
-}
 
 int lookupNode(const TensegrityStructure& s, const std::string& name, const Reader& r) {
   const int i = s.findNode(name);
-  if (i < 0) r.fail("unknown node " + q(name));
+  if (i < 0) r.fail("unknown node " + inQuotes(name));
   return i;
 }
 
 std::pair<int, int> nodePair(const TensegrityStructure& s, const Reader& r) {
-  const json& v = r.at("nodes");
+  const json& v = r.required("nodes");
   if (!v.is_array() || v.size() != 2 || !v[0].is_string() || !v[1].is_string()) {
     r.fail("key \"nodes\" must be two node names [\"a\", \"b\"], got " + describe(v));
   }
@@ -238,7 +100,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
     const double m = r.nonNegative("mass", 0.0);
     std::vector<bool> fixed(d, false);
     if (r.has("fixed")) {
-      const json& f = r.at("fixed");
+      const json& f = r.required("fixed");
       if (f.is_boolean()) {
         fixed.assign(d, f.get<bool>());
       } else if (f.is_array() && static_cast<int>(f.size()) == d &&
@@ -264,7 +126,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
     const double m = r.nonNegative("mass", 0.0);
     const std::string model = r.string("mass_model", "lumped");
     if (model != "lumped" && model != "consistent") {
-      r.fail("key \"mass_model\" must be \"lumped\" or \"consistent\", got " + q(model));
+      r.fail("key \"mass_model\" must be \"lumped\" or \"consistent\", got " + inQuotes(model));
     }
     const double radius = r.nonNegative("radius", 0.0);
     located(r.where(), [&] {
@@ -291,20 +153,20 @@ TensegrityScene parseTensegrityScene(const json& j) {
     r.allowOnly({"name", "node", "force"});
     const std::string name = r.string("name", "load" + std::to_string(k));
     const int node = lookupNode(s, r.string("node"), r);
-    const json& f = r.at("force");
+    const json& f = r.required("force");
     if (!f.is_array() || static_cast<int>(f.size()) != d) {
       r.fail("key \"force\" must be an array of " + std::to_string(d) + " laws (or null), got " + describe(f));
     }
     std::vector<TimeLawPtr> comps(d);
     for (int a = 0; a < d; ++a) {
-      if (!f[a].is_null()) comps[a] = parseLaw(f[a], r.where() + ".force[" + std::to_string(a) + "]");
+      if (!f[a].is_null()) comps[a] = parseTimeLaw(f[a], r.where() + ".force[" + std::to_string(a) + "]");
     }
     located(r.where(), [&] { s.addLoad(name, node, comps); });
   }
   s.finalize();
 
   if (top.has("prestress")) {
-    Reader r(top.at("prestress"), "prestress");
+    Reader r(top.required("prestress"), "prestress");
     r.allowOnly({"cable", "tension"});
     const std::string cableName = r.string("cable");
     const double tension = r.positive("tension");
@@ -317,16 +179,16 @@ TensegrityScene parseTensegrityScene(const json& j) {
     for (int c = 0; c < s.numCables(); ++c) {
       if (s.cable(c).name == cableName) member = s.numStruts() + c;
     }
-    if (member < 0) r.fail("unknown cable " + q(cableName));
+    if (member < 0) r.fail("unknown cable " + inQuotes(cableName));
     VecX qd = st.forceDensities.col(0);
     const auto [ni, nj] = s.memberNodes({false, member - s.numStruts()});
     const double l = (x0.segment(d * ni, d) - x0.segment(d * nj, d)).norm();
-    if (std::abs(qd[member]) < 1e-12) r.fail("cable " + q(cableName) + " carries no force in the self-stress state");
+    if (std::abs(qd[member]) < 1e-12) r.fail("cable " + inQuotes(cableName) + " carries no force in the self-stress state");
     qd *= tension / (qd[member] * l);  // force of the reference cable: q l = tension
     located(r.where(), [&] { applyPrestress(s, qd, 1.0); });
   }
 
-  Reader sv(top.at("solver"), "solver");
+  Reader sv(top.required("solver"), "solver");
   const std::string method = sv.string("method");
   if (method == "time_stepping") {
     sv.allowOnly({"method", "t_start", "t_end", "time_step", "output_step", "lcp", "lcp_tolerance",
@@ -363,7 +225,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
     if (!(o.tEnd > o.tStart)) sv.fail("key \"t_end\" must be > t_start, got " + fmt(o.tEnd));
     located(sv.where(), [&] { return MasslessCableIntegrator(s, o), 0; });
   } else {
-    sv.fail("unknown method " + q(method) + " (expected one of: time_stepping, massless_cables)");
+    sv.fail("unknown method " + inQuotes(method) + " (expected one of: time_stepping, massless_cables)");
   }
   return scene;
 }

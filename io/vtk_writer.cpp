@@ -65,7 +65,7 @@ void VtkWriter::write(const OutputSample& s) {
       std::vector<int> line;
       for (const Vec2& p : rigidPoints_[b]) {
         line.push_back(static_cast<int>(points.size()));
-        points.push_back(body.pointKinematics(q, p).r);
+        points.push_back(body.pointKinematics(q, p, false).r);
         displacement.push_back(Vec2::Zero());
         axial.push_back(0.0);
         moment.push_back(0.0);

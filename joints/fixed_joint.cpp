@@ -11,7 +11,7 @@ FixedJoint::FixedJoint(std::string name, BodyIndex bodyI, const Vec2& pointI, Bo
 
 void FixedJoint::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
                           ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies);
+  const PointPair p = pair(bodies, withHessians);
   out.h.resize(3);
   out.h << p.d, p.phiJ - p.phiI - referenceAngle_;
   out.G.resize(3, p.n());

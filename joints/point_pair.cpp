@@ -2,7 +2,7 @@
 
 namespace flexmbd {
 
-PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj) {
+PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians) {
   PointPair p;
   p.ni = static_cast<int>(pi.Jr.cols());
   p.nj = static_cast<int>(pj.Jr.cols());
@@ -11,18 +11,19 @@ PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj) {
   p.D.setZero(2, n);
   p.D.leftCols(p.ni) = -pi.Jr;
   p.D.rightCols(p.nj) = pj.Jr;
-  p.Hdx.setZero(n, n);
-  p.Hdy.setZero(n, n);
-  p.Hdx.topLeftCorner(p.ni, p.ni) = -pi.Hrx;
-  p.Hdy.topLeftCorner(p.ni, p.ni) = -pi.Hry;
-  p.Hdx.bottomRightCorner(p.nj, p.nj) = pj.Hrx;
-  p.Hdy.bottomRightCorner(p.nj, p.nj) = pj.Hry;
   p.phiI = pi.phi;
   p.phiJ = pj.phi;
   p.JphiI.setZero(n);
   p.JphiJ.setZero(n);
   p.JphiI.head(p.ni) = pi.Jphi;
   p.JphiJ.tail(p.nj) = pj.Jphi;
+  if (!withHessians) return p;
+  p.Hdx.setZero(n, n);
+  p.Hdy.setZero(n, n);
+  p.Hdx.topLeftCorner(p.ni, p.ni) = -pi.Hrx;
+  p.Hdy.topLeftCorner(p.ni, p.ni) = -pi.Hry;
+  p.Hdx.bottomRightCorner(p.nj, p.nj) = pj.Hrx;
+  p.Hdy.bottomRightCorner(p.nj, p.nj) = pj.Hry;
   p.HphiI.setZero(n, n);
   p.HphiJ.setZero(n, n);
   p.HphiI.topLeftCorner(p.ni, p.ni) = pi.Hphi;
@@ -62,9 +63,9 @@ TwoPointConstraint::TwoPointConstraint(std::string name, BodyIndex bodyI, const 
   }
 }
 
-PointPair TwoPointConstraint::pair(const std::vector<BodyState>& bodies) const {
-  return makePointPair(bodies[0].body.pointKinematics(bodies[0].q, pointI_),
-                       bodies[1].body.pointKinematics(bodies[1].q, pointJ_));
+PointPair TwoPointConstraint::pair(const std::vector<BodyState>& bodies, bool withHessians) const {
+  return makePointPair(bodies[0].body.pointKinematics(bodies[0].q, pointI_, withHessians),
+                       bodies[1].body.pointKinematics(bodies[1].q, pointJ_, withHessians), withHessians);
 }
 
 }  // namespace flexmbd

@@ -19,8 +19,9 @@ struct PointPair {
   MatX hessianD(const Vec2& w) const { return w.x() * Hdx + w.y() * Hdy; }
 };
 
-/// Combines the kinematics of point i (on the first body) and point j (second body).
-PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj);
+/// Combines the kinematics of point i (on the first body) and point j (second body);
+/// the Hessian blocks only if withHessians (then both points must carry them).
+PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians = true);
 
 
 
@@ -50,7 +51,8 @@ class TwoPointConstraint : public Constraint {
   }
 
  protected:
-  PointPair pair(const std::vector<BodyState>& bodies) const;
+  /// Kinematics of the two points; Hessians only if withHessians (not in residuals).
+  PointPair pair(const std::vector<BodyState>& bodies, bool withHessians) const;
 
  private:
   Vec2 pointI_, pointJ_;

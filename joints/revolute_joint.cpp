@@ -4,7 +4,7 @@ namespace flexmbd {
 
 void RevoluteJoint::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
                              ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies);
+  const PointPair p = pair(bodies, withHessians);
   out.h = p.d;
   out.G = p.D;
   if (withHessians) out.H = {p.Hdx, p.Hdy};

@@ -1,0 +1,315 @@
+// The strict JSON reading shared by every scene format (multibody, kinematics,
+// tensegrity): typed, checked access to the keys of one object, one-line errors
+// "<location>: <what is wrong>, got <what was found>", and the time-law objects.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "core/time_law.hpp"
+#include "core/types.hpp"
+
+namespace flexmbd::jsonread {
+
+using nlohmann::json;
+
+// ----- formatting ------------------------------------------------------------------
+
+/// Shortest text that reads back as the same double ("-1", "0.1", "1e-08").
+inline std::string fmt(double x) {
+  if (std::isnan(x)) return "nan";
+  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
+  char buf[40];
+  for (int p = 1; p <= 17; ++p) {
+    std::snprintf(buf, sizeof buf, "%.*g", p, x);
+    if (std::strtod(buf, nullptr) == x) break;
+  }
+  return buf;
+}
+
+/// "string \"abc\"", "number 3", "array [1,2]", "null", ... (long values shortened).
+inline std::string describe(const json& v) {
+  if (v.is_null()) return "null";
+  if (v.is_number_float() && !std::isfinite(v.get<double>())) return "number " + fmt(v.get<double>());
+  std::string d = v.dump();
+  if (d.size() > 60) d = d.substr(0, 57) + "...";
+  switch (v.type()) {
+    case json::value_t::string: return "string " + d;
+    case json::value_t::boolean: return "boolean " + d;
+    case json::value_t::array: return "array " + d;
+    case json::value_t::object: return "object " + d;
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "number " + d;
+    default: return d;
+  }
+}
+
+inline std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+inline std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+
+// ----- reading one JSON object ---------------------------------------------------------
+
+/// Typed, checked access to the keys of one JSON object at a location of the scene.
+/// Every failure throws InputError("<location>: <message>").
+class ObjectReader {
+ public:
+  ObjectReader(const json& j, std::string where) : j_(j), where_(std::move(where)) {
+    if (!j_.is_object()) fail("expected an object {...}, got " + describe(j_));
+  }
+
+  const std::string& where() const { return where_; }
+  [[noreturn]] void fail(const std::string& message) const { throw InputError(where_ + ": " + message); }
+
+  /// Adds the object's name to the location: `bodies[1]` -> `bodies[1] ("rod")`.
+  /// Used as soon as a string name is found, so later messages carry it.
+  void peekName() {
+    const auto it = j_.find("name");
+    if (it != j_.end() && it->is_string()) where_ += " (" + inQuotes(it->get<std::string>()) + ")";
+  }
+
+  /// Rejects keys not in `allowed`; `what` qualifies the list (" for a harmonic law").
+  void allowOnly(const std::vector<std::string>& allowed, const std::string& what = "") const {
+    for (auto it = j_.begin(); it != j_.end(); ++it) {
+      if (std::find(allowed.begin(), allowed.end(), it.key()) == allowed.end()) {
+        fail("unknown key " + inQuotes(it.key()) + " (allowed keys" + what + ": " + join(allowed) + ")");
+      }
+    }
+  }
+
+  bool has(const std::string& key) const { return j_.contains(key); }
+
+  const json& required(const std::string& key) const {
+    const auto it = j_.find(key);
+    if (it == j_.end()) fail("missing required key " + inQuotes(key));
+    return *it;
+  }
+
+  // --- scalars ---
+  double number(const std::string& key) const { return toNumber(required(key), key); }
+  double number(const std::string& key, double fallback) const {
+    return has(key) ? number(key) : fallback;
+  }
+  double positive(const std::string& key) const { return checkPositive(number(key), key); }
+  double positive(const std::string& key, double fallback) const {
+    return has(key) ? positive(key) : fallback;
+  }
+  double nonNegative(const std::string& key) const { return checkNonNegative(number(key), key); }
+  double nonNegative(const std::string& key, double fallback) const {
+    return has(key) ? nonNegative(key) : fallback;
+  }
+
+  std::string string(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_string()) fail("key " + inQuotes(key) + " must be a string, got " + describe(v));
+    return v.get<std::string>();
+  }
+  std::string string(const std::string& key, const std::string& fallback) const {
+    return has(key) ? string(key) : fallback;
+  }
+  /// A required, non-empty name (of this object or of one it refers to).
+  std::string name(const std::string& key) const {
+    std::string s = string(key);
+    if (s.empty()) fail("key " + inQuotes(key) + " must not be empty");
+    return s;
+  }
+
+  bool boolean(const std::string& key, bool fallback) const {
+    if (!has(key)) return fallback;
+    const json& v = required(key);
+    if (!v.is_boolean()) fail("key " + inQuotes(key) + " must be true or false, got " + describe(v));
+    return v.get<bool>();
+  }
+
+  /// An integer >= minimum (1e6 written as a float is accepted if integral).
+  long integer(const std::string& key, long fallback, long minimum) const {
+    if (!has(key)) return fallback;
+    const json& v = required(key);
+    long value = 0;
+    if (v.is_number_integer() || v.is_number_unsigned()) {
+      if (v.is_number_unsigned() &&
+          v.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<long>::max())) {
+        fail("key " + inQuotes(key) + " is too large, got " + describe(v));
+      }
+      value = v.get<long>();
+    } else if (v.is_number_float()) {
+      const double d = toNumber(v, key);
+      if (d != std::floor(d) || std::fabs(d) > 9.0e18) {
+        fail("key " + inQuotes(key) + " must be an integer, got " + fmt(d));
+      }
+      value = static_cast<long>(d);
+    } else {
+      fail("key " + inQuotes(key) + " must be an integer, got " + describe(v));
+    }
+    if (value < minimum) {
+      fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + std::to_string(value));
+    }
+    return value;
+  }
+
+  // --- vectors ---
+  Vec2 vec2(const std::string& key) const { return toVec2(required(key), key); }
+  Vec2 vec2(const std::string& key, const Vec2& fallback) const {
+    return has(key) ? vec2(key) : fallback;
+  }
+
+  /// [[xi, yi], [xj, yj]]
+  std::array<Vec2, 2> pointPair(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.size() != 2) {
+      fail("key " + inQuotes(key) + " must be two points [[xi, yi], [xj, yj]], got " + describe(v));
+    }
+    return {toVec2(v[0], key + "[0]"), toVec2(v[1], key + "[1]")};
+  }
+
+  /// [nameI, nameJ]
+  std::array<std::string, 2> namePair(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.size() != 2 || !v[0].is_string() || !v[1].is_string()) {
+      fail("key " + inQuotes(key) + " must be two body names [\"bodyI\", \"bodyJ\"], got " + describe(v));
+    }
+    return {v[0].get<std::string>(), v[1].get<std::string>()};
+  }
+
+  /// A non-empty array of finite numbers.
+  std::vector<double> numbers(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array() || v.empty()) {
+      fail("key " + inQuotes(key) + " must be a non-empty array of numbers, got " + describe(v));
+    }
+    std::vector<double> out;
+    out.reserve(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) out.push_back(toNumber(v[k], key + "[" + std::to_string(k) + "]"));
+    return out;
+  }
+
+  /// A matrix written as an array of rows of numbers (all rows the same length).
+  MatX matrix(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array of rows [[...], ...], got " + describe(v));
+    if (v.empty()) return MatX(0, 0);
+    const std::size_t cols = v[0].is_array() ? v[0].size() : 0;
+    MatX m(v.size(), cols);
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const std::string row = key + "[" + std::to_string(i) + "]";
+      if (!v[i].is_array() || v[i].size() != cols) {
+        fail("key " + inQuotes(row) + " must be a row of " + std::to_string(cols) + " numbers, got " + describe(v[i]));
+      }
+      for (std::size_t k = 0; k < cols; ++k) m(i, k) = toNumber(v[i][k], row + "[" + std::to_string(k) + "]");
+    }
+    return m;
+  }
+  /// A vector of numbers (possibly empty).
+  /// A vector of exactly n numbers.
+  VecX vector(const std::string& key, int n) const {
+    const json& v = required(key);
+    if (!v.is_array() || static_cast<int>(v.size()) != n) {
+      fail("key " + inQuotes(key) + " must be an array of " + std::to_string(n) + " numbers, got " + describe(v));
+    }
+    return vector(key);
+  }
+  VecX vector(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array of numbers, got " + describe(v));
+    VecX out(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) out[k] = toNumber(v[k], key + "[" + std::to_string(k) + "]");
+    return out;
+  }
+  /// A non-negative integer from an arbitrary JSON value (array entries).
+  int index(const json& v, const std::string& label) const {
+    if (!v.is_number_integer() || v.get<long>() < 0) {
+      fail("key " + inQuotes(label) + " must be a non-negative integer, got " + describe(v));
+    }
+    return static_cast<int>(v.get<long>());
+  }
+
+  const json& object(const std::string& key) const {
+    const json& v = required(key);
+    if (!v.is_object()) fail("key " + inQuotes(key) + " must be an object {...}, got " + describe(v));
+    return v;
+  }
+
+  /// The array under a required `key`.
+  const json& requiredArray(const std::string& key) const {
+    required(key);
+    return array(key);
+  }
+  /// The array under `key`, or an empty one if the key is absent.
+  const json& array(const std::string& key) const {
+    static const json kEmpty = json::array();
+    if (!has(key)) return kEmpty;
+    const json& v = required(key);
+    if (!v.is_array()) fail("key " + inQuotes(key) + " must be an array [...], got " + describe(v));
+    return v;
+  }
+
+  double checkPositive(double x, const std::string& key) const {
+    if (!(x > 0.0)) fail("key " + inQuotes(key) + " must be > 0, got " + fmt(x));
+    return x;
+  }
+  double checkNonNegative(double x, const std::string& key) const {
+    if (!(x >= 0.0)) fail("key " + inQuotes(key) + " must be >= 0, got " + fmt(x));
+    return x;
+  }
+
+ private:
+  double toNumber(const json& v, const std::string& label) const {
+    if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
+    const double x = v.get<double>();
+    if (!std::isfinite(x)) fail("key " + inQuotes(label) + " must be a finite number, got " + fmt(x));
+    return x;
+  }
+  Vec2 toVec2(const json& v, const std::string& label) const {
+    if (!v.is_array() || v.size() != 2) {
+      fail("key " + inQuotes(label) + " must be an array of 2 numbers [x, y], got " + describe(v));
+    }
+    return Vec2(toNumber(v[0], label + "[0]"), toNumber(v[1], label + "[1]"));
+  }
+
+  const json& j_;
+  std::string where_;
+};
+
+/// Runs a System / law-factory call and puts the scene location in front of its
+/// InputError messages (keeping the exception type).
+template <class F>
+auto located(const std::string& where, F&& f) -> decltype(f()) {
+  try {
+    return f();
+  } catch (const ModelError& e) {
+    throw ModelError(where + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(where + ": " + e.what());
+  }
+}
+
+/// Checks the "type" key against the allowed values and returns it.
+inline std::string readType(const ObjectReader& r, const std::string& kind,
+                     const std::vector<std::string>& types) {
+  const std::string type = r.string("type");
+  if (std::find(types.begin(), types.end(), type) == types.end()) {
+    r.fail("unknown " + kind + " type " + inQuotes(type) + " (expected one of: " + join(types) + ")");
+  }
+  return type;
+}
+
+
+/// A time-law object {"type": "constant_speed", "speed": ...} (docs/scene-format.md).
+TimeLawPtr parseTimeLaw(const json& j, const std::string& where);
+
+}  // namespace flexmbd::jsonread
