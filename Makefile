@@ -1,6 +1,7 @@
 # Two entry points (see README, Quick start):
 #   make demo  - install missing packages, build (Release), run the rigid slider-crank demo
-#   make test  - install missing packages, build (Release), run the whole CTest suite
+#   make test  - install missing packages, build (Release), run the CTest suite except the
+#                long runs labelled "slow" (cd build && ctest -L slow runs those)
 BUILD ?= build
 JOBS  ?= 2
 

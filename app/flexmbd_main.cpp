@@ -19,6 +19,7 @@
 
 #include "app/kinematics_command.hpp"
 #include "app/tensegrity_command.hpp"
+#include "app/command_line.hpp"
 #include "core/errors.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
@@ -32,6 +33,7 @@
 namespace {
 
 using namespace flexmbd;
+using namespace flexmbd::cli;
 
 constexpr int kExitOk = 0;
 constexpr int kExitSolverFailure = 1;
@@ -67,10 +69,6 @@ const char* const kUsage =
     "singular position (results up to there are kept); 2 invalid command line, scene or\n"
     "model (nothing is integrated).\n";
 
-/// A bad command line (exit status 2).
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 struct Options {
   bool help = false;
@@ -82,36 +80,12 @@ struct Options {
   bool vtk = false;  ///< also write DIR/vtk/bodies_*.vtu and bodies.pvd
 };
 
-/// Messages go to the terminal on one line.
-std::string oneLine(std::string s) {
-  for (char& c : s) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  return s;
-}
 
 std::string fmt(double x) {
   std::ostringstream os;
   os.precision(6);
   os << x;
   return os.str();
-}
-
-double parseNumberOption(const std::string& option, const std::string& text) {
-  const char* begin = text.c_str();
-  char* end = nullptr;
-  const double x = std::strtod(begin, &end);
-  if (text.empty() || end == begin || *end != '\0') {
-    throw UsageError("option " + option + " expects a number, got '" + text + "'");
-  }
-  if (!std::isfinite(x)) throw UsageError("option " + option + " expects a finite number, got '" + text + "'");
-  return x;
-}
-
-double parsePositiveOption(const std::string& option, const std::string& text) {
-  const double x = parseNumberOption(option, text);
-  if (!(x > 0.0)) throw UsageError("option " + option + " must be > 0, got " + text);
-  return x;
 }
 
 Options parseCommandLine(int argc, char** argv) {
@@ -136,37 +110,12 @@ Options parseCommandLine(int argc, char** argv) {
   if (args[0] != "run") {
     throw UsageError("unknown command '" + args[0] + "' (expected 'run', 'kinematics', '--help' or '--version')");
   }
-  std::vector<std::string> positional;
-  for (std::size_t k = 1; k < args.size(); ++k) {
-    std::string a = args[k];
-    if (a.size() < 2 || a[0] != '-') {
-      positional.push_back(a);
-      continue;
-    }
-    if (a == "--quiet" || a == "-q") {
-      o.quiet = true;
-      continue;
-    }
-    if (a == "--vtk") {
-      o.vtk = true;
-      continue;
-    }
-    // --name VALUE or --name=VALUE
-    std::string name = a, value;
-    bool haveValue = false;
-    if (const auto eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
-      name = a.substr(0, eq);
-      value = a.substr(eq + 1);
-      haveValue = true;
-    }
-    if (name != "--out" && name != "--t-end" && name != "--rtol" && name != "--atol") {
-      throw UsageError("unknown option '" + name +
-                       "' (known options: --out, --t-end, --rtol, --atol, --vtk, --quiet, --help)");
-    }
-    if (!haveValue) {
-      if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
-      value = args[++k];
-    }
+  const cli::SplitArguments split =
+      cli::splitArguments({args.begin() + 1, args.end()}, {"--out", "--t-end", "--rtol", "--atol"},
+                          {{"--quiet", "--quiet"}, {"-q", "--quiet"}, {"--vtk", "--vtk"}}, "");
+  o.quiet = split.flags.count("--quiet") > 0;
+  o.vtk = split.flags.count("--vtk") > 0;
+  for (const auto& [name, value] : split.values) {
     if (name == "--out") {
       if (value.empty()) throw UsageError("option --out needs a directory");
       o.outDir = value;
@@ -178,6 +127,7 @@ Options parseCommandLine(int argc, char** argv) {
       o.atol = parsePositiveOption(name, value);
     }
   }
+  const std::vector<std::string>& positional = split.positional;
   if (positional.empty()) throw UsageError("run: missing the scene file (flexmbd run SCENE.json --out DIR)");
   if (positional.size() > 1) {
     throw UsageError("run: expected one scene file, got " + std::to_string(positional.size()) + " arguments ('" +
@@ -188,7 +138,6 @@ Options parseCommandLine(int argc, char** argv) {
   return o;
 }
 
-void printError(const std::string& message) { std::cerr << "flexmbd: error: " << oneLine(message) << std::endl; }
 
 /// Input error once the output directory is known: no results.csv, a summary.json that
 /// says why (best effort: a failure to write it must not hide the original error).

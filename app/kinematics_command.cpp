@@ -1,5 +1,7 @@
 #include "app/kinematics_command.hpp"
 
+#include "app/command_line.hpp"
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -25,9 +27,7 @@ constexpr int kExitOk = 0;
 constexpr int kExitStopped = 1;
 constexpr int kExitInputError = 2;
 
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using cli::UsageError;
 
 struct Options {
   std::string scenePath, outDir;
@@ -36,39 +36,14 @@ struct Options {
   std::optional<std::string> corrector;
 };
 
-std::string oneLine(std::string s) {
-  for (char& c : s) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  return s;
-}
-
-void printError(const std::string& m) { std::cerr << "flexmbd: error: " << oneLine(m) << std::endl; }
+using cli::oneLine;
+using cli::printError;
 
 Options parseOptions(const std::vector<std::string>& args) {
   Options o;
-  std::vector<std::string> positional;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const std::string& a = args[k];
-    if (a.size() < 2 || a[0] != '-') {
-      positional.push_back(a);
-      continue;
-    }
-    std::string name = a, value;
-    bool haveValue = false;
-    if (const auto eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
-      name = a.substr(0, eq);
-      value = a.substr(eq + 1);
-      haveValue = true;
-    }
-    if (name != "--out" && name != "--steps" && name != "--tolerance" && name != "--corrector") {
-      throw UsageError("kinematics: unknown option '" + name +
-                       "' (known options: --out, --steps, --tolerance, --corrector, --help)");
-    }
-    if (!haveValue) {
-      if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
-      value = args[++k];
-    }
+  const cli::SplitArguments split =
+      cli::splitArguments(args, {"--out", "--steps", "--tolerance", "--corrector"}, {}, "kinematics: ");
+  for (const auto& [name, value] : split.values) {
     if (name == "--out") {
       if (value.empty()) throw UsageError("option --out needs a directory");
       o.outDir = value;
@@ -77,21 +52,15 @@ Options parseOptions(const std::vector<std::string>& args) {
         throw UsageError("option --corrector expects 'newton' or 'modified_newton', got '" + value + "'");
       }
       o.corrector = value;
+    } else if (name == "--steps") {
+      const double x = cli::parseNumberOption(name, value);
+      if (x != std::floor(x) || x < 1 || x > 1e8) throw UsageError("option --steps expects an integer >= 1, got '" + value + "'");
+      o.steps = static_cast<long>(x);
     } else {
-      char* end = nullptr;
-      const double x = std::strtod(value.c_str(), &end);
-      if (value.empty() || *end != '\0' || !std::isfinite(x)) {
-        throw UsageError("option " + name + " expects a finite number, got '" + value + "'");
-      }
-      if (name == "--steps") {
-        if (x != std::floor(x) || x < 1 || x > 1e8) throw UsageError("option --steps expects an integer >= 1, got '" + value + "'");
-        o.steps = static_cast<long>(x);
-      } else {
-        if (!(x > 0)) throw UsageError("option --tolerance must be > 0, got '" + value + "'");
-        o.tolerance = x;
-      }
+      o.tolerance = cli::parsePositiveOption(name, value);
     }
   }
+  const std::vector<std::string>& positional = split.positional;
   if (positional.empty()) throw UsageError("kinematics: missing the scene file (flexmbd kinematics SCENE.json --out DIR)");
   if (positional.size() > 1) {
     throw UsageError("kinematics: expected one scene file, got " + std::to_string(positional.size()) + " arguments ('" +

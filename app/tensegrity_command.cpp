@@ -1,5 +1,7 @@
 #include "app/tensegrity_command.hpp"
 
+#include "app/command_line.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -21,14 +23,8 @@ constexpr int kExitOk = 0;
 constexpr int kExitSolverFailure = 1;
 constexpr int kExitInputError = 2;
 
-std::string oneLine(std::string s) {
-  for (char& c : s) {
-    if (c == '\n' || c == '\r') c = ' ';
-  }
-  return s;
-}
-
-void printError(const std::string& m) { std::cerr << "flexmbd: error: " << oneLine(m) << std::endl; }
+using cli::oneLine;
+using cli::printError;
 
 std::string num(double x) {
   std::ostringstream os;

@@ -16,18 +16,22 @@ void checkFrame(const std::string& who, const FrameState2d& s) {
   requireFinite(s.angularVelocity, who + ": angular_velocity");
 }
 
+const FfrBeamModel& requireModel(const std::shared_ptr<const FfrBeamModel>& model, const std::string& name) {
+  if (!model) throw InputError("body '" + name + "': no beam model given");
+  return *model;
+}
+
 }  // namespace
 
 FfrBody2d::FfrBody2d(std::string name, FfrInvariants invariants, const FrameState2d& initial)
-    : Body(std::move(name)), inv_(std::move(invariants)), initial_(initial) {
+    : Body(std::move(name)), ownInvariants_(std::move(invariants)), inv_(ownInvariants_), initial_(initial) {
   inv_.validate("body '" + this->name() + "'");
   checkFrame("body '" + this->name() + "'", initial);
 }
 
 FfrBody2d::FfrBody2d(std::string name, std::shared_ptr<const FfrBeamModel> model, const FrameState2d& initial)
-    : Body(std::move(name)), model_(std::move(model)), initial_(initial) {
-  if (!model_) throw InputError("body '" + this->name() + "': no beam model given");
-  inv_ = model_->invariants();
+    : Body(std::move(name)), model_(std::move(model)), inv_(requireModel(model_, this->name()).invariants()),
+      initial_(initial) {
   checkFrame("body '" + this->name() + "'", initial);
 }
 

@@ -65,8 +65,9 @@ class FfrBody2d final : public Body {
   int findPoint(const Vec2& point) const;
   VecX elasticGradient(const VecX& qf) const;
 
-  FfrInvariants inv_;
-  std::shared_ptr<const FfrBeamModel> model_;
+  FfrInvariants ownInvariants_;                  // given directly; empty with a model
+  std::shared_ptr<const FfrBeamModel> model_;    // generating mesh model, or null
+  const FfrInvariants& inv_;                     // ownInvariants_ or model_->invariants()
   FrameState2d initial_;
   VecX initialQf_, initialQfDot_;
 };

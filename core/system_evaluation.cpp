@@ -9,57 +9,54 @@ VecX gather(const std::vector<int>& cols, const VecX& x) {
   return out;
 }
 
+/// Calls fn(index, constraint, evaluation, f, f', f'') for every constraint at (q, t).
+template <class Fn>
+void forEachConstraint(const System& sys, const VecX& q, double t, bool withHessians, Fn&& fn) {
+  ConstraintEvaluation ev;
+  VecX f, df, ddf;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    con.evaluate(sys.bodyStates(con.bodies(), q.data()), withHessians, ev);
+    con.timeFunction(t, f, df, ddf);
+    fn(ci, con, ev, f, df, ddf);
+  }
+}
+
 }  // namespace
 
 void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, MatX* G) {
   const int m = sys.numConstraintEquations();
   if (g) g->setZero(m);
   if (G) G->setZero(m, sys.numCoordinates());
-  ConstraintEvaluation ev;
-  VecX f, df, ddf;
-  for (int c = 0; c < sys.numConstraints(); ++c) {
-    const ConstraintIndex ci(c);
-    const Constraint& con = sys.constraint(ci);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
-    con.timeFunction(t, f, df, ddf);
-    const int row = sys.constraintOffset(ci);
-    const int me = con.numEquations();
+  forEachConstraint(sys, q, t, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
+                                          const VecX& f, const VecX&, const VecX&) {
+    const int row = sys.constraintOffset(ci), me = con.numEquations();
     if (g) g->segment(row, me) = ev.h - f;
     if (G) {
       const auto& cols = sys.constraintColumns(ci);
       for (size_t k = 0; k < cols.size(); ++k) G->block(row, cols[k], me, 1) += ev.G.col(k);
     }
-  }
+  });
 }
 
 VecX velocityConstraintResidual(const System& sys, const VecX& q, const VecX& v, double t) {
   VecX out(sys.numConstraintEquations());
-  ConstraintEvaluation ev;
-  VecX f, df, ddf;
-  for (int c = 0; c < sys.numConstraints(); ++c) {
-    const ConstraintIndex ci(c);
-    const Constraint& con = sys.constraint(ci);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
-    con.timeFunction(t, f, df, ddf);
-    out.segment(sys.constraintOffset(ci), con.numEquations()) =
-        ev.G * gather(sys.constraintColumns(ci), v) - df;
-  }
+  forEachConstraint(sys, q, t, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
+                                          const VecX&, const VecX& df, const VecX&) {
+    out.segment(sys.constraintOffset(ci), con.numEquations()) = ev.G * gather(sys.constraintColumns(ci), v) - df;
+  });
   return out;
 }
 
 VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, double t) {
   VecX out(sys.numConstraintEquations());
-  ConstraintEvaluation ev;
-  VecX f, df, ddf;
-  for (int c = 0; c < sys.numConstraints(); ++c) {
-    const ConstraintIndex ci(c);
-    const Constraint& con = sys.constraint(ci);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), true, ev);
-    con.timeFunction(t, f, df, ddf);
+  forEachConstraint(sys, q, t, true, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
+                                         const VecX&, const VecX&, const VecX& ddf) {
     const VecX vl = gather(sys.constraintColumns(ci), v);
     const int row = sys.constraintOffset(ci);
     for (int a = 0; a < con.numEquations(); ++a) out[row + a] = ddf[a] - vl.dot(ev.H[a] * vl);
-  }
+  });
   return out;
 }
 

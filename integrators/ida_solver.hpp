@@ -19,10 +19,10 @@ std::string toString(LinearSolverKind k);
 /// "auto", "dense", "klu". @throws InputError otherwise.
 LinearSolverKind parseLinearSolver(const std::string& name);
 
-/// Unknowns up to which Automatic picks the dense solver. Measured: KLU is already
-/// faster than SUNDIALS' (unblocked) dense LU for a 10-unknown pendulum (0.05 s against
-/// 0.07 s for 200 s of motion) and for the 36-unknown slider-crank (ratio 0.77), so
-/// dense is kept only for the smallest systems (benchmarks/README.md).
+/// Unknowns up to which Automatic picks the dense solver. KLU is already faster than
+/// SUNDIALS' dense LU for the 10-unknown pendulum and the 36-unknown slider-crank
+/// (bench_rigid_slider_crank; figures in benchmarks/README.md), so dense is kept only
+/// for the smallest systems.
 inline constexpr int kDenseSizeLimit = 8;
 
 struct IntegratorOptions {

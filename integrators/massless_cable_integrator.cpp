@@ -91,12 +91,7 @@ TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& obse
   std::optional<MemberContactDetector> contacts;
   std::vector<TensegrityEvent> pending;
   auto emit = [&](const TensegrityEvent& e) {
-    switch (e.type) {
-      case TensegrityEvent::Type::Snap: ++sum.snaps; break;
-      case TensegrityEvent::Type::Taut: ++sum.tautTransitions; break;
-      case TensegrityEvent::Type::Slack: ++sum.slackTransitions; break;
-      case TensegrityEvent::Type::Contact: ++sum.contacts; break;
-    }
+    sum.count(e);
     if (observer.onEvent) observer.onEvent(e);
   };
   if (o.detectContacts) {

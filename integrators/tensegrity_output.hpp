@@ -48,6 +48,15 @@ struct TensegrityRunSummary {
   long steps = 0;
   double cpuSeconds = 0.0;
   int snaps = 0, tautTransitions = 0, slackTransitions = 0, contacts = 0;
+  /// Adds the event to its counter.
+  void count(const TensegrityEvent& e) {
+    switch (e.type) {
+      case TensegrityEvent::Type::Snap: ++snaps; break;
+      case TensegrityEvent::Type::Taut: ++tautTransitions; break;
+      case TensegrityEvent::Type::Slack: ++slackTransitions; break;
+      case TensegrityEvent::Type::Contact: ++contacts; break;
+    }
+  }
   double energyStart = 0.0, energyEnd = 0.0;
   /// Method 1: largest increase of total energy over a step containing a snap (<= 0 expected).
   double maxEnergyIncreaseAtSnap = -1e300;

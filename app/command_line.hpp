@@ -1,0 +1,97 @@
+// Command-line helpers shared by the flexmbd commands (run, kinematics, tensegrity):
+// one-line errors, option splitting and number parsing. Exit status 2 on UsageError.
+#pragma once
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace flexmbd::cli {
+
+/// A bad command line (exit status 2).
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Messages go to the terminal on one line.
+inline std::string oneLine(std::string s) {
+  for (char& c : s) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return s;
+}
+
+inline void printError(const std::string& message) {
+  std::cerr << "flexmbd: error: " << oneLine(message) << std::endl;
+}
+
+inline double parseNumberOption(const std::string& option, const std::string& text) {
+  const char* begin = text.c_str();
+  char* end = nullptr;
+  const double x = std::strtod(begin, &end);
+  if (text.empty() || end == begin || *end != '\0') {
+    throw UsageError("option " + option + " expects a number, got '" + text + "'");
+  }
+  if (!std::isfinite(x)) throw UsageError("option " + option + " expects a finite number, got '" + text + "'");
+  return x;
+}
+
+inline double parsePositiveOption(const std::string& option, const std::string& text) {
+  const double x = parseNumberOption(option, text);
+  if (!(x > 0.0)) throw UsageError("option " + option + " must be > 0, got " + text);
+  return x;
+}
+
+struct SplitArguments {
+  std::vector<std::string> positional;
+  std::map<std::string, std::string> values;  ///< "--name" -> value (last one wins)
+  std::set<std::string> flags;                ///< flags given
+};
+
+/// Splits arguments into positionals, `--name VALUE` / `--name=VALUE` options (names
+/// in valueOptions) and flags (names in flagOptions; aliases map to their long name).
+/// @throws UsageError naming the unknown option and listing the known ones.
+inline SplitArguments splitArguments(const std::vector<std::string>& args, const std::set<std::string>& valueOptions,
+                                     const std::map<std::string, std::string>& flagOptions,
+                                     const std::string& command) {
+  SplitArguments out;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (a.size() < 2 || a[0] != '-') {
+      out.positional.push_back(a);
+      continue;
+    }
+    if (const auto f = flagOptions.find(a); f != flagOptions.end()) {
+      out.flags.insert(f->second);
+      continue;
+    }
+    std::string name = a, value;
+    bool haveValue = false;
+    if (const auto eq = a.find('='); a.rfind("--", 0) == 0 && eq != std::string::npos) {
+      name = a.substr(0, eq);
+      value = a.substr(eq + 1);
+      haveValue = true;
+    }
+    if (!valueOptions.count(name)) {
+      std::string known;
+      for (const auto& v : valueOptions) known += (known.empty() ? "" : ", ") + v;
+      for (const auto& [alias, flag] : flagOptions) {
+        if (alias == flag) known += ", " + flag;
+      }
+      throw UsageError(command + "unknown option '" + name + "' (known options: " + known + ", --help)");
+    }
+    if (!haveValue) {
+      if (k + 1 >= args.size()) throw UsageError("option " + name + " needs a value");
+      value = args[++k];
+    }
+    out.values[name] = value;
+  }
+  return out;
+}
+
+}  // namespace flexmbd::cli
