@@ -160,6 +160,7 @@ IdaSolver::IdaSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX
   d.check(IDASetMaxNumSteps(d.mem, o.maxSteps), "IDASetMaxNumSteps");
   if (o.maxStepSize > 0.0) d.check(IDASetMaxStep(d.mem, o.maxStepSize), "IDASetMaxStep");
   if (o.minStepSize > 0.0) d.check(IDASetMinStep(d.mem, o.minStepSize), "IDASetMinStep");
+  if (o.maxOrder != 5) d.check(IDASetMaxOrd(d.mem, o.maxOrder), "IDASetMaxOrd");
 
   LinearSolverKind kind = o.linearSolver;
   if (kind == LinearSolverKind::Automatic) {

@@ -35,6 +35,7 @@ struct IntegratorOptions {
   long maxSteps = 1000000;        ///< per call of advance()
   double maxStepSize = 0.0;      ///< 0: no limit
   double minStepSize = 0.0;      ///< IDA fails (IDA_ERR_FAIL/IDA_CONV_FAIL) below this
+  int maxOrder = 5;              ///< highest BDF order, 1..5
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;  ///< IDA's own difference quotients (dense only)
 };

@@ -24,6 +24,9 @@ struct SolverSettings {
   /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start).
   std::optional<double> minStepSize;
   long maxSteps = 1000000;        ///< per output interval
+  /// Highest BDF order (1..5). Orders 1 and 2 are A-stable: undamped high-frequency
+  /// modes cannot force small steps for stability (docs/formulations.md).
+  int maxOrder = 5;
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;
   bool progress = true;           ///< progress on stderr for long runs (if a terminal)

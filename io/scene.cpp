@@ -429,6 +429,7 @@ SolverSettings parseSolver(const json& j) {
   s.maxStepSize = r.number("max_step", s.maxStepSize);
   if (r.has("min_step")) s.minStepSize = r.number("min_step", 0.0);
   s.maxSteps = r.integer("max_steps", s.maxSteps, 1);
+  s.maxOrder = static_cast<int>(r.integer("max_order", s.maxOrder, 1));
   s.finiteDifferenceJacobian = r.boolean("fd_jacobian", s.finiteDifferenceJacobian);
   checkSolverSettings(s);
   return s;
