@@ -1,0 +1,200 @@
+// Micro-benchmarks (Google Benchmark): one residual evaluation (DaeSystem::residual),
+// one Jacobian assembly (DaeSystem::jacobian into a JacobianSink::sparse of the DAE's
+// pattern) and one KLU refactorisation (klu_l_analyze and klu_l_factor once, then
+// klu_l_refactor on the pattern's CSC arrays) for the elastic slider-crank (GGL) with 8
+// and 256 rod elements, at its consistent initial state, cj = 1e6 (about 1/h of the
+// runs at rtol 1e-6). After the runs: the cost of a Jacobian and of a refactorisation
+// in residual evaluations (target: a Jacobian costs at most a few residuals).
+//
+// Options of its own (--elements, --quick, --repeat, --csv, --out-dir); any other
+// argument goes to Google Benchmark (--benchmark_filter=..., ...).
+#include <benchmark/benchmark.h>
+#include <klu.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "benchmarks/bench_common.hpp"
+#include "benchmarks/bench_scenes.hpp"
+#include "integrators/initial_conditions.hpp"
+
+using namespace flexmbd;
+using namespace flexmbd::bench;
+
+namespace {
+
+constexpr double kTime = 0.0, kCj = 1e6;
+
+/// The DAE of one mesh at its consistent initial state, built once per mesh.
+struct Fixture {
+  Scene scene;
+  std::unique_ptr<DaeSystem> dae;
+  VecX y, yp, F;
+  std::vector<double> values;
+  std::vector<SuiteSparse_long> colStart, rowIndex;
+};
+
+Fixture& fixture(int elements) {
+  static std::map<int, std::unique_ptr<Fixture>> all;
+  auto& f = all[elements];
+  if (!f) {
+    f = std::make_unique<Fixture>();
+    f->scene = testmodels::elasticSliderCrank(elements, 1.0, 0, 1.0, 1e-6, 1e-8);
+    const System& sys = f->scene.system;
+    const ConsistentState cs = computeConsistentState(sys, kTime, sys.initialCoordinates(), sys.initialVelocities());
+    f->dae = std::make_unique<DaeSystem>(sys, Formulation::Ggl);
+    f->dae->packState(cs.q, cs.v, cs.a, cs.lambda, f->y, f->yp);
+    f->F.resize(f->dae->layout().size);
+    const SparsePattern& p = f->dae->pattern();
+    f->values.assign(p.nonZeros(), 0.0);
+    f->colStart.assign(p.colStart().begin(), p.colStart().end());
+    f->rowIndex.assign(p.rowIndex().begin(), p.rowIndex().end());
+  }
+  return *f;
+}
+
+void sizeCounters(benchmark::State& st, const Fixture& f) {
+  st.counters["dae_size"] = f.dae->layout().size;
+  st.counters["nnz"] = static_cast<double>(f.dae->pattern().nonZeros());
+}
+
+void assembleJacobian(Fixture& f) {
+  std::fill(f.values.begin(), f.values.end(), 0.0);
+  JacobianSink sink = JacobianSink::sparse(f.values.data(), f.dae->pattern());
+  f.dae->jacobian(kTime, f.y.data(), f.yp.data(), kCj, sink);
+}
+
+void residualBench(benchmark::State& st, int elements) {
+  Fixture& f = fixture(elements);
+  for (auto _ : st) {
+    f.dae->residual(kTime, f.y.data(), f.yp.data(), f.F.data());
+    benchmark::DoNotOptimize(f.F.data());
+    benchmark::ClobberMemory();
+  }
+  sizeCounters(st, f);
+}
+
+void jacobianBench(benchmark::State& st, int elements) {
+  Fixture& f = fixture(elements);
+  // a residual's cost measured alongside, for the ratio counter
+  const double tRes = timePerCall([&] { f.dae->residual(kTime, f.y.data(), f.yp.data(), f.F.data()); },
+                                  std::max(1, 20000 / f.dae->layout().size), 5);
+  const auto t0 = Clock::now();
+  for (auto _ : st) {
+    assembleJacobian(f);
+    benchmark::DoNotOptimize(f.values.data());
+    benchmark::ClobberMemory();
+  }
+  const double tJac = secondsSince(t0) / static_cast<double>(st.iterations());
+  sizeCounters(st, f);
+  st.counters["jac_in_residuals"] = tJac / tRes;
+}
+
+void kluRefactorBench(benchmark::State& st, int elements) {
+  Fixture& f = fixture(elements);
+  assembleJacobian(f);
+  klu_l_common common;
+  klu_l_defaults(&common);
+  const SuiteSparse_long n = f.dae->layout().size;
+  klu_l_symbolic* sym = klu_l_analyze(n, f.colStart.data(), f.rowIndex.data(), &common);
+  klu_l_numeric* num = sym ? klu_l_factor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, &common)
+                           : nullptr;
+  if (!num) {
+    st.SkipWithError("KLU analyze/factor failed");
+    if (sym) klu_l_free_symbolic(&sym, &common);
+    return;
+  }
+  for (auto _ : st) {
+    const int ok = klu_l_refactor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, num, &common);
+    benchmark::DoNotOptimize(ok);
+  }
+  sizeCounters(st, f);
+  st.counters["lu_nnz"] = static_cast<double>(num->lnz + num->unz);
+  klu_l_free_numeric(&num, &common);
+  klu_l_free_symbolic(&sym, &common);
+}
+
+/// Console output as usual; the per-iteration times kept for the ratios.
+class CollectingReporter : public benchmark::ConsoleReporter {
+ public:
+  CollectingReporter() : ConsoleReporter(isatty(STDOUT_FILENO) ? OO_ColorTabular : OO_Tabular) {}
+  std::map<std::string, double> seconds;  // benchmark name -> real time per iteration [s]
+  std::map<std::string, double> iterations;
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      if (r.error_occurred) continue;
+      // plain runs, or the median aggregate when repeated
+      const bool use = r.run_type == Run::RT_Iteration ? !r.report_big_o && r.repetitions <= 1
+                                                       : r.aggregate_name == "median";
+      if (!use) continue;
+      const std::string name = r.run_name.function_name;
+      seconds[name] = r.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(r.time_unit);
+      iterations[name] = static_cast<double>(r.iterations);
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options opt("bench_micro", "Residual, Jacobian and KLU refactorisation of the elastic slider-crank (Google Benchmark).",
+              1);
+  std::vector<std::string> elementList;
+  opt.addList("--elements", "rod meshes (default 8,256; --quick: 8,32)", &elementList);
+  std::vector<std::string> gbArgs;
+  opt.parse(argc, argv, &gbArgs);
+  if (elementList.empty()) elementList = opt.quick ? std::vector<std::string>{"8", "32"} : std::vector<std::string>{"8", "256"};
+  std::vector<int> meshes;
+  for (const std::string& e : elementList) meshes.push_back(Options::toInt(e, "--elements"));
+
+  std::vector<std::string> args = {argv[0]};
+  if (opt.quick) args.push_back("--benchmark_min_time=0.02");
+  if (opt.repeat > 1) {
+    args.push_back("--benchmark_repetitions=" + std::to_string(opt.repeat));
+    args.push_back("--benchmark_report_aggregates_only=true");
+  }
+  args.insert(args.end(), gbArgs.begin(), gbArgs.end());
+  std::vector<char*> cargs;
+  for (std::string& a : args) cargs.push_back(a.data());
+  int cargc = static_cast<int>(cargs.size());
+  benchmark::Initialize(&cargc, cargs.data());
+  if (benchmark::ReportUnrecognizedArguments(cargc, cargs.data())) return 2;
+
+  for (int n : meshes) {
+    const std::string suffix = "/elements:" + std::to_string(n);
+    benchmark::RegisterBenchmark(("residual" + suffix).c_str(), residualBench, n)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("jacobian" + suffix).c_str(), jacobianBench, n)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("klu_refactor" + suffix).c_str(), kluRefactorBench, n)
+        ->Unit(benchmark::kMicrosecond);
+  }
+  CollectingReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+
+  CsvWriter csv(opt.csvPath("bench_micro.csv"),
+                {"elements", "dae_size", "jacobian_nonzeros", "residual_us", "jacobian_us", "klu_refactor_us",
+                 "jacobian_in_residuals", "klu_refactor_in_residuals"});
+  std::printf("\n%8s %8s %10s %12s %12s %14s %10s %10s\n", "elements", "size", "nnz(J)", "residual[us]",
+              "jacobian[us]", "klu_refac[us]", "jac/res", "klu/res");
+  for (int n : meshes) {
+    const std::string suffix = "/elements:" + std::to_string(n);
+    const auto get = [&](const std::string& name) {
+      const auto it = reporter.seconds.find(name + suffix);
+      return it == reporter.seconds.end() ? NAN : it->second;
+    };
+    const double tr = get("residual"), tj = get("jacobian"), tk = get("klu_refactor");
+    const Fixture& f = fixture(n);
+    std::printf("%8d %8d %10lld %12.3f %12.3f %14.3f %10.2f %10.2f\n", n, f.dae->layout().size,
+                static_cast<long long>(f.dae->pattern().nonZeros()), 1e6 * tr, 1e6 * tj, 1e6 * tk, tj / tr, tk / tr);
+    csv.row({std::to_string(n), std::to_string(f.dae->layout().size), std::to_string(f.dae->pattern().nonZeros()),
+             fmt(1e6 * tr), fmt(1e6 * tj), fmt(1e6 * tk), fmt(tj / tr, "%.3f"), fmt(tk / tr, "%.3f")});
+  }
+  std::printf("jac/res, klu/res: the cost of one Jacobian assembly and of one KLU refactorisation in residual "
+              "evaluations (target: a Jacobian costs at most a few residuals).\nCSV written to %s\n",
+              csv.path().c_str());
+  return 0;
+}

@@ -1,0 +1,166 @@
+#!/usr/bin/python3
+"""Figures from the benchmark CSV files (run with Debian's /usr/bin/python3, which has
+python3-matplotlib):
+
+  work_precision_<group>.png  error against CPU time, log-log, one line per model
+                              (bench_work_precision.csv), labelled with rtol
+  variants_<scene>.png        time ratios to the default variant (bench_variants.csv)
+  scaling.png                 time per step against the DAE size, log-log, with the
+                              least-squares exponent from --fit-from elements up
+                              (bench_scaling.csv)
+
+usage: /usr/bin/python3 benchmarks/plot.py [--in-dir DIR] [--out-dir DIR] [--fit-from N]
+Missing CSV files are skipped with a message.
+"""
+import argparse
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def read_csv(path):
+    """Rows as dicts; lines starting with '#' are skipped (comments)."""
+    if not os.path.exists(path):
+        print(f"plot.py: {path} not found, skipped")
+        return None
+    with open(path, newline="") as f:
+        return list(csv.DictReader(line for line in f if not line.startswith("#")))
+
+
+def num(s):
+    try:
+        v = float(s)
+        return v if math.isfinite(v) else None
+    except (TypeError, ValueError):
+        return None
+
+
+def work_precision(rows, out_dir):
+    groups = []
+    for r in rows:
+        if r["group"] not in groups:
+            groups.append(r["group"])
+    written = []
+    for g in groups:
+        fig, ax = plt.subplots(figsize=(7, 5))
+        models = []
+        for r in rows:
+            if r["group"] == g and r["model"] not in models:
+                models.append(r["model"])
+        reference = ""
+        for m in models:
+            pts = [(num(r["seconds"]), num(r["error"]), r["rtol"]) for r in rows
+                   if r["group"] == g and r["model"] == m and r.get("ok", "1") == "1"]
+            pts = [p for p in pts if p[0] and p[1]]
+            if not pts:
+                continue
+            reference = next(r["reference"] for r in rows if r["group"] == g)
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=m)
+            for t, e, rtol in pts:
+                ax.annotate(rtol, (t, e), textcoords="offset points", xytext=(4, 3), fontsize=7)
+        ax.set_xlabel("CPU time [s] (wall time of the run)")
+        ax.set_ylabel("max position error / characteristic length")
+        ax.set_title(f"work-precision: {g}\nreference: {reference}", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend()
+        path = os.path.join(out_dir, f"work_precision_{g}.png")
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
+def variants(rows, out_dir):
+    written = []
+    scenes = []
+    for r in rows:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    for s in scenes:
+        sub = [r for r in rows if r["scene"] == s]
+        fig, ax = plt.subplots(figsize=(7, 0.45 * len(sub) + 1.5))
+        names = [r["variant"] for r in sub]
+        ratios = [num(r["time_ratio"]) or 0.0 for r in sub]
+        ax.barh(range(len(sub)), ratios, color=["C0" if i == 0 else "C1" for i in range(len(sub))])
+        ax.set_yticks(range(len(sub)))
+        ax.set_yticklabels(names, fontsize=8)
+        ax.invert_yaxis()
+        ax.axvline(1.0, color="k", lw=0.8)
+        for i, v in enumerate(ratios):
+            ax.text(v, i, f" {v:.2f}", va="center", fontsize=8)
+        ax.set_xlabel("median time ratio to the default (round-robin repeats)")
+        ax.set_title(f"variants: {s} (rtol {sub[0]['rtol']})", fontsize=10)
+        path = os.path.join(out_dir, f"variants_{s}.png")
+        fig.tight_layout()
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        written.append(path)
+    return written
+
+
+def scaling(rows, out_dir, fit_from):
+    pts = [(int(r["elements"]), num(r["dae_size"]), num(r["seconds_per_step"])) for r in rows]
+    pts = [p for p in pts if p[1] and p[2]]
+    if not pts:
+        return []
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.loglog([p[1] for p in pts], [1e6 * p[2] for p in pts], "o-", label="time per step")
+    for n, size, t in pts:
+        ax.annotate(f"{n} el.", (size, 1e6 * t), textcoords="offset points", xytext=(4, -10), fontsize=7)
+    fit = [p for p in pts if p[0] >= fit_from]
+    title = "elastic slider-crank, nodal rod, rtol 1e-6, KLU"
+    if len(fit) >= 2:
+        xs = [math.log(p[1]) for p in fit]
+        ys = [math.log(p[2]) for p in fit]
+        n = len(xs)
+        mx, my = sum(xs) / n, sum(ys) / n
+        b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+        a = my - b * mx
+        x0, x1 = min(p[1] for p in fit), max(p[1] for p in fit)
+        ax.loglog([x0, x1], [1e6 * math.exp(a + b * math.log(x0)), 1e6 * math.exp(a + b * math.log(x1))], "--",
+                  label=f"least squares from {fit_from} elements: ~ size^{b:.2f}")
+        title += f"\nexponent {b:.2f} (target <= 1.15)"
+    ax.set_xlabel("unknowns (DAE size)")
+    ax.set_ylabel("time per step [µs]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    path = os.path.join(out_dir, "scaling.png")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--in-dir", default=".", help="directory of the CSV files (default: .)")
+    p.add_argument("--out-dir", default=os.path.join(here, "figures"), help="PNG directory (default: benchmarks/figures)")
+    p.add_argument("--fit-from", type=int, default=16, help="smallest mesh of the scaling fit (default 16)")
+    a = p.parse_args()
+    os.makedirs(a.out_dir, exist_ok=True)
+    written = []
+    rows = read_csv(os.path.join(a.in_dir, "bench_work_precision.csv"))
+    if rows:
+        written += work_precision(rows, a.out_dir)
+    rows = read_csv(os.path.join(a.in_dir, "bench_variants.csv"))
+    if rows:
+        written += variants(rows, a.out_dir)
+    rows = read_csv(os.path.join(a.in_dir, "bench_scaling.csv"))
+    if rows:
+        written += scaling(rows, a.out_dir, a.fit_from)
+    for w in written:
+        print("wrote", w)
+    return 0 if written else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
