@@ -3,16 +3,15 @@
 // closed form of source document 000, eqs. 30-32), the formulations and linear solvers
 // side by side, and the cost of one residual and one Jacobian evaluation.
 //
-// Usage: bench_rigid_slider_crank [--repeat N] [--csv FILE]
+// Usage: bench_rigid_slider_crank [--repeat N] [--quick] [--csv FILE] [--out-dir DIR]
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include "benchmarks/bench_common.hpp"
 #include "core/dae_system.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/simulation.hpp"
@@ -20,7 +19,10 @@
 #include "tests/reference_solutions.hpp"
 
 using namespace flexmbd;
-using Clock = std::chrono::steady_clock;
+using flexmbd::bench::Clock;
+using flexmbd::bench::median;
+using flexmbd::bench::secondsSince;
+using flexmbd::bench::timePerCall;
 
 namespace {
 
@@ -59,7 +61,7 @@ Row runOnce(double rtol, Formulation f, LinearSolverKind ls, bool fdJac, int rep
       ev = std::max(ev, std::abs(o.v[ix] - ref.xd) / vScale);
       ea = std::max(ea, std::abs(o.a[ix] - ref.xdd) / aScale);
     });
-    times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+    times.push_back(secondsSince(t0));
     if (!s.ok) std::fprintf(stderr, "%s rtol %g failed: %s\n", name.c_str(), rtol, s.message.c_str());
     row.steps = s.stats.steps;
     row.res = s.stats.residualEvals;
@@ -69,39 +71,19 @@ Row runOnce(double rtol, Formulation f, LinearSolverKind ls, bool fdJac, int rep
     row.errV = ev;
     row.errA = ea;
   }
-  std::sort(times.begin(), times.end());
-  row.seconds = times[times.size() / 2];
+  row.seconds = median(times);
   return row;
-}
-
-/// Median time of one call of fn over batches of n calls.
-template <class F>
-double timePerCall(F&& fn, int n, int batches = 7) {
-  std::vector<double> t;
-  for (int b = 0; b < batches; ++b) {
-    const auto t0 = Clock::now();
-    for (int i = 0; i < n; ++i) fn();
-    t.push_back(std::chrono::duration<double>(Clock::now() - t0).count() / n);
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int repeat = 5;
-  std::string csvPath = "bench_rigid_slider_crank.csv";
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--repeat") && i + 1 < argc) {
-      repeat = std::max(1, std::atoi(argv[++i]));
-    } else if (!std::strcmp(argv[i], "--csv") && i + 1 < argc) {
-      csvPath = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: %s [--repeat N] [--csv FILE]\n", argv[0]);
-      return 2;
-    }
-  }
+  bench::Options opt("bench_rigid_slider_crank",
+                     "Rigid slider-crank: precision, formulations, linear solvers, residual and Jacobian cost.", 5);
+  opt.parse(argc, argv);
+  if (opt.quick) opt.repeat = 1;
+  const int repeat = opt.repeat;
+  const std::string csvPath = opt.csvPath("bench_rigid_slider_crank.csv");
   std::vector<Row> rows;
   for (double rtol : {1e-6, 1e-8, 1e-10}) {
     rows.push_back(runOnce(rtol, Formulation::Ggl, LinearSolverKind::Dense, false, repeat, "ggl/dense/analytic"));
@@ -141,10 +123,9 @@ int main(int argc, char** argv) {
         scene.solver.progress = false;
         const auto t0 = Clock::now();
         steps[k] = simulate(scene.system, scene.solver, nullptr).stats.steps;
-        times.push_back(std::chrono::duration<double>(Clock::now() - t0).count());
+        times.push_back(secondsSince(t0));
       }
-      std::sort(times.begin(), times.end());
-      t[k++] = times[times.size() / 2];
+      t[k++] = median(times);
     }
     std::printf("\nPendulum (DAE size 10), 100 s at rtol 1e-8: dense %.1f ms (%ld steps), KLU %.1f ms (%ld steps), "
                 "KLU/dense %.2f\n", 1e3 * t[0], steps[0], 1e3 * t[1], steps[1], t[1] / t[0]);
