@@ -8,7 +8,10 @@
 #include <ctime>
 #include <sstream>
 
+#include <Eigen/SVD>
+
 #include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
 
@@ -51,6 +54,66 @@ class ProgressReporter {
   bool shown_ = false;
 };
 
+/// Names the constraint (joint or driver) that owns global equation `row`.
+std::string constraintOfRow(const System& sys, int row) {
+  for (int c = sys.numConstraints() - 1; c >= 0; --c) {
+    const ConstraintIndex ci(c);
+    if (row >= sys.constraintOffset(ci)) {
+      const Constraint& con = sys.constraint(ci);
+      return std::string(con.isDriver() ? "driver '" : "joint '") + con.name() + "' (" +
+             con.typeName() + ", equation " + std::to_string(row - sys.constraintOffset(ci)) + ")";
+    }
+  }
+  return "?";
+}
+
+/// A constraint row whose Gram-Schmidt remainder falls below this fraction of its norm
+/// counts as dependent in a failure diagnosis. Measured (tests/test_stability.cpp): where
+/// IDA stops at the lock-up of examples/slider_crank_lockup.json the smallest/largest
+/// singular value of G is 1.6e-5, at the crossing of examples/slider_crank_equal_links.json
+/// 1e-7; a regular position of the rigid slider-crank has 0.17.
+constexpr double kNearlyDependent = 1e-2;
+
+/// After a solver failure at tFail: is the mechanism at a singular position? The last
+/// output state is carried to tFail (Taylor, then minimum-norm Newton on g(q, tFail) = 0,
+/// which may stop short beyond a lock-up) and the constraint Jacobian G is examined there.
+std::string singularityDiagnosis(const System& sys, const OutputSample& last, double tFail) {
+  const int m = sys.numConstraintEquations();
+  if (m == 0 || last.q.size() == 0 || m > sys.numCoordinates()) return "";
+  const double dt = tFail - last.t;
+  VecX q = last.q + dt * last.v + 0.5 * dt * dt * last.a;
+  VecX g;
+  MatX G;
+  evaluateConstraints(sys, q, tFail, &g, &G);
+  for (int it = 0; it < 10 && g.allFinite() && g.lpNorm<Eigen::Infinity>() > 1e-13 * (1.0 + q.norm()); ++it) {
+    const VecX dq = -G.completeOrthogonalDecomposition().solve(g);
+    if (!dq.allFinite() || dq.norm() > 0.1 * (1.0 + q.norm())) break;  // diverging: keep the last q
+    VecX gn;
+    MatX Gn;
+    evaluateConstraints(sys, q + dq, tFail, &gn, &Gn);
+    if (!gn.allFinite() || gn.norm() >= g.norm()) break;
+    q += dq;
+    g = gn;
+    G = Gn;
+  }
+  if (!G.allFinite()) return "";
+  const VecX sv = Eigen::JacobiSVD<MatX>(G).singularValues();
+  const double ratio = sv.size() > 0 && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
+  const std::vector<int> rows = dependentRows(G, kNearlyDependent);
+  std::ostringstream os;
+  os << "; constraint Jacobian at t = " << tFail << ": smallest/largest singular value " << ratio;
+  if (rows.empty()) {
+    os << ", full rank: the mechanism is not near a singular configuration";
+    return os.str();
+  }
+  os << ", nearly rank-deficient: ";
+  for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << constraintOfRow(sys, rows[k]);
+  os << (rows.size() == 1 ? " becomes" : " become")
+     << " dependent on the joints and drivers defined before: the mechanism reaches a singular position "
+        "(lock-up, dead centre or change point) where the drivers do not determine its motion";
+  return os.str();
+}
+
 }  // namespace
 
 void SolverSettings::validate() const {
@@ -92,7 +155,10 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   SimulationSummary summary;
   summary.initialPositionIterations = init.positionIterations;
   const bool conservative = isConservative(sys);
+  OutputSample last;  // the last output, for the diagnosis of a failure
+  double tOutput = t0;  // the output being evaluated
   auto emit = [&](double t, const VecX& y, const VecX& yp) {
+    tOutput = t;
     OutputSample s;
     s.t = t;
     s.q = y.segment(L.q, L.nq);
@@ -115,6 +181,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     }
     summary.tReached = t;
     if (onOutput) onOutput(s);
+    last = std::move(s);
   };
   emit(t0, y0, yp0);
 
@@ -145,13 +212,23 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     summary.ok = false;
     summary.message = e.what();
     summary.failureTime = e.time();
+    try {
+      summary.message += singularityDiagnosis(sys, last, summary.failureTime);
+    } catch (const std::exception&) {
+      // the diagnosis is optional: IDA's reason stays the message
+    }
   } catch (const std::exception& e) {
     // post-processing of an output state failed (e.g. a singular mass matrix after the
-    // solution blew up): a failure of the run, reported like a solver failure
+    // solution blew up, or an output exactly at a singular position of the mechanism,
+    // where the augmented matrix for the accelerations is singular): a failure of the
+    // run, reported like a solver failure
     summary.ok = false;
     summary.failureTime = ida.stats().currentTime;
-    summary.message = "evaluating the outputs at t = " + std::to_string(summary.failureTime) +
-                      " failed: " + e.what();
+    summary.message = "evaluating the outputs at t = " + std::to_string(tOutput) + " failed: " + e.what();
+    try {
+      summary.message += singularityDiagnosis(sys, last, tOutput);
+    } catch (const std::exception&) {
+    }
   }
   summary.stats = ida.stats();
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
