@@ -66,10 +66,7 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
   nodal.sBar = Mat2X::Zero(2, nd);
   nodal.i1 = VecX::Zero(nd);
   nodal.j0 = VecX::Zero(nd);
-  nodal.mff = MatX::Zero(nd, nd);
-  nodal.sTilde = MatX::Zero(nd, nd);
-  nodal.kff = MatX::Zero(nd, nd);
-  nodal.dff = MatX::Zero(nd, nd);
+  std::vector<Eigen::Triplet<double>> tm, ts, tk, td;  // element blocks of m_ff, S~, K_ff, D_ff
   for (size_t e = 0; e < elements_.size(); ++e) {
     const BeamElement2d& el = elements_[e];
     const auto& T = el.transformation();
@@ -96,12 +93,17 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
       nodal.i1[idx[a]] += i1[a];
       nodal.j0[idx[a]] += j0[a];
       for (int b = 0; b < 6; ++b) {
-        nodal.mff(idx[a], idx[b]) += m(a, b);
-        nodal.sTilde(idx[a], idx[b]) += st(a, b);
-        nodal.kff(idx[a], idx[b]) += k(a, b);
-        nodal.dff(idx[a], idx[b]) += el.section().damping * k(a, b);
+        tm.emplace_back(idx[a], idx[b], m(a, b));
+        ts.emplace_back(idx[a], idx[b], st(a, b));
+        tk.emplace_back(idx[a], idx[b], k(a, b));
+        if (el.section().damping > 0.0) td.emplace_back(idx[a], idx[b], el.section().damping * k(a, b));
       }
     }
+  }
+  for (auto [A, t] : {std::pair<SpMat*, const std::vector<Eigen::Triplet<double>>*>{&nodal.mff, &tm},
+                      {&nodal.sTilde, &ts}, {&nodal.kff, &tk}, {&nodal.dff, &td}}) {
+    A->resize(nd, nd);
+    A->setFromTriplets(t->begin(), t->end());  // duplicates summed
   }
 
   // ----- reference conditions: rows C of C q_n = 0, then B2 = null(C) -------------
@@ -153,13 +155,14 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
     throw InputError(owner + ": the reference conditions over-constrain the body: condition '" + rowNames[dep[0]] +
                      "' repeats the others");
   }
-  MatX B = nullSpaceBasis(C);
+  // B2 keeps unit columns where it can: sparse for the pinned and clamped conditions
+  SpMat B = nullSpaceBasis(C).sparseView(1.0, 1e-14);
 
   // ----- modal reduction -----------------------------------------------------------
-  FfrInvariants reduced = nodal.transformed(B);
   if (options_.modes > 0 || !options_.modeSet.empty()) {
-    if (Eigen::LLT<MatX>(reduced.kff).info() != Eigen::Success) reduced.validate(owner);  // names the rigid mode
-    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(reduced.kff, reduced.mff);
+    FfrInvariants reduced = nodal.transformed(B);
+    reduced.validate(owner);  // names a rigid mode left by the reference conditions
+    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(reduced.kff), MatX(reduced.mff));
     const int available = static_cast<int>(eig.eigenvalues().size());
     std::vector<int> keep;
     if (!options_.modeSet.empty()) {
@@ -175,7 +178,7 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
       }
       Phi.col(k) = eig.eigenvectors().col(keep[k] - 1);  // mass-normalised
     }
-    B = B * Phi;
+    B = (B * Phi).sparseView();
   }
   basis_ = B;
   invariants_ = nodal.transformed(B);
@@ -183,33 +186,50 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
   for (int n = 0; n < nn; ++n) {
     FfrPoint p;
     p.position = mesh_.nodes[n];
-    p.shape = basis_.middleRows(dof(n, 0), 2);
-    p.rotationShape = basis_.row(dof(n, 2));
+    p.shape = MatX(basis_.middleRows(dof(n, 0), 2));
+    p.rotationShape = MatX(basis_.row(dof(n, 2)));
     invariants_.points.push_back(p);
   }
   invariants_.validate(owner);
 }
 
 VecX FfrBeamModel::naturalFrequencies() const {
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(invariants_.kff, invariants_.mff,
+  const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(invariants_.kff), MatX(invariants_.mff),
                                                            Eigen::EigenvaluesOnly);
   return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
-Eigen::Matrix<double, 6, Eigen::Dynamic> FfrBeamModel::elementBasis(int e) const {
+FfrBeamModel::ElementBasis FfrBeamModel::elementBasis(int e) const {
   const auto& el = mesh_.elements[e];
-  Eigen::Matrix<double, 6, Eigen::Dynamic> Be(6, basis_.cols());
-  Be.topRows(3) = basis_.middleRows(dof(el.node1, 0), 3);
-  Be.bottomRows(3) = basis_.middleRows(dof(el.node2, 0), 3);
-  return Be;
+  const int rows[6] = {dof(el.node1, 0), dof(el.node1, 1), dof(el.node1, 2),
+                       dof(el.node2, 0), dof(el.node2, 1), dof(el.node2, 2)};
+  ElementBasis eb;
+  for (int r : rows) {
+    for (SpMatRow::InnerIterator it(basis_, r); it; ++it) eb.cols.push_back(static_cast<int>(it.col()));
+  }
+  std::sort(eb.cols.begin(), eb.cols.end());
+  eb.cols.erase(std::unique(eb.cols.begin(), eb.cols.end()), eb.cols.end());
+  eb.B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, eb.cols.size());
+  for (int r = 0; r < 6; ++r) {
+    for (SpMatRow::InnerIterator it(basis_, rows[r]); it; ++it) {
+      const auto k = std::lower_bound(eb.cols.begin(), eb.cols.end(), static_cast<int>(it.col())) - eb.cols.begin();
+      eb.B(r, k) = it.value();
+    }
+  }
+  return eb;
+}
+
+BeamElement2d::Vec6 FfrBeamModel::elementCoordinates(int e, const ElementBasis& eb, const VecX& qf) const {
+  VecX ql(eb.cols.size());
+  for (size_t k = 0; k < eb.cols.size(); ++k) ql[k] = qf[eb.cols[k]];
+  return elements_[e].transformation() * (eb.B * ql);
 }
 
 double FfrBeamModel::strainEnergy(const VecX& qf) const {
   if (!options_.geometricStiffening) return 0.5 * qf.dot(invariants_.kff * qf);
   double U = 0.0;
   for (size_t e = 0; e < elements_.size(); ++e) {
-    const BeamElement2d::Vec6 ee = elements_[e].transformation() * (elementBasis(e) * qf);
-    U += elements_[e].strainEnergy(ee, true);
+    U += elements_[e].strainEnergy(elementCoordinates(e, elementBasis(e), qf), true);
   }
   return U;
 }
@@ -218,24 +238,27 @@ VecX FfrBeamModel::strainEnergyGradient(const VecX& qf) const {
   if (!options_.geometricStiffening) return invariants_.kff * qf;
   VecX g = VecX::Zero(qf.size());
   for (size_t e = 0; e < elements_.size(); ++e) {
-    const auto Be = elementBasis(e);
+    const ElementBasis eb = elementBasis(e);
     const auto& T = elements_[e].transformation();
-    const BeamElement2d::Vec6 ee = T * (Be * qf);
-    g += Be.transpose() * (T.transpose() * elements_[e].strainEnergyGradient(ee, true));
+    const VecX ge = eb.B.transpose() * (T.transpose() * elements_[e].strainEnergyGradient(elementCoordinates(e, eb, qf), true));
+    for (size_t k = 0; k < eb.cols.size(); ++k) g[eb.cols[k]] += ge[k];
   }
   return g;
 }
 
-MatX FfrBeamModel::strainEnergyHessian(const VecX& qf) const {
+SpMat FfrBeamModel::strainEnergyHessian(const VecX& qf) const {
   if (!options_.geometricStiffening) return invariants_.kff;
-  MatX H = MatX::Zero(qf.size(), qf.size());
+  std::vector<Eigen::Triplet<double>> t;
   for (size_t e = 0; e < elements_.size(); ++e) {
-    const auto Be = elementBasis(e);
-    const auto& T = elements_[e].transformation();
-    const BeamElement2d::Vec6 ee = T * (Be * qf);
-    const Eigen::Matrix<double, 6, Eigen::Dynamic> TB = T * Be;
-    H += TB.transpose() * elements_[e].strainEnergyHessian(ee, true) * TB;
+    const ElementBasis eb = elementBasis(e);
+    const MatX TB = elements_[e].transformation() * eb.B;
+    const MatX He = TB.transpose() * elements_[e].strainEnergyHessian(elementCoordinates(e, eb, qf), true) * TB;
+    for (size_t j = 0; j < eb.cols.size(); ++j) {
+      for (size_t i = 0; i < eb.cols.size(); ++i) t.emplace_back(eb.cols[i], eb.cols[j], He(i, j));  // all entries: fixed structure
+    }
   }
+  SpMat H(qf.size(), qf.size());
+  H.setFromTriplets(t.begin(), t.end());
   return H;
 }
 
@@ -256,18 +279,24 @@ bool FfrBeamModel::locate(const Vec2& point, int& element, double& xi) const {
 FfrPoint FfrBeamModel::materialPoint(int e, double xi) const {
   const BeamElement2d& el = elements_.at(e);
   const Mat2 R = rotation(el.angle());
-  const Eigen::Matrix<double, 6, Eigen::Dynamic> TB = el.transformation() * elementBasis(e);
+  const ElementBasis eb = elementBasis(e);
+  const MatX TB = el.transformation() * eb.B;
   FfrPoint p;
   p.position = el.start() + R * Vec2(xi * el.length(), 0.0);
-  p.shape = R * BeamElement2d::shape(xi, el.length()) * TB;
-  p.rotationShape = BeamElement2d::slopeShape(xi, el.length()) * TB;
+  p.shape = Mat2X::Zero(2, numElastic());
+  p.rotationShape = RowVecX::Zero(numElastic());
+  const Mat2X shape = R * BeamElement2d::shape(xi, el.length()) * TB;
+  const RowVecX slope = BeamElement2d::slopeShape(xi, el.length()) * TB;
+  for (size_t k = 0; k < eb.cols.size(); ++k) {
+    p.shape.col(eb.cols[k]) = shape.col(k);
+    p.rotationShape[eb.cols[k]] = slope[k];
+  }
   return p;
 }
 
 Vec2 FfrBeamModel::sectionForces(const VecX& qf, int e, double xi) const {
   const BeamElement2d& el = elements_.at(e);
-  const BeamElement2d::Vec6 ee = el.transformation() * (elementBasis(e) * qf);
-  return el.sectionForces(ee, xi, options_.geometricStiffening);
+  return el.sectionForces(elementCoordinates(e, elementBasis(e), qf), xi, options_.geometricStiffening);
 }
 
 }  // namespace flexmbd

@@ -59,8 +59,9 @@ class FfrBeamModel {
   const BeamMesh2d& mesh() const { return mesh_; }
   const std::vector<BeamElement2d>& elements() const { return elements_; }
   bool geometricStiffening() const { return options_.geometricStiffening; }
+  using SpMatRow = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   /// Nodal displacements (ux, uy, psi per node, body frame) = basis() * q_f.
-  const MatX& basis() const { return basis_; }
+  const SpMatRow& basis() const { return basis_; }
   int numElastic() const { return static_cast<int>(basis_.cols()); }
   /// Natural frequencies (rad/s) of the body with its frame held fixed, ascending:
   /// K_ff phi = omega^2 m_ff phi.
@@ -68,7 +69,8 @@ class FfrBeamModel {
 
   double strainEnergy(const VecX& qf) const;
   VecX strainEnergyGradient(const VecX& qf) const;
-  MatX strainEnergyHessian(const VecX& qf) const;
+  /// Sparse, with the same structure for every q_f (the Jacobian pattern is fixed).
+  SpMat strainEnergyHessian(const VecX& qf) const;
 
   /// Element and local coordinate xi in [0, 1] of a body-frame point on the beam axis.
   /// @return false if no element passes within 1e-9 (relative) of the point.
@@ -79,12 +81,20 @@ class FfrBeamModel {
   Vec2 sectionForces(const VecX& qf, int element, double xi) const;
 
  private:
-  Eigen::Matrix<double, 6, Eigen::Dynamic> elementBasis(int element) const;
+  /// The rows of basis() of an element's six nodal coordinates, over the elastic
+  /// coordinates `cols` they depend on (compact, so element loops stay O(elements)).
+  struct ElementBasis {
+    std::vector<int> cols;
+    Eigen::Matrix<double, 6, Eigen::Dynamic> B;
+  };
+  ElementBasis elementBasis(int element) const;
+  /// Element nodal displacements in element axes (T B q_f).
+  BeamElement2d::Vec6 elementCoordinates(int element, const ElementBasis& eb, const VecX& qf) const;
 
   BeamMesh2d mesh_;
   FfrBeamOptions options_;
   std::vector<BeamElement2d> elements_;
-  MatX basis_;
+  SpMatRow basis_;
   FfrInvariants invariants_;
 };
 

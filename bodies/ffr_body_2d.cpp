@@ -1,5 +1,6 @@
 #include "bodies/ffr_body_2d.hpp"
 
+#include <numeric>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -69,24 +70,42 @@ VecX FfrBody2d::initialVelocities() const {
   return v;
 }
 
-MatX FfrBody2d::massMatrix(const ConstVecRef& q) const {
-  const int nf = numElastic(), n = 3 + nf;
-  const auto qf = q.tail(nf);
-  const Mat2 A = rotation(q[2]);
-  const Vec2 s = inv_.firstMoment + inv_.sBar * qf;
-  MatX M = MatX::Zero(n, n);
-  M(0, 0) = M(1, 1) = inv_.mass;
-  M.block<2, 1>(0, 2) = perp(A * s);                        // m_R theta = S A s
-  M.block(0, 3, 2, nf) = A * inv_.sBar;                     // m_Rf = A S-bar
-  M(2, 2) = inv_.polarMoment + 2.0 * inv_.i1.dot(qf) + qf.dot(inv_.mff * qf);  // m_theta theta
-  M.block(2, 3, 1, nf) = inv_.j0.transpose() + qf.transpose() * inv_.sTilde;   // m_theta f
-  M.bottomRightCorner(nf, nf) = inv_.mff;
-  M.block(3, 0, nf, 3) = M.block(0, 3, 3, nf).transpose();
-  M.block<1, 2>(2, 0) = M.block<2, 1>(0, 2).transpose();
+Eigen::Matrix3d FfrBody2d::frameMass(const ConstVecRef& q) const {
+  // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T m_ff qf
+  const auto qf = q.tail(numElastic());
+  const Vec2 sas = perp(rotation(q[2]) * (inv_.firstMoment + inv_.sBar * qf));
+  Eigen::Matrix3d M;
+  M << inv_.mass, 0.0, sas.x(),  //
+      0.0, inv_.mass, sas.y(),   //
+      sas.x(), sas.y(), inv_.polarMoment + 2.0 * inv_.i1.dot(qf) + qf.dot(inv_.mff * qf);
   return M;
 }
 
-void FfrBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, MatX& K) const {
+Eigen::Matrix<double, 3, Eigen::Dynamic> FfrBody2d::frameElasticMass(const ConstVecRef& q) const {
+  // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~
+  const int nf = numElastic();
+  Eigen::Matrix<double, 3, Eigen::Dynamic> M(3, nf);
+  M.topRows<2>() = rotation(q[2]) * inv_.sBar;
+  M.row(2) = inv_.j0.transpose() + (inv_.sTilde.transpose() * q.tail(nf)).transpose();
+  return M;
+}
+
+void FfrBody2d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
+  const auto Mrf = frameElasticMass(q);
+  M.addBlock(0, 0, frameMass(q));
+  M.addBlock(0, 3, Mrf);
+  M.addBlock(3, 0, Mrf.transpose());
+  M.addSparse(3, 3, inv_.mff);
+}
+
+void FfrBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const {
+  const int nf = numElastic();
+  const auto Mrf = frameElasticMass(q);
+  out.head<3>() += frameMass(q) * a.head<3>() + Mrf * a.tail(nf);
+  out.tail(nf) += Mrf.transpose() * a.head<3>() + inv_.mff * a.tail(nf);
+}
+
+void FfrBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, const MatrixSink& K) const {
   const int nf = numElastic();
   const auto qf = q.tail(nf);
   const Mat2 A = rotation(q[2]);
@@ -98,15 +117,15 @@ void FfrBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   const double at = a[2];
   const auto af = a.tail(nf);
   // row R: (S A s) a_t + A S-bar a_f
-  K.block<2, 1>(0, 2) += -As * at + SASb * af;
-  K.block(0, 3, 2, nf) += SASb * at;
+  K.addBlock(0, 2, Vec2(-As * at + SASb * af));
+  K.addBlock(0, 3, SASb * at);
   // row theta: (S A s)^T a_R + m_tt a_t + m_tf a_f
-  K(2, 2) += -As.dot(aR);
-  K.block(2, 3, 1, nf) += aR.transpose() * SASb + 2.0 * at * (inv_.i1 + inv_.mff * qf).transpose() +
-                          (inv_.sTilde * af).transpose();
-  // rows f: S-bar^T A^T a_R + m_ft a_t + m_ff a_f
-  K.block(3, 2, nf, 1) += SASb.transpose() * aR;
-  K.block(3, 3, nf, nf) += inv_.sTilde.transpose() * at;
+  K.add(2, 2, -As.dot(aR));
+  K.addBlock(2, 3, RowVecX(aR.transpose() * SASb + 2.0 * at * (inv_.i1 + inv_.mff * qf).transpose() +
+                           (inv_.sTilde * af).transpose()));
+  // rows f: S-bar^T A^T a_R + m_ft a_t + m_ff a_f;  d(S~^T qf a_t)/dqf = S~^T a_t = -S~ a_t
+  K.addBlock(3, 2, VecX(SASb.transpose() * aR));
+  K.addSparse(3, 3, inv_.sTilde, -at);
 }
 
 VecX FfrBody2d::elasticGradient(const VecX& qf) const {
@@ -130,8 +149,8 @@ void FfrBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   Q.tail(nf) -= elasticGradient(qf) + inv_.dff * p;
 }
 
-void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, MatX& dQdq,
-                                          MatX& dQdv) const {
+void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
+                                          const MatrixSink& dQdv) const {
   const int nf = numElastic();
   const VecX qf = q.tail(nf);
   const auto p = v.tail(nf);
@@ -144,19 +163,20 @@ void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   for (int k = 0; k < nf; ++k) SASb.col(k) = perp(ASb.col(k));
   const VecX iu = inv_.i1 + inv_.mff * qf;
   // Q_R = A s w^2 - 2 S A S-bar p w
-  dQdq.block<2, 1>(0, 2) += perp(As) * w * w + 2.0 * ASbp * w;
-  dQdq.block(0, 3, 2, nf) += ASb * w * w;
-  dQdv.block<2, 1>(0, 2) += 2.0 * As * w - 2.0 * perp(ASbp);
-  dQdv.block(0, 3, 2, nf) += -2.0 * SASb * w;
+  dQdq.addBlock(0, 2, Vec2(perp(As) * w * w + 2.0 * ASbp * w));
+  dQdq.addBlock(0, 3, ASb * w * w);
+  dQdv.addBlock(0, 2, Vec2(2.0 * As * w - 2.0 * perp(ASbp)));
+  dQdv.addBlock(0, 3, -2.0 * SASb * w);
   // Q_theta = -2 w iu^T p
-  dQdq.block(2, 3, 1, nf) += -2.0 * w * (inv_.mff * p).transpose();
-  dQdv(2, 2) += -2.0 * iu.dot(p);
-  dQdv.block(2, 3, 1, nf) += -2.0 * w * iu.transpose();
+  dQdq.addBlock(2, 3, RowVecX(-2.0 * w * (inv_.mff * p).transpose()));
+  dQdv.add(2, 2, -2.0 * iu.dot(p));
+  dQdv.addBlock(2, 3, RowVecX(-2.0 * w * iu.transpose()));
   // Q_f = w^2 iu + 2 w S~ p - dU/dqf - D p
-  const MatX Kt = model_ ? model_->strainEnergyHessian(qf) : inv_.kff;
-  dQdq.block(3, 3, nf, nf) += w * w * inv_.mff - Kt;
-  dQdv.block(3, 2, nf, 1) += 2.0 * w * iu + 2.0 * inv_.sTilde * p;
-  dQdv.block(3, 3, nf, nf) += 2.0 * w * inv_.sTilde - inv_.dff;
+  dQdq.addSparse(3, 3, inv_.mff, w * w);
+  dQdq.addSparse(3, 3, model_ ? model_->strainEnergyHessian(qf) : inv_.kff, -1.0);
+  dQdv.addBlock(3, 2, VecX(2.0 * w * iu + 2.0 * (inv_.sTilde * p)));
+  dQdv.addSparse(3, 3, inv_.sTilde, 2.0 * w);
+  dQdv.addSparse(3, 3, inv_.dff, -1.0);
 }
 
 void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const {
@@ -168,16 +188,16 @@ void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) co
   Q.tail(nf) += (A * inv_.sBar).transpose() * g;
 }
 
-void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const {
+void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const {
   const int nf = numElastic();
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * q.tail(nf));
   const Mat2X ASb = A * inv_.sBar;
   Mat2X SASb(2, nf);
   for (int k = 0; k < nf; ++k) SASb.col(k) = perp(ASb.col(k));
-  K(2, 2) += -As.dot(g);
-  K.block(2, 3, 1, nf) += g.transpose() * SASb;
-  K.block(3, 2, nf, 1) += SASb.transpose() * g;
+  K.add(2, 2, -As.dot(g));
+  K.addBlock(2, 3, RowVecX(g.transpose() * SASb));
+  K.addBlock(3, 2, VecX(SASb.transpose() * g));
 }
 
 double FfrBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
@@ -210,40 +230,72 @@ void FfrBody2d::checkAttachmentPoint(const Vec2& point, const std::string& user)
   throw InputError(os.str());
 }
 
+std::vector<int> FfrBody2d::pointSupport(const Vec2& point) const {
+  const int k = findPoint(point);
+  if (k < 0) checkAttachmentPoint(point, "attachment");
+  std::vector<int> cols = {0, 1, 2};
+  for (int e : FfrInvariants::support(inv_.points[k])) cols.push_back(3 + e);
+  return cols;
+}
+
 PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, bool withHessians) const {
   const int k = findPoint(point);
   if (k < 0) checkAttachmentPoint(point, "attachment");
   return pointKinematics(q, inv_.points[k], withHessians);
 }
 
+PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
+                                           bool withHessians) const {
+  const int k = findPoint(point);
+  if (k < 0) checkAttachmentPoint(point, "attachment");
+  return kinematicsOn(q, inv_.points[k], cols, withHessians);
+}
+
 PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint& pt, bool withHessians) const {
+  std::vector<int> all(numCoordinates());
+  std::iota(all.begin(), all.end(), 0);
+  return kinematicsOn(q, pt, all, withHessians);
+}
+
+PointKinematics FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt, const std::vector<int>& cols,
+                                        bool withHessians) const {
   // r = R + A u,  u = u0 + N qf;  dr/dtheta = S A u;  dr/dqf = A N;
   // d2r/dtheta2 = -A u;  d2r/dtheta dqf = S A N;  phi = theta + Nphi qf.
-  const int nf = numElastic(), n = 3 + nf;
+  const int nf = numElastic(), n = static_cast<int>(cols.size());
   const Mat2 A = rotation(q[2]);
   const Vec2 Au = A * (pt.position + pt.shape * q.tail(nf));
-  const Mat2X AN = A * pt.shape;
   PointKinematics p;
   p.r = q.head<2>() + Au;
   p.phi = q[2] + pt.rotationShape.dot(q.tail(nf));
   p.Jr = Mat2X::Zero(2, n);
-  p.Jr(0, 0) = p.Jr(1, 1) = 1.0;
-  p.Jr.col(2) = perp(Au);
-  p.Jr.rightCols(nf) = AN;
   p.Jphi = RowVecX::Zero(n);
-  p.Jphi[2] = 1.0;
-  p.Jphi.tail(nf) = pt.rotationShape;
+  int thetaCol = -1;
+  for (int a = 0; a < n; ++a) {
+    const int c = cols[a];
+    if (c < 2) {
+      p.Jr(c, a) = 1.0;
+    } else if (c == 2) {
+      p.Jr.col(a) = perp(Au);
+      p.Jphi[a] = 1.0;
+      thetaCol = a;
+    } else {
+      p.Jr.col(a) = A * pt.shape.col(c - 3);
+      p.Jphi[a] = pt.rotationShape[c - 3];
+    }
+  }
   if (!withHessians) return p;
   p.Hrx = MatX::Zero(n, n);
   p.Hry = MatX::Zero(n, n);
-  p.Hrx(2, 2) = -Au.x();
-  p.Hry(2, 2) = -Au.y();
-  for (int k = 0; k < nf; ++k) {
-    const Vec2 s = perp(AN.col(k));
-    p.Hrx(2, 3 + k) = p.Hrx(3 + k, 2) = s.x();
-    p.Hry(2, 3 + k) = p.Hry(3 + k, 2) = s.y();
-  }
   p.Hphi = MatX::Zero(n, n);
+  if (thetaCol < 0) return p;
+  p.Hrx(thetaCol, thetaCol) = -Au.x();
+  p.Hry(thetaCol, thetaCol) = -Au.y();
+  for (int a = 0; a < n; ++a) {
+    if (cols[a] < 3) continue;
+    const Vec2 s = perp(p.Jr.col(a));  // S A N_k
+    p.Hrx(thetaCol, a) = p.Hrx(a, thetaCol) = s.x();
+    p.Hry(thetaCol, a) = p.Hry(a, thetaCol) = s.y();
+  }
   return p;
 }
 

@@ -42,20 +42,25 @@ class FfrBody2d final : public Body {
   VecX initialCoordinates() const override;
   VecX initialVelocities() const override;
   double mass() const override { return inv_.mass; }
-  MatX massMatrix(const ConstVecRef& q) const override;
-  void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, MatX& K) const override;
+  void addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const override;
+  void addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const override;
+  void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, const MatrixSink& K) const override;
   void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
-  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, MatX& dQdq,
-                                 MatX& dQdv) const override;
+  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
+                                 const MatrixSink& dQdv) const override;
   void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
-  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const override;
   double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
   double internalPotential(const ConstVecRef& q) const override;
-  bool isDissipative() const override { return inv_.dff.cwiseAbs().maxCoeff() > 0.0; }
+  bool isDissipative() const override { return inv_.dff.nonZeros() > 0 && inv_.dff.coeffs().cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
   /// phi = theta + Nphi q_f.
   PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
                                   bool withHessians = true) const override;
+  /// The frame coordinates and the elastic coordinates the node's shape depends on.
+  std::vector<int> pointSupport(const Vec2& point) const override;
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
+                                  bool withHessians) const override;
   void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;
   /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
@@ -63,6 +68,11 @@ class FfrBody2d final : public Body {
 
  private:
   int findPoint(const Vec2& point) const;
+  /// Mass matrix blocks: frame-frame (3 x 3) and frame-elastic (3 x nf).
+  Eigen::Matrix3d frameMass(const ConstVecRef& q) const;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> frameElasticMass(const ConstVecRef& q) const;
+  PointKinematics kinematicsOn(const ConstVecRef& q, const FfrPoint& p, const std::vector<int>& cols,
+                               bool withHessians) const;
   VecX elasticGradient(const VecX& qf) const;
 
   FfrInvariants ownInvariants_;                  // given directly; empty with a model

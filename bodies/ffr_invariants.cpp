@@ -1,6 +1,7 @@
 #include "bodies/ffr_invariants.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCholesky>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -12,15 +13,38 @@ void requireSize(bool ok, const std::string& owner, const std::string& what, con
   if (!ok) throw InputError(owner + ": invariant " + what + " has the wrong size; expected " + expected);
 }
 
-void requireSymmetric(const MatX& A, const std::string& owner, const std::string& what) {
-  const double scale = A.cwiseAbs().maxCoeff() + 1e-300;
-  if ((A - A.transpose()).cwiseAbs().maxCoeff() > 1e-10 * scale) {
+double maxAbs(const SpMat& A) {
+  double m = 0.0;
+  for (int j = 0; j < A.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(A, j); it; ++it) m = std::max(m, std::abs(it.value()));
+  }
+  return m;
+}
+
+void requireSymmetric(const SpMat& A, const std::string& owner, const std::string& what) {
+  const double scale = maxAbs(A) + 1e-300;
+  if (maxAbs(SpMat(A - SpMat(A.transpose()))) > 1e-10 * scale) {
     throw InputError(owner + ": invariant " + what + " is not symmetric; expected a symmetric matrix");
+  }
+}
+
+void requireFiniteAll(const SpMat& A, const std::string& owner, const std::string& what) {
+  for (int j = 0; j < A.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(A, j); it; ++it) {
+      if (!std::isfinite(it.value())) throw InputError(owner + ": invariant " + what + " has non-finite entries");
+    }
   }
 }
 
 void requireFiniteAll(const MatX& A, const std::string& owner, const std::string& what) {
   if (!A.allFinite()) throw InputError(owner + ": invariant " + what + " has non-finite entries");
+}
+
+/// Sparse Cholesky succeeds with positive pivots: A is positive definite (a dense
+/// factorisation would cost O(n^3) for a large nodal mesh).
+bool isPositiveDefinite(const SpMat& A) {
+  const Eigen::SimplicialLDLT<SpMat> ldlt(A);
+  return ldlt.info() == Eigen::Success && ldlt.vectorD().minCoeff() > 0.0;
 }
 
 }  // namespace
@@ -39,7 +63,7 @@ void FfrInvariants::validate(const std::string& owner) const {
   requireSize(sTilde.rows() == n && sTilde.cols() == n, owner, "s_tilde", sz + " x " + sz);
   requireSize(kff.rows() == n && kff.cols() == n, owner, "k_ff", sz + " x " + sz);
   requireSize(dff.rows() == n && dff.cols() == n, owner, "d_ff", sz + " x " + sz);
-  for (auto [A, name] : {std::pair<const MatX*, const char*>{&mff, "m_ff"}, {&kff, "k_ff"}, {&dff, "d_ff"},
+  for (auto [A, name] : {std::pair<const SpMat*, const char*>{&mff, "m_ff"}, {&kff, "k_ff"}, {&dff, "d_ff"},
                          {&sTilde, "s_tilde"}}) {
     requireFiniteAll(*A, owner, name);
   }
@@ -50,21 +74,24 @@ void FfrInvariants::validate(const std::string& owner) const {
   requireSymmetric(kff, owner, "k_ff");
   requireSymmetric(dff, owner, "d_ff");
   if (n > 0) {
-    const double scale = sTilde.cwiseAbs().maxCoeff() + mff.cwiseAbs().maxCoeff();
-    if ((sTilde + sTilde.transpose()).cwiseAbs().maxCoeff() > 1e-10 * scale) {
+    const double scale = maxAbs(sTilde) + maxAbs(mff);
+    if (maxAbs(SpMat(sTilde + SpMat(sTilde.transpose()))) > 1e-10 * scale) {
       throw InputError(owner + ": invariant s_tilde is not skew-symmetric; expected S~ = -S~^T");
     }
-    if (Eigen::LLT<MatX>(mff).info() != Eigen::Success) {
+    if (!isPositiveDefinite(mff)) {
       throw InputError(owner + ": invariant m_ff is not positive definite; expected a positive definite mass matrix");
     }
-    if (Eigen::LLT<MatX>(kff).info() != Eigen::Success) {
+    if (!isPositiveDefinite(kff)) {
       throw InputError(owner +
                        ": the stiffness matrix k_ff is not positive definite: the reference conditions leave a "
                        "rigid-body mode (expected conditions that fix the body frame: pinned_pinned, clamped or "
                        "free_free)");
     }
-    const Eigen::SelfAdjointEigenSolver<MatX> ed(dff, Eigen::EigenvaluesOnly);
-    if (ed.eigenvalues().minCoeff() < -1e-10 * (dff.cwiseAbs().maxCoeff() + 1e-300)) {
+    // D_ff + eps I positive definite <=> D_ff positive semi-definite up to eps
+    SpMat shifted(n, n);
+    shifted.setIdentity();
+    shifted = dff + (1e-10 * (maxAbs(dff) + 1e-300)) * shifted;
+    if (maxAbs(dff) > 0.0 && !isPositiveDefinite(shifted)) {
       throw InputError(owner + ": invariant d_ff is not positive semi-definite; damping would add energy");
     }
   }
@@ -81,7 +108,15 @@ void FfrInvariants::validate(const std::string& owner) const {
   }
 }
 
-FfrInvariants FfrInvariants::transformed(const MatX& P) const {
+std::vector<int> FfrInvariants::support(const FfrPoint& p) {
+  std::vector<int> s;
+  for (int k = 0; k < p.shape.cols(); ++k) {
+    if (p.shape(0, k) != 0.0 || p.shape(1, k) != 0.0 || p.rotationShape[k] != 0.0) s.push_back(k);
+  }
+  return s;
+}
+
+FfrInvariants FfrInvariants::transformed(const SpMat& P) const {
   FfrInvariants r;
   r.mass = mass;
   r.firstMoment = firstMoment;
@@ -89,10 +124,11 @@ FfrInvariants FfrInvariants::transformed(const MatX& P) const {
   r.sBar = sBar * P;
   r.i1 = P.transpose() * i1;
   r.j0 = P.transpose() * j0;
-  r.mff = P.transpose() * mff * P;
-  r.sTilde = P.transpose() * sTilde * P;
-  r.kff = P.transpose() * kff * P;
-  r.dff = P.transpose() * dff * P;
+  const SpMat Pt = P.transpose();
+  r.mff = Pt * mff * P;
+  r.sTilde = Pt * sTilde * P;
+  r.kff = Pt * kff * P;
+  r.dff = Pt * dff * P;
   for (const FfrPoint& p : points) r.points.push_back({p.position, p.shape * P, p.rotationShape * P});
   return r;
 }

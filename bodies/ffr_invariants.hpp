@@ -27,10 +27,12 @@ struct FfrInvariants {
   Mat2X sBar;                           ///< S-bar = int rho N dV (2 x nf)
   VecX i1;                              ///< I1 = int rho N^T u0 dV
   VecX j0;                              ///< J0 = int rho N^T S u0 dV (S: +90 degree rotation)
-  MatX mff;                             ///< m_ff = int rho N^T N dV = S_xx + S_yy
-  MatX sTilde;                          ///< S~ = int rho N^T S^T N dV = S_xy - S_yx (skew)
-  MatX kff;                             ///< stiffness under the reference conditions
-  MatX dff;                             ///< damping
+  // Sparse: banded for nodal beam meshes (the body's cost stays linear in its size),
+  // full for modal models.
+  SpMat mff;                            ///< m_ff = int rho N^T N dV = S_xx + S_yy
+  SpMat sTilde;                         ///< S~ = int rho N^T S^T N dV = S_xy - S_yx (skew)
+  SpMat kff;                            ///< stiffness under the reference conditions
+  SpMat dff;                            ///< damping
   std::vector<FfrPoint> points;         ///< attachment points (nodes)
 
   int numElastic() const { return static_cast<int>(mff.rows()); }
@@ -39,7 +41,9 @@ struct FfrInvariants {
   /// @throws InputError naming `owner` and the offending invariant.
   void validate(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
-  FfrInvariants transformed(const MatX& P) const;
+  FfrInvariants transformed(const SpMat& P) const;
+  /// The elastic coordinates the point's shape depends on (ascending).
+  static std::vector<int> support(const FfrPoint& p);
 };
 
 }  // namespace flexmbd

@@ -13,14 +13,16 @@ class Ground final : public Body {
   VecX initialCoordinates() const override { return VecX(0); }
   VecX initialVelocities() const override { return VecX(0); }
   double mass() const override { return 0.0; }
-  MatX massMatrix(const ConstVecRef&) const override { return MatX(0, 0); }
-  void addMassMatrixDerivative(const ConstVecRef&, const ConstVecRef&, MatX&) const override {}
+  void addMassMatrix(const ConstVecRef&, const MatrixSink&) const override {}
+  void addMassTimes(const ConstVecRef&, const ConstVecRef&, Eigen::Ref<VecX>) const override {}
+  void addMassMatrixDerivative(const ConstVecRef&, const ConstVecRef&, const MatrixSink&) const override {}
   void addInternalForces(const ConstVecRef&, const ConstVecRef&, VecX&) const override {}
-  void addInternalForceJacobians(const ConstVecRef&, const ConstVecRef&, MatX&,
-                                 MatX&) const override {}
+  void addInternalForceJacobians(const ConstVecRef&, const ConstVecRef&, const MatrixSink&,
+                                 const MatrixSink&) const override {}
   void addGravityForce(const ConstVecRef&, const Vec2&, VecX&) const override {}
-  void addGravityJacobian(const ConstVecRef&, const Vec2&, MatX&) const override {}
+  void addGravityJacobian(const ConstVecRef&, const Vec2&, const MatrixSink&) const override {}
   double gravityPotential(const ConstVecRef&, const Vec2&) const override { return 0.0; }
+  using Body::pointKinematics;
   PointKinematics pointKinematics(const ConstVecRef&, const Vec2& point, bool = true) const override {
     PointKinematics p;
     p.r = point;

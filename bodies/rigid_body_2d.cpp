@@ -28,24 +28,33 @@ VecX RigidBody2d::initialVelocities() const {
   return Eigen::Vector3d(initial_.velocity.x(), initial_.velocity.y(), initial_.angularVelocity);
 }
 
-MatX RigidBody2d::massMatrix(const ConstVecRef& q) const {
-  const double m = props_.mass;
-  const Vec2 sac = perp(rotation(q[2]) * props_.com);  // S A c = dA/dtheta c
-  MatX M(3, 3);
+/// The 3 x 3 mass matrix of the frame coordinates (x, y, theta) with the COM offset c.
+static Eigen::Matrix3d rigidMassMatrix(const RigidBodyProperties& props, double theta) {
+  const double m = props.mass;
+  const Vec2 sac = perp(rotation(theta) * props.com);  // S A c = dA/dtheta c
+  Eigen::Matrix3d M;
   M << m, 0.0, m * sac.x(),                           //
       0.0, m, m * sac.y(),                            //
-      m * sac.x(), m * sac.y(), props_.inertia + m * props_.com.squaredNorm();
+      m * sac.x(), m * sac.y(), props.inertia + m * props.com.squaredNorm();
   return M;
 }
 
+void RigidBody2d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
+  M.addBlock(0, 0, rigidMassMatrix(props_, q[2]));
+}
+
+void RigidBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const {
+  out += rigidMassMatrix(props_, q[2]) * a;
+}
+
 void RigidBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
-                                          MatX& K) const {
+                                          const MatrixSink& K) const {
   // d(S A c)/dtheta = S S A c = -A c
   const double m = props_.mass;
   const Vec2 ac = rotation(q[2]) * props_.com;
-  K(0, 2) += -m * ac.x() * a[2];
-  K(1, 2) += -m * ac.y() * a[2];
-  K(2, 2) += -m * ac.dot(a.head<2>());
+  K.add(0, 2, -m * ac.x() * a[2]);
+  K.add(1, 2, -m * ac.y() * a[2]);
+  K.add(2, 2, -m * ac.dot(a.head<2>()));
 }
 
 void RigidBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const {
@@ -56,11 +65,11 @@ void RigidBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, 
 }
 
 void RigidBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v,
-                                            MatX& dQdq, MatX& dQdv) const {
+                                            const MatrixSink& dQdq, const MatrixSink& dQdv) const {
   const Vec2 ac = rotation(q[2]) * props_.com;
   const double m = props_.mass;
-  dQdq.block<2, 1>(0, 2) += m * perp(ac) * v[2] * v[2];
-  dQdv.block<2, 1>(0, 2) += 2.0 * m * ac * v[2];
+  dQdq.addBlock(0, 2, m * perp(ac) * v[2] * v[2]);
+  dQdv.addBlock(0, 2, 2.0 * m * ac * v[2]);
 }
 
 void RigidBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const {
@@ -69,8 +78,8 @@ void RigidBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) 
   Q[2] += m * perp(rotation(q[2]) * props_.com).dot(g);
 }
 
-void RigidBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const {
-  K(2, 2) += -props_.mass * (rotation(q[2]) * props_.com).dot(g);
+void RigidBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const {
+  K.add(2, 2, -props_.mass * (rotation(q[2]) * props_.com).dot(g));
 }
 
 double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {

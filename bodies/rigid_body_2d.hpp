@@ -38,15 +38,17 @@ class RigidBody2d final : public Body {
   double inertia() const { return props_.inertia; }
   const Vec2& com() const { return props_.com; }
 
-  MatX massMatrix(const ConstVecRef& q) const override;
+  void addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const override;
+  void addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const override;
   void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
-                               MatX& K) const override;
+                               const MatrixSink& K) const override;
   void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
-  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, MatX& dQdq,
-                                 MatX& dQdv) const override;
+  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
+                                 const MatrixSink& dQdv) const override;
   void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
-  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const override;
   double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
+  using Body::pointKinematics;
   PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
                                   bool withHessians = true) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;

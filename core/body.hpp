@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/matrix_sink.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
@@ -48,32 +49,48 @@ class Body {
 
   /// Total mass (for checks and the Newton-Euler balance).
   virtual double mass() const = 0;
-  /// Mass matrix M(q), n x n, symmetric positive definite.
-  virtual MatX massMatrix(const ConstVecRef& q) const = 0;
+  /// M += mass matrix M(q) (n x n, symmetric positive definite), structural non-zeros only.
+  virtual void addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const = 0;
+  /// out += M(q) a (the residual's inertia term, without forming M).
+  virtual void addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const = 0;
   /// K += d(M(q) a)/dq for a fixed vector a (n x n).
   virtual void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
-                                       MatX& K) const = 0;
+                                       const MatrixSink& K) const = 0;
   /// Q += internal generalised forces: quadratic velocity forces (and, for flexible
   /// bodies, elastic and damping forces).
   virtual void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const = 0;
   /// dQdq += d(internal forces)/dq, dQdv += d(internal forces)/dv.
   virtual void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v,
-                                         MatX& dQdq, MatX& dQdv) const = 0;
+                                         const MatrixSink& dQdq, const MatrixSink& dQdv) const = 0;
   /// Q += generalised gravity force for the acceleration of gravity g.
   virtual void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const = 0;
   /// K += d(gravity force)/dq.
-  virtual void addGravityJacobian(const ConstVecRef& q, const Vec2& g, MatX& K) const = 0;
+  virtual void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const = 0;
+  /// Dense mass matrix (small systems, outputs and tests).
+  MatX massMatrix(const ConstVecRef& q) const {
+    MatX M = MatX::Zero(numCoordinates(), numCoordinates());
+    addMassMatrix(q, M);
+    return M;
+  }
   /// Potential energy of gravity (zero at the world origin) and internal (elastic) energy.
   virtual double gravityPotential(const ConstVecRef& q, const Vec2& g) const = 0;
   virtual double internalPotential(const ConstVecRef& q) const { (void)q; return 0.0; }
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 
-  /// Kinematics of the material point with body-frame coordinates `point`; the
-  /// Hessians (Hrx, Hry, Hphi) only if withHessians (Jacobian assembly), else left empty.
+  /// Kinematics of the material point with body-frame coordinates `point`, over all n
+  /// coordinates; the Hessians (Hrx, Hry, Hphi) only if withHessians, else left empty.
   /// @throws InputError if the body has no material point there.
   virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
                                           bool withHessians = true) const = 0;
+  /// The body coordinates the kinematics of `point` depend on (ascending). Default: all.
+  virtual std::vector<int> pointSupport(const Vec2& point) const;
+  /// The same kinematics over the coordinates `cols` only (ascending, a superset of
+  /// pointSupport(point)): Jr is 2 x cols.size(), and so on. Joints on large flexible
+  /// bodies use this, so their Jacobians do not grow with the body. Default: selects
+  /// the columns of the full kinematics.
+  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
+                                          bool withHessians) const;
   /// Checks at model build time that `point` is a valid attachment point.
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
     (void)point; (void)user;

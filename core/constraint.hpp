@@ -1,6 +1,7 @@
 // The interface of constraints: joints (scleronomic) and drivers (rheonomic).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -9,15 +10,25 @@
 
 namespace flexmbd {
 
-/// A body together with its current coordinates (a view, nothing is copied).
+/// A body together with its current coordinates (a view, nothing is copied) and the
+/// coordinates a constraint or force uses of it (`cols`, ascending; null: all).
+/// Derivatives are taken with respect to the used coordinates only.
 struct BodyState {
-  BodyState(const Body& b, const double* data) : body(b), q(data, b.numCoordinates()) {}
+  BodyState(const Body& b, const double* data, const std::vector<int>* used = nullptr)
+      : body(b), q(data, b.numCoordinates()), cols(used) {}
   const Body& body;
   Eigen::Map<const VecX> q;
+  const std::vector<int>* cols;
+  /// Number of used coordinates.
+  int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numCoordinates(); }
+  /// Kinematics of a body point over the used coordinates.
+  PointKinematics point(const Vec2& p, bool withHessians) const {
+    return cols ? body.pointKinematics(q, p, *cols, withHessians) : body.pointKinematics(q, p, withHessians);
+  }
 };
 
 /// Constraint equations g(q, t) = h(q) - f(t) = 0 over the local coordinates
-/// q_local = [q_body0; q_body1; ...] of the constraint's bodies.
+/// q_local = [used coordinates of body 0; of body 1; ...] of the constraint's bodies.
 struct ConstraintEvaluation {
   VecX h;               ///< h(q), m
   MatX G;               ///< dh/dq, m x n_local
@@ -38,6 +49,13 @@ class Constraint {
 
   /// Body points the constraint attaches to (checked by System::finalize()).
   virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
+  /// The coordinates of bodies()[slot] that h depends on (ascending), if the
+  /// constraint knows them better than System::finalize(), which takes the union of
+  /// the supports of the attachment points on that body, or all of its coordinates.
+  virtual std::optional<std::vector<int>> coordinatesUsed(int slot) const {
+    (void)slot;
+    return std::nullopt;
+  }
 
   virtual int numEquations() const = 0;
   /// "revolute", "prismatic", "fixed", "body_coordinate", "joint_angle", ...

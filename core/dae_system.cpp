@@ -27,17 +27,6 @@ std::vector<int> range(int start, int n) {
   return r;
 }
 
-/// Body states of a constraint's bodies laid out consecutively in a local vector.
-std::vector<BodyState> localStates(const System& sys, const Constraint& con, const VecX& ql) {
-  std::vector<BodyState> states;
-  int off = 0;
-  for (BodyIndex b : con.bodies()) {
-    states.emplace_back(sys.body(b), ql.data() + off);
-    off += sys.body(b).numCoordinates();
-  }
-  return states;
-}
-
 }  // namespace
 
 std::string toString(Formulation f) {
@@ -86,6 +75,14 @@ VecX DaeSystem::differentialIds() const {
   return id;
 }
 
+std::vector<int64_t> DaeSystem::eliminationGroups() const {
+  const DaeLayout& L = layout_;
+  std::vector<int64_t> groups(L.size, 0);
+  for (int k = 2 * L.nq; k < L.size; ++k) groups[k] = 1;
+  for (int f : sys_.frameCoordinates()) groups[L.q + f] = groups[L.v + f] = 1;
+  return groups;
+}
+
 void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const VecX& lambda,
                           VecX& y, VecX& yp) const {
   const DaeLayout& L = layout_;
@@ -114,14 +111,15 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F)
     VecX Qb = VecX::Zero(nb);
     body.addInternalForces(qb, v.segment(off, nb), Qb);
     body.addGravityForce(qb, sys.gravity(), Qb);
-    Fv.segment(off, nb) += body.massMatrix(qb) * vp.segment(off, nb) - Qb;
+    Fv.segment(off, nb) -= Qb;
+    body.addMassTimes(qb, vp.segment(off, nb), Fv.segment(off, nb));
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
     const Force& force = sys.force(fi);
     const auto& cols = sys.forceColumns(fi);
     VecX Ql = VecX::Zero(cols.size());
-    force.addForce(t, sys.bodyStates(force.bodies(), q.data()), gather(cols, v.data()), Ql,
+    force.addForce(t, sys.forceStates(fi, q.data()), gather(cols, v.data()), Ql,
                    nullptr, nullptr);
     for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] -= Ql[k];
   }
@@ -133,7 +131,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F)
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
     const int row = sys.constraintOffset(ci), me = con.numEquations();
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), needH, ev);
+    con.evaluate(sys.constraintStates(ci, q.data()), needH, ev);
     con.timeFunction(t, f, df, ddf);
     const VecX GtLambda = ev.G.transpose() * ConstMap(y + L.lambda + row, me);
     for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] += GtLambda[k];
@@ -177,13 +175,13 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
     if (nb == 0) continue;
     const int off = sys.coordinateOffset(BodyIndex(b));
     const auto qb = q.segment(off, nb);
-    MatX Kq = MatX::Zero(nb, nb), dQdq = MatX::Zero(nb, nb), dQdv = MatX::Zero(nb, nb);
-    body.addMassMatrixDerivative(qb, vp.segment(off, nb), Kq);
-    body.addInternalForceJacobians(qb, v.segment(off, nb), dQdq, dQdv);
-    body.addGravityJacobian(qb, sys.gravity(), dQdq);
-    const std::vector<int> idx = range(off, nb);
-    addBlock(J, L.v, idx, L.q, idx, Kq - dQdq);
-    addBlock(J, L.v, idx, L.v, idx, cj * body.massMatrix(qb) - dQdv);
+    // each body writes its structural non-zeros only (sparse for large flexible bodies)
+    const MatrixSink Jq(J, L.v + off, L.q + off), minusJq(J, L.v + off, L.q + off, -1.0);
+    const MatrixSink cjM(J, L.v + off, L.v + off, cj), minusJv(J, L.v + off, L.v + off, -1.0);
+    body.addMassMatrixDerivative(qb, vp.segment(off, nb), Jq);
+    body.addInternalForceJacobians(qb, v.segment(off, nb), minusJq, minusJv);
+    body.addGravityJacobian(qb, sys.gravity(), minusJq);
+    body.addMassMatrix(qb, cjM);
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
@@ -192,7 +190,7 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
     const int nl = static_cast<int>(cols.size());
     VecX Ql = VecX::Zero(nl);
     MatX dQdq = MatX::Zero(nl, nl), dQdv = MatX::Zero(nl, nl);
-    force.addForce(t, sys.bodyStates(force.bodies(), q.data()), gather(cols, v.data()), Ql, &dQdq,
+    force.addForce(t, sys.forceStates(fi, q.data()), gather(cols, v.data()), Ql, &dQdq,
                    &dQdv);
     addBlock(J, L.v, cols, L.q, cols, -dQdq);
     addBlock(J, L.v, cols, L.v, cols, -dQdv);
@@ -206,7 +204,7 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
     const int nl = static_cast<int>(cols.size());
     const int row = sys.constraintOffset(ci), me = con.numEquations();
     const std::vector<int> rows = range(row, me);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), true, ev);
+    con.evaluate(sys.constraintStates(ci, q.data()), true, ev);
     const VecX vl = gather(cols, v.data());
     const MatX Gt = ev.G.transpose();
     // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
@@ -237,15 +235,16 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
         const VecX al = gather(cols, vp.data());
         MatX dFdq(me, nl);
         for (int a = 0; a < me; ++a) dFdq.row(a) = al.transpose() * ev.H[a];
-        const VecX ql = gather(cols, q.data());
+        VecX qp = q, qm = q;
         ConstraintEvaluation ep, em;
         for (int k = 0; k < nl; ++k) {
-          const double h = 1e-6 * (1.0 + std::abs(ql[k]));
-          VecX qp = ql, qm = ql;
-          qp[k] += h;
-          qm[k] -= h;
-          con.evaluate(localStates(sys, con, qp), true, ep);
-          con.evaluate(localStates(sys, con, qm), true, em);
+          const int c = cols[k];
+          const double h = 1e-6 * (1.0 + std::abs(q[c]));
+          qp[c] = q[c] + h;
+          qm[c] = q[c] - h;
+          con.evaluate(sys.constraintStates(ci, qp.data()), true, ep);
+          con.evaluate(sys.constraintStates(ci, qm.data()), true, em);
+          qp[c] = qm[c] = q[c];
           for (int a = 0; a < me; ++a) {
             dFdq(a, k) += (vl.dot(ep.H[a] * vl) - vl.dot(em.H[a] * vl)) / (2.0 * h);
           }

@@ -2,7 +2,9 @@
 // dF/dy + cj dF/dy', assembled from the components of a finalized System.
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/sparse_pattern.hpp"
 #include "core/system.hpp"
@@ -49,6 +51,11 @@ class DaeSystem {
 
   void residual(double t, const double* y, const double* yp, double* F) const;
   void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const;
+
+  /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
+  /// the positions and velocities of elastic coordinates, 1 for frame coordinates
+  /// (coupled to their whole body) and multipliers (zero diagonal), to be eliminated last.
+  std::vector<int64_t> eliminationGroups() const;
 
   /// y and y' from positions, velocities, accelerations and multipliers (mu = 0).
   void packState(const VecX& q, const VecX& v, const VecX& a, const VecX& lambda, VecX& y,

@@ -9,7 +9,7 @@
 namespace flexmbd {
 
 /// A force element adds generalised forces Q(t, q, v) over the local coordinates of
-/// its bodies, q_local = [q_body0; q_body1; ...].
+/// its bodies, q_local = [used coordinates of body 0; of body 1; ...] (see BodyState).
 class Force {
  public:
   Force(std::string name, std::vector<BodyIndex> bodies)

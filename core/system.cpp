@@ -1,6 +1,9 @@
 #include "core/system.hpp"
 
+#include <functional>
+#include <optional>
 #include <set>
+
 
 #include "bodies/ground.hpp"
 #include "bodies/rigid_body_2d.hpp"
@@ -221,23 +224,55 @@ void System::finalize() {
     bodyOffset_.push_back(nq_);
     nq_ += b->numCoordinates();
   }
-  auto columns = [&](const std::vector<BodyIndex>& bs) {
+  // Coordinates used of each body: the union of the supports of the attachment points
+  // on it (a joint on a node of a large flexible body uses only the frame and that
+  // node's coordinates), all of them if nothing is attached there.
+  auto usedCoordinates = [&](const std::vector<BodyIndex>& bs,
+                             const std::vector<std::pair<BodyIndex, Vec2>>& attachments,
+                             const std::function<std::optional<std::vector<int>>(int)>& declared) {
+    std::vector<std::vector<int>> used;
+    for (size_t slot = 0; slot < bs.size(); ++slot) {
+      if (auto d = declared(static_cast<int>(slot))) {
+        used.push_back(*d);
+        continue;
+      }
+      std::set<int> cols;
+      bool attached = false;
+      for (const auto& [b, p] : attachments) {
+        if (b != bs[slot]) continue;
+        attached = true;
+        for (int c : body(b).pointSupport(p)) cols.insert(c);
+      }
+      if (!attached) {
+        for (int k = 0; k < body(bs[slot]).numCoordinates(); ++k) cols.insert(k);
+      }
+      used.emplace_back(cols.begin(), cols.end());
+    }
+    return used;
+  };
+  auto globalColumns = [&](const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used) {
     std::vector<int> cols;
-    for (BodyIndex b : bs) {
-      for (int k = 0; k < body(b).numCoordinates(); ++k) cols.push_back(bodyOffset_[b.value] + k);
+    for (size_t slot = 0; slot < bs.size(); ++slot) {
+      for (int k : used[slot]) cols.push_back(bodyOffset_[bs[slot].value] + k);
     }
     return cols;
   };
   m_ = 0;
   constraintOffset_.clear();
   constraintCols_.clear();
+  constraintUsed_.clear();
   for (const auto& c : constraints_) {
     constraintOffset_.push_back(m_);
     m_ += c->numEquations();
-    constraintCols_.push_back(columns(c->bodies()));
+    constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), [&](int slot) { return c->coordinatesUsed(slot); }));
+    constraintCols_.push_back(globalColumns(c->bodies(), constraintUsed_.back()));
   }
   forceCols_.clear();
-  for (const auto& f : forces_) forceCols_.push_back(columns(f->bodies()));
+  forceUsed_.clear();
+  for (const auto& f : forces_) {
+    forceUsed_.push_back(usedCoordinates(f->bodies(), f->attachments(), [](int) { return std::nullopt; }));
+    forceCols_.push_back(globalColumns(f->bodies(), forceUsed_.back()));
+  }
   finalized_ = true;
 }
 
@@ -259,11 +294,22 @@ VecX System::initialVelocities() const {
   return v;
 }
 
-std::vector<BodyState> System::bodyStates(const std::vector<BodyIndex>& bs, const double* q) const {
+std::vector<BodyState> System::states(const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
+                                      const double* q) const {
   std::vector<BodyState> out;
   out.reserve(bs.size());
-  for (BodyIndex b : bs) out.emplace_back(body(b), q + bodyOffset_[b.value]);
+  for (size_t slot = 0; slot < bs.size(); ++slot) {
+    out.emplace_back(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot]);
+  }
   return out;
+}
+
+std::vector<BodyState> System::constraintStates(ConstraintIndex i, const double* q) const {
+  return states(constraint(i).bodies(), constraintUsed_.at(i.value), q);
+}
+
+std::vector<BodyState> System::forceStates(ForceIndex i, const double* q) const {
+  return states(force(i).bodies(), forceUsed_.at(i.value), q);
 }
 
 std::vector<int> System::frameCoordinates() const {

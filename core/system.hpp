@@ -78,14 +78,17 @@ class System {
   int numConstraintEquations() const { return m_; }
   int coordinateOffset(BodyIndex i) const { return bodyOffset_.at(i.value); }
   int constraintOffset(ConstraintIndex i) const { return constraintOffset_.at(i.value); }
-  /// Global coordinate index of each local coordinate of a constraint / force.
+  /// Global coordinate index of each local coordinate of a constraint / force: the
+  /// coordinates it uses of each of its bodies (see Constraint::coordinatesUsed).
   const std::vector<int>& constraintColumns(ConstraintIndex i) const { return constraintCols_.at(i.value); }
   const std::vector<int>& forceColumns(ForceIndex i) const { return forceCols_.at(i.value); }
   /// Coordinates and velocities given at construction, stacked (nq).
   VecX initialCoordinates() const;
   VecX initialVelocities() const;
-  /// Views of the given bodies at the global coordinates q (size nq).
-  std::vector<BodyState> bodyStates(const std::vector<BodyIndex>& bodies, const double* q) const;
+  /// Views of a constraint's / force's bodies at the global coordinates q (size nq),
+  /// restricted to the coordinates it uses.
+  std::vector<BodyState> constraintStates(ConstraintIndex i, const double* q) const;
+  std::vector<BodyState> forceStates(ForceIndex i, const double* q) const;
   /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
   std::vector<int> frameCoordinates() const;
   /// "crank.x", ... for every coordinate, in order.
@@ -107,6 +110,10 @@ class System {
   int nq_ = 0, m_ = 0;
   std::vector<int> bodyOffset_, constraintOffset_;
   std::vector<std::vector<int>> constraintCols_, forceCols_;
+  // per constraint / force, per body slot: the body-local coordinates used
+  std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_;
+  std::vector<BodyState> states(const std::vector<BodyIndex>& bodies,
+                                const std::vector<std::vector<int>>& used, const double* q) const;
 };
 
 }  // namespace flexmbd

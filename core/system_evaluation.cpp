@@ -17,7 +17,7 @@ void forEachConstraint(const System& sys, const VecX& q, double t, bool withHess
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), withHessians, ev);
+    con.evaluate(sys.constraintStates(ci, q.data()), withHessians, ev);
     con.timeFunction(t, f, df, ddf);
     fn(ci, con, ev, f, df, ddf);
   }
@@ -90,14 +90,20 @@ VecX generalizedForces(const System& sys, double t, const VecX& q, const VecX& v
     const Force& force = sys.force(fi);
     const auto& cols = sys.forceColumns(fi);
     VecX Ql = VecX::Zero(cols.size());
-    force.addForce(t, sys.bodyStates(force.bodies(), q.data()), gather(cols, v), Ql, nullptr, nullptr);
+    force.addForce(t, sys.forceStates(fi, q.data()), gather(cols, v), Ql, nullptr, nullptr);
     for (size_t k = 0; k < cols.size(); ++k) Q[cols[k]] += Ql[k];
   }
   return Q;
 }
 
 double kineticEnergy(const System& sys, const VecX& q, const VecX& v) {
-  return 0.5 * v.dot(massMatrix(sys, q) * v);
+  VecX Mv = VecX::Zero(v.size());
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int off = sys.coordinateOffset(BodyIndex(b)), nb = body.numCoordinates();
+    body.addMassTimes(q.segment(off, nb), v.segment(off, nb), Mv.segment(off, nb));
+  }
+  return 0.5 * v.dot(Mv);
 }
 
 double potentialEnergy(const System& sys, const VecX& q) {
@@ -110,8 +116,8 @@ double potentialEnergy(const System& sys, const VecX& q) {
     V += body.gravityPotential(qb, sys.gravity()) + body.internalPotential(qb);
   }
   for (int f = 0; f < sys.numForces(); ++f) {
-    const Force& force = sys.force(ForceIndex(f));
-    V += force.potentialEnergy(sys.bodyStates(force.bodies(), q.data()));
+    const ForceIndex fi(f);
+    V += sys.force(fi).potentialEnergy(sys.forceStates(fi, q.data()));
   }
   return V;
 }
@@ -134,7 +140,7 @@ VecX reactionOutputs(const System& sys, const VecX& q, const VecX& lambda) {
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
-    const VecX r = con.reactions(sys.bodyStates(con.bodies(), q.data()),
+    const VecX r = con.reactions(sys.constraintStates(ci, q.data()),
                                  lambda.segment(sys.constraintOffset(ci), con.numEquations()));
     out.insert(out.end(), r.data(), r.data() + r.size());
   }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <cmath>
 #include <string>
 
@@ -14,6 +15,7 @@ using MatX = Eigen::MatrixXd;
 using RowVecX = Eigen::RowVectorXd;
 using Mat2X = Eigen::Matrix<double, 2, Eigen::Dynamic>;
 using ConstVecRef = Eigen::Ref<const VecX>;
+using SpMat = Eigen::SparseMatrix<double>;  ///< column-major sparse matrix
 
 /// Planar rotation matrix A(theta).
 inline Mat2 rotation(double theta) {

@@ -17,7 +17,7 @@ AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, Ti
 
 void AppliedLoad::addForce(double t, const std::vector<BodyState>& b, const VecX&, VecX& Q,
                            MatX* dQdq, MatX*) const {
-  const PointKinematics p = b[0].body.pointKinematics(b[0].q, point_, dQdq != nullptr);
+  const PointKinematics p = b[0].point(point_, dQdq != nullptr);
   const Vec2 F(forceX_ ? forceX_->evaluate(t).f : 0.0, forceY_ ? forceY_->evaluate(t).f : 0.0);
   const double tau = torque_ ? torque_->evaluate(t).f : 0.0;
   Q += p.Jr.transpose() * F + tau * p.Jphi.transpose();

@@ -26,8 +26,8 @@ RotationalSpringDamper::RotationalSpringDamper(std::string name, BodyIndex bodyI
 void RotationalSpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v,
                                       VecX& Q, MatX* dQdq, MatX* dQdv) const {
   const bool withHessians = dQdq != nullptr;
-  const PointPair p = makePointPair(b[0].body.pointKinematics(b[0].q, pointI_, withHessians),
-                                    b[1].body.pointKinematics(b[1].q, pointJ_, withHessians), withHessians);
+  const PointPair p = makePointPair(b[0].point(pointI_, withHessians),
+                                    b[1].point(pointJ_, withHessians), withHessians);
   const RowVecX J = p.JphiJ - p.JphiI;
   const double phi = p.phiJ - p.phiI;
   const double tau = stiffness_ * (phi - freeAngle_) + damping_ * J.dot(v);
@@ -40,8 +40,8 @@ void RotationalSpringDamper::addForce(double, const std::vector<BodyState>& b, c
 }
 
 double RotationalSpringDamper::potentialEnergy(const std::vector<BodyState>& b) const {
-  const double phi = b[1].body.pointKinematics(b[1].q, pointJ_, false).phi -
-                     b[0].body.pointKinematics(b[0].q, pointI_, false).phi;
+  const double phi = b[1].point(pointJ_, false).phi -
+                     b[0].point(pointI_, false).phi;
   return 0.5 * stiffness_ * (phi - freeAngle_) * (phi - freeAngle_);
 }
 

@@ -29,15 +29,15 @@ SpringDamper::SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI
 }
 
 double SpringDamper::length(const std::vector<BodyState>& b) const {
-  return (b[1].body.pointKinematics(b[1].q, pointJ_, false).r - b[0].body.pointKinematics(b[0].q, pointI_, false).r)
+  return (b[1].point(pointJ_, false).r - b[0].point(pointI_, false).r)
       .norm();
 }
 
 void SpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v, VecX& Q,
                             MatX* dQdq, MatX* dQdv) const {
   const bool withHessians = dQdq != nullptr;
-  const PointPair p = makePointPair(b[0].body.pointKinematics(b[0].q, pointI_, withHessians),
-                                    b[1].body.pointKinematics(b[1].q, pointJ_, withHessians), withHessians);
+  const PointPair p = makePointPair(b[0].point(pointI_, withHessians),
+                                    b[1].point(pointJ_, withHessians), withHessians);
   const double l = p.d.norm();
   if (!(l > 1e-12)) {
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");

@@ -174,8 +174,8 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
   inv.mass = iv.positive("mass");
   inv.firstMoment = iv.vec2("first_moment");
   inv.polarMoment = iv.positive("polar_moment");
-  inv.mff = iv.matrix("m_ff");
-  const int nf = static_cast<int>(inv.mff.rows());
+  const MatX mff = iv.matrix("m_ff");
+  const int nf = static_cast<int>(mff.rows());
   const auto sized = [&](MatX m, const char* key, int rows, int cols) {
     if (m.rows() != rows || m.cols() != cols) {
       iv.fail("key " + inQuotes(key) + " must be a " + std::to_string(rows) + " x " + std::to_string(cols) +
@@ -184,13 +184,13 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
     }
     return m;
   };
-  inv.mff = sized(inv.mff, "m_ff", nf, nf);
+  inv.mff = sized(mff, "m_ff", nf, nf).sparseView(1.0, 0.0);
   inv.sBar = sized(iv.matrix("s_bar"), "s_bar", 2, nf);
   inv.i1 = sized(iv.vector("i1"), "i1", nf, 1);
   inv.j0 = sized(iv.vector("j0"), "j0", nf, 1);
-  inv.sTilde = sized(iv.matrix("s_tilde"), "s_tilde", nf, nf);
-  inv.kff = sized(iv.matrix("k_ff"), "k_ff", nf, nf);
-  inv.dff = iv.has("d_ff") ? sized(iv.matrix("d_ff"), "d_ff", nf, nf) : MatX::Zero(nf, nf);
+  inv.sTilde = sized(iv.matrix("s_tilde"), "s_tilde", nf, nf).sparseView(1.0, 0.0);
+  inv.kff = sized(iv.matrix("k_ff"), "k_ff", nf, nf).sparseView(1.0, 0.0);
+  inv.dff = (iv.has("d_ff") ? sized(iv.matrix("d_ff"), "d_ff", nf, nf) : MatX::Zero(nf, nf)).sparseView(1.0, 0.0);
   const json& pts = iv.array("points");
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const ObjectReader p(pts[k], iv.where() + ": points[" + std::to_string(k) + "]");

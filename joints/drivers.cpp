@@ -10,11 +10,10 @@ BodyCoordinateDriver::BodyCoordinateDriver(std::string name, BodyIndex body, int
 
 void BodyCoordinateDriver::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
                                     ConstraintEvaluation& out) const {
-  const int n = bodies[0].body.numCoordinates();
+  // local coordinates: only q_k (coordinatesUsed)
   out.h = VecX::Constant(1, bodies[0].q[coordinate_]);
-  out.G = MatX::Zero(1, n);
-  out.G(0, coordinate_) = 1.0;
-  if (withHessians) out.H = {MatX::Zero(n, n)};
+  out.G = MatX::Ones(1, 1);
+  if (withHessians) out.H = {MatX::Zero(1, 1)};
 }
 
 JointAngleDriver::JointAngleDriver(std::string name, BodyIndex bodyI, const Vec2& pointI,

@@ -41,6 +41,7 @@ class BodyCoordinateDriver final : public LawDriver<Constraint> {
   BodyCoordinateDriver(std::string name, BodyIndex body, int coordinate, std::string coordinateName,
                        TimeLawPtr law);
   std::string typeName() const override { return "body_" + coordinateName_; }
+  std::optional<std::vector<int>> coordinatesUsed(int) const override { return std::vector<int>{coordinate_}; }
   void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
                 ConstraintEvaluation& out) const override;
 

@@ -64,8 +64,8 @@ TwoPointConstraint::TwoPointConstraint(std::string name, BodyIndex bodyI, const 
 }
 
 PointPair TwoPointConstraint::pair(const std::vector<BodyState>& bodies, bool withHessians) const {
-  return makePointPair(bodies[0].body.pointKinematics(bodies[0].q, pointI_, withHessians),
-                       bodies[1].body.pointKinematics(bodies[1].q, pointJ_, withHessians), withHessians);
+  return makePointPair(bodies[0].point(pointI_, withHessians),
+                       bodies[1].point(pointJ_, withHessians), withHessians);
 }
 
 }  // namespace flexmbd

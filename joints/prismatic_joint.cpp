@@ -33,7 +33,7 @@ void PrismaticJoint::evaluate(const std::vector<BodyState>& bodies, bool withHes
 }
 
 VecX PrismaticJoint::reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const {
-  const double phiI = bodies[0].body.pointKinematics(bodies[0].q, pointI(), false).phi;
+  const double phiI = bodies[0].point(pointI(), false).phi;
   const Vec2 n = rotation(phiI) * perp(axis_);
   const Vec2 f = -lambda[0] * n;
   return Eigen::Vector3d(f.x(), f.y(), -lambda[1]);

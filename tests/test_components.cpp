@@ -205,11 +205,11 @@ TEST(ConstraintValues, RevoluteJointVanishesWhenAssembled) {
     q.segment(sys.coordinateOffset(b), 3) = Eigen::Vector3d(Rb.x(), Rb.y(), thB);
     ConstraintEvaluation ev;
     const Constraint& hinge = sys.constraint(ab);
-    hinge.evaluate(sys.bodyStates(hinge.bodies(), q.data()), false, ev);
+    hinge.evaluate(sys.constraintStates(ab, q.data()), false, ev);
     EXPECT_LT(ev.h.norm(), kRoundoffTol * 10.0) << "sample " << s << ": h = " << ev.h.transpose();
     // the ground pin is satisfied only if the ground point is where b's point is
     const Constraint& pin = sys.constraint(gb);
-    pin.evaluate(sys.bodyStates(pin.bodies(), q.data()), false, ev);
+    pin.evaluate(sys.constraintStates(gb, q.data()), false, ev);
     EXPECT_NEAR((ev.h - (P - ug)).norm(), 0.0, kRoundoffTol * 10.0) << "sample " << s;
   }
 }
@@ -247,7 +247,7 @@ TEST(ConstraintValues, PrismaticNormalEquationIsSignedDistanceToAxisLine) {
         q.segment(sys.coordinateOffset(b), 3) = Eigen::Vector3d(Rb.x(), Rb.y(), thB);
         ConstraintEvaluation ev;
         const Constraint& con = sys.constraint(ci);
-        con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
+        con.evaluate(sys.constraintStates(ci, q.data()), false, ev);
         // hand-computed signed distance of P_j from the line through P_i along a_w
         const Vec2 d = Pj - Pi;
         const double distance = (aw.x() * d.y() - aw.y() * d.x()) / aw.norm();
@@ -284,7 +284,7 @@ TEST(ConstraintValues, JointDisplacementDriverIsProjectionOnRotatingAxis) {
     const Vec2 aw = rotate(qa[2], axis) / axis.norm();
     ConstraintEvaluation ev;
     const Constraint& con = sys.constraint(ci);
-    con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev);
+    con.evaluate(sys.constraintStates(ci, q.data()), false, ev);
     EXPECT_NEAR(ev.h[0], aw.dot(d), kRoundoffTol * 10.0) << "sample " << s;
     // g = h - f(t) through the whole-system evaluation
     const double t = rnd.uniform(0.0, 3.0);

@@ -323,7 +323,11 @@ struct RodInertia {
   }
 };
 
-void checkInvariantProperties(const FfrInvariants& inv, const std::string& what) {
+void checkInvariantProperties(const FfrInvariants& sparse, const std::string& what) {
+  struct {
+    MatX mff, sTilde, kff;
+    int numElastic() const { return static_cast<int>(mff.rows()); }
+  } inv{MatX(sparse.mff), MatX(sparse.sTilde), MatX(sparse.kff)};
   const double mscale = inv.mff.cwiseAbs().maxCoeff();
   EXPECT_LE((inv.mff - inv.mff.transpose()).cwiseAbs().maxCoeff(), kSymmetryTol * mscale) << what << ": m_ff symmetric";
   const Eigen::SelfAdjointEigenSolver<MatX> es(inv.mff, Eigen::EigenvaluesOnly);
@@ -571,6 +575,28 @@ TEST(FfrBody2d, DerivativesMatchFiniteDifferences) {
         const Vec2 u = node + nm.model->basis().middleRows(3 * k, 2) * q.tail(nf);
         expectMatrixNear(pk.r, Vec2(q.head<2>() + rotation(q[2]) * u), 1e-14, where + ": r", 1.0);
         EXPECT_NEAR(pk.phi, q[2] + nm.model->basis().row(3 * k + 2).dot(q.tail(nf)), 1e-14) << where;
+        // over the node's support (what joints use): the same entries, none outside it
+        const std::vector<int> cols = body.pointSupport(node);
+        const PointKinematics pc = body.pointKinematics(q, node, cols, true);
+        std::vector<bool> inSupport(n, false);
+        for (size_t a = 0; a < cols.size(); ++a) {
+          inSupport[cols[a]] = true;
+          EXPECT_TRUE(pc.Jr.col(a) == pk.Jr.col(cols[a]) && pc.Jphi[a] == pk.Jphi[cols[a]]) << where << ", col " << cols[a];
+          for (size_t b = 0; b < cols.size(); ++b) {
+            EXPECT_TRUE(pc.Hrx(a, b) == pk.Hrx(cols[a], cols[b]) && pc.Hry(a, b) == pk.Hry(cols[a], cols[b]))
+                << where << ", Hessian (" << cols[a] << ", " << cols[b] << ")";
+          }
+        }
+        for (int c = 0; c < n; ++c) {
+          if (inSupport[c]) continue;
+          EXPECT_EQ(pk.Jr.col(c).norm() + std::abs(pk.Jphi[c]) + pk.Hrx.col(c).norm() + pk.Hry.col(c).norm(), 0.0)
+              << where << ": coordinate " << c << " outside the support moves the node";
+        }
+        // pinned and clamped nodal meshes: B2 keeps unit columns, a node moves with its
+        // own (at most 3) coordinates; mean-axis (free_free) conditions couple them all
+        if (nm.name.find("nodal") != std::string::npos && nm.name.find("free_free") == std::string::npos) {
+          EXPECT_LE(static_cast<int>(cols.size()), 3 + 3) << where << ": support " << cols.size();
+        }
       }
     }
   }
@@ -850,8 +876,10 @@ TEST(FfrBody2d, RejectsInvalidInvariants) {
 
   // a stiffness with a rigid-body mode (reference conditions that do not fix the frame)
   FfrInvariants inv = good;
-  inv.kff.row(0).setZero();
-  inv.kff.col(0).setZero();
+  MatX k = MatX(good.kff);
+  k.row(0).setZero();
+  k.col(0).setZero();
+  inv.kff = k.sparseView();
   expectInputError(direct(inv), {"body 'direct'", "k_ff", "rigid-body mode"});
   inv = good;
   inv.kff *= -1.0;
@@ -859,18 +887,18 @@ TEST(FfrBody2d, RejectsInvalidInvariants) {
 
   // m_ff not symmetric / not positive definite
   inv = good;
-  inv.mff(0, 1) += 0.1 * good.mff.cwiseAbs().maxCoeff();
+  inv.mff.coeffRef(0, 1) += 0.1 * MatX(good.mff).cwiseAbs().maxCoeff();
   expectInputError(direct(inv), {"body 'direct'", "m_ff", "not symmetric"});
   inv = good;
-  inv.mff(2, 2) = -inv.mff(2, 2);
+  inv.mff.coeffRef(2, 2) = -inv.mff.coeff(2, 2);
   expectInputError(direct(inv), {"body 'direct'", "m_ff", "positive definite"});
 
   // S~ not skew
   inv = good;
-  inv.sTilde(1, 1) = 0.05;
+  inv.sTilde.coeffRef(1, 1) = 0.05;
   expectInputError(direct(inv), {"body 'direct'", "s_tilde", "skew"});
   inv = good;
-  inv.sTilde(0, 2) += 0.05;
+  inv.sTilde.coeffRef(0, 2) += 0.05;
   expectInputError(direct(inv), {"body 'direct'", "s_tilde"});
 
   // other invariants
@@ -884,7 +912,7 @@ TEST(FfrBody2d, RejectsInvalidInvariants) {
   inv.dff = -good.kff;
   expectInputError(direct(inv), {"body 'direct'", "d_ff"});
   inv = good;
-  inv.kff(0, 1) += 1.0;
+  inv.kff.coeffRef(0, 1) += 1.0;
   expectInputError(direct(inv), {"body 'direct'", "k_ff", "not symmetric"});
   inv = good;
   inv.j0.conservativeResize(inv.j0.size() - 1);

@@ -178,7 +178,7 @@ double spinningFrequency(const FfrBeamModel& m, double Omega) {
   const MatX K = m.strainEnergyHessian(q) - Omega * Omega * inv.mff;
   const MatX G = -2.0 * Omega * inv.sTilde;
   MatX A = MatX::Zero(2 * n, 2 * n);
-  const MatX Minv = inv.mff.inverse();
+  const MatX Minv = MatX(inv.mff).inverse();
   A.topRightCorner(n, n).setIdentity();
   A.bottomLeftCorner(n, n) = -Minv * K;
   A.bottomRightCorner(n, n) = -Minv * G;

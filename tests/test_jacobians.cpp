@@ -18,6 +18,8 @@
 #include <utility>
 #include <vector>
 
+#include "bodies/ffr_beam_model.hpp"
+#include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
 #include "core/dae_system.hpp"
 #include "core/errors.hpp"
@@ -249,7 +251,7 @@ void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const Vec
   const std::string who = con.typeName() + " '" + con.name() + "', " + at;
 
   ConstraintEvaluation ev;
-  con.evaluate(sys.bodyStates(con.bodies(), q.data()), true, ev);
+  con.evaluate(sys.constraintStates(ci, q.data()), true, ev);
   ASSERT_EQ(ev.h.size(), me) << who;
   ASSERT_EQ(ev.G.rows(), me) << who;
   ASSERT_EQ(ev.G.cols(), nl) << who;
@@ -257,7 +259,7 @@ void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const Vec
 
   // Without Hessians h and G are the same (bitwise: same code path).
   ConstraintEvaluation ev0;
-  con.evaluate(sys.bodyStates(con.bodies(), q.data()), false, ev0);
+  con.evaluate(sys.constraintStates(ci, q.data()), false, ev0);
   EXPECT_TRUE(ev0.h == ev.h) << who;
   EXPECT_TRUE(ev0.G == ev.G) << who;
 
@@ -268,7 +270,7 @@ void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const Vec
     VecX qg = q;
     for (int k = 0; k < nl; ++k) qg[cols[k]] = z[k];
     ConstraintEvaluation e;
-    con.evaluate(sys.bodyStates(con.bodies(), qg.data()), false, e);
+    con.evaluate(sys.constraintStates(ci, qg.data()), false, e);
     return e;
   };
   expectMatrixNear(ev.G, fdJacobian([&](const VecX& z) { return evalAt(z).h; }, ql), kFdTol,
@@ -361,12 +363,12 @@ void checkForceDerivatives(const System& sys, ForceIndex fi, double t, const Vec
     VecX qg = q;
     for (int k = 0; k < nl; ++k) qg[cols[k]] = qz[k];
     VecX out = VecX::Zero(nl);
-    force.addForce(t, sys.bodyStates(force.bodies(), qg.data()), vz, out, nullptr, nullptr);
+    force.addForce(t, sys.forceStates(fi, qg.data()), vz, out, nullptr, nullptr);
     return out;
   };
   VecX Qj = VecX::Zero(nl);
   MatX dQdq = MatX::Zero(nl, nl), dQdv = MatX::Zero(nl, nl);
-  force.addForce(t, sys.bodyStates(force.bodies(), q.data()), vl, Qj, &dQdq, &dQdv);
+  force.addForce(t, sys.forceStates(fi, q.data()), vl, Qj, &dQdq, &dQdv);
   // The force itself does not depend on whether Jacobians are requested.
   EXPECT_TRUE(Qj == Q(ql, vl)) << who;
   expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, vl); }, ql), kFdTol,
@@ -390,12 +392,12 @@ void checkForceIsEnergyGradient(const System& sys, ForceIndex fi, const VecX& q,
     return qg;
   };
   VecX Q = VecX::Zero(nl);
-  force.addForce(0.0, sys.bodyStates(force.bodies(), q.data()), VecX::Zero(nl), Q, nullptr,
+  force.addForce(0.0, sys.forceStates(fi, q.data()), VecX::Zero(nl), Q, nullptr,
                  nullptr);
   const VecX gradV = fdGradient(
       [&](const VecX& z) {
         const VecX qg = withLocal(z);
-        return force.potentialEnergy(sys.bodyStates(force.bodies(), qg.data()));
+        return force.potentialEnergy(sys.forceStates(fi, qg.data()));
       },
       ql);
   expectMatrixNear(Q, -gradV, kFdTol, "Q vs -dV/dq, " + who);
@@ -451,7 +453,7 @@ VecX randomForceConfiguration(Random& rnd, const ForceCase& fc) {
     bool ok = true;
     for (int f = 0; f < sys.numForces(); ++f) {
       const auto* s = dynamic_cast<const SpringDamper*>(&sys.force(ForceIndex(f)));
-      if (s && s->length(sys.bodyStates(s->bodies(), q.data())) < 0.5) ok = false;
+      if (s && s->length(sys.forceStates(ForceIndex(f), q.data())) < 0.5) ok = false;
     }
     if (ok) return q;
   }
@@ -500,7 +502,7 @@ TEST(ForceJacobians, AppliedLoadIsTheVirtualWorkOfForceAndTorque) {
     const VecX q = randomForceConfiguration(rnd, *fc);
     const double t = rnd.uniform(0.0, 3.0);
     VecX Q = VecX::Zero(3);
-    sys.force(load).addForce(t, sys.bodyStates(sys.force(load).bodies(), q.data()), VecX::Zero(3), Q,
+    sys.force(load).addForce(t, sys.forceStates(load, q.data()), VecX::Zero(3), Q,
                              nullptr, nullptr);
     const double th = q[sys.coordinateOffset(fc->b) + 2];
     const Vec2 au(std::cos(th) * u.x() - std::sin(th) * u.y(),
@@ -519,7 +521,8 @@ TEST(ForceJacobians, AppliedLoadIsTheVirtualWorkOfForceAndTorque) {
 /// slide line, driven by a harmonic body-angle driver; a small body welded to the rod;
 /// a spring-damper from ground to the slider; a rotational spring-damper in the crank
 /// pin; an applied load on the rod; gravity; a carriage on a tilted prismatic joint to
-/// ground driven in displacement and an arm hinged on it driven in angle.
+/// ground driven in displacement and an arm hinged on it driven in angle; a flexible
+/// beam hinged to the arm.
 System makeEverythingSystem() {
   System sys;
   sys.setGravity(Vec2(0.0, -9.81));
@@ -564,6 +567,27 @@ System makeEverythingSystem() {
   sys.addJointDriver("lift", carriageSlide, makePolynomialLaw({0.0, 0.2, -0.1}));
   sys.addJointDriver("swing", hinge, makeHarmonicLaw(0.3, 1.5, 0.0, -0.85));
 
+  // A flexible beam (4 FFR elements, geometric stiffening, damping) hinged at its middle
+  // node to the arm, loaded at a quarter node, sprung at its end node: joints and forces
+  // on nodes use only the frame and that node's coordinates (sparse Jacobian blocks).
+  BeamSection section;
+  section.area = 1e-3;
+  section.inertia = 1e-7;
+  section.youngsModulus = 1e5;
+  section.density = 1000.0;
+  section.damping = 0.01;
+  FfrBeamOptions beamOptions;
+  beamOptions.geometricStiffening = true;
+  auto beamModel = std::make_shared<const FfrBeamModel>(BeamMesh2d::straight(1.0, 4, section), beamOptions,
+                                                        "body 'beam'");
+  const BodyIndex beam = sys.addBody(std::make_unique<FfrBody2d>(
+      "beam", beamModel, FrameState2d{Vec2(2.7, 1.6), 0.3, Vec2::Zero(), 0.0}));
+  sys.addRevoluteJoint("beam_hinge", arm, Vec2(0.6, 0.0), beam, Vec2(0.5, 0.0));
+  sys.addSpringDamper("beam_spring", kGround, Vec2(4.0, 2.5), beam, Vec2(1.0, 0.0), 50.0, 2.0, 1.0);
+  sys.addAppliedLoad("beam_load", beam, Vec2(0.25, 0.0), makeHarmonicLaw(1.0, 2.0, 0.1), makeConstantLaw(0.5),
+                     makeConstantLaw(0.2));
+  sys.addBodyCoordinateDriver("beam_mode", beam, "q4", makeHarmonicLaw(0.01, 5.0, 0.0));
+
   sys.addSpringDamper("spring", kGround, Vec2(-1.0, 0.5), slider, Vec2(0.1, 0.05), 120.0, 3.0, 1.5);
   sys.addRotationalSpringDamper("torsion", crankPin, 25.0, 1.5, 0.2);
   sys.addAppliedLoad("load", rod, Vec2(1.5, 0.1), makeHarmonicLaw(4.0, 2.5, 0.3),
@@ -583,7 +607,7 @@ void randomDaeState(Random& rnd, const System& sys, const DaeSystem& dae, VecX& 
     bool ok = true;
     for (int f = 0; f < sys.numForces(); ++f) {
       const auto* s = dynamic_cast<const SpringDamper*>(&sys.force(ForceIndex(f)));
-      if (s && s->length(sys.bodyStates(s->bodies(), y.data() + L.q)) < 0.5) ok = false;
+      if (s && s->length(sys.forceStates(ForceIndex(f), y.data() + L.q)) < 0.5) ok = false;
     }
     if (ok) return;
   }

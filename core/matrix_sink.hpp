@@ -1,0 +1,47 @@
+// Where a body writes a matrix block (mass matrix, force Jacobians): a dense matrix, or
+// the DAE Jacobian at an offset, with a scale factor. Bodies write only their structural
+// non-zeros, so a large flexible body fills a sparse Jacobian in O(non-zeros).
+#pragma once
+
+#include "core/sparse_pattern.hpp"
+#include "core/types.hpp"
+
+namespace flexmbd {
+
+class MatrixSink {
+ public:
+  /// Into a dense matrix: M(i, j) += scale * value (implicit, so MatX arguments work).
+  MatrixSink(MatX& M, double scale = 1.0) : dense_(&M), scale_(scale) {}
+  /// Into the DAE Jacobian: J(row0 + i, col0 + j) += scale * value.
+  MatrixSink(JacobianSink& J, int row0, int col0, double scale = 1.0)
+      : jacobian_(&J), row0_(row0), col0_(col0), scale_(scale) {}
+
+  void add(int i, int j, double value) const {
+    if (dense_) {
+      (*dense_)(i, j) += scale_ * value;
+    } else {
+      jacobian_->add(row0_ + i, col0_ + j, scale_ * value);
+    }
+  }
+  /// Block B at (i0, j0), every entry (dense blocks: frame rows and columns).
+  template <class Derived>
+  void addBlock(int i0, int j0, const Eigen::MatrixBase<Derived>& B) const {
+    for (Eigen::Index j = 0; j < B.cols(); ++j) {
+      for (Eigen::Index i = 0; i < B.rows(); ++i) add(i0 + static_cast<int>(i), j0 + static_cast<int>(j), B(i, j));
+    }
+  }
+  /// s * S at (i0, j0), its stored entries only.
+  void addSparse(int i0, int j0, const SpMat& S, double s = 1.0) const {
+    for (int j = 0; j < S.outerSize(); ++j) {
+      for (SpMat::InnerIterator it(S, j); it; ++it) add(i0 + static_cast<int>(it.row()), j0 + j, s * it.value());
+    }
+  }
+
+ private:
+  MatX* dense_ = nullptr;
+  JacobianSink* jacobian_ = nullptr;
+  int row0_ = 0, col0_ = 0;
+  double scale_ = 1.0;
+};
+
+}  // namespace flexmbd
