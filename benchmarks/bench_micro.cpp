@@ -11,6 +11,8 @@
 #include <benchmark/benchmark.h>
 #include <klu.h>
 
+#include "integrators/klu_ordering.hpp"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -98,6 +100,8 @@ void kluRefactorBench(benchmark::State& st, int elements) {
   assembleJacobian(f);
   klu_l_common common;
   klu_l_defaults(&common);
+  const std::vector<int64_t> groups = f.dae->eliminationGroups();
+  configureKluOrdering(common, groups);  // as the engine's IdaSolver does
   const SuiteSparse_long n = f.dae->layout().size;
   klu_l_symbolic* sym = klu_l_analyze(n, f.colStart.data(), f.rowIndex.data(), &common);
   klu_l_numeric* num = sym ? klu_l_factor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, &common)
