@@ -691,9 +691,11 @@ TEST(InitialValues, BodiesMetresOffTheirJointsAreProjectedAndRunAsTheConsistentO
   constexpr double kProjected = 1e-12;
   EXPECT_LT(g0, kProjected);
   EXPECT_LT(gv0, kProjected);
-  // Same state at t0 (the same assembly branch), so the same trajectory up to round-off
-  // driven step-size decisions: well inside rtol 1e-8.
-  constexpr double kSameRun = 1e-8;
+  // Same state at t0 (the same assembly branch, up to round-off), so the same trajectory
+  // up to round-off-driven step-size decisions: each run is within the 1e-7 of
+  // tests/test_slider_crank_rigid.cpp of the exact one (measured: 2e-12 on one build,
+  // 1.5e-8 on another, where round-off changed a step-size decision).
+  constexpr double kSameRun = 1e-7;
   EXPECT_LT(diff, kSameRun);
 }
 
