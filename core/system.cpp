@@ -312,6 +312,18 @@ std::vector<BodyState> System::forceStates(ForceIndex i, const double* q) const 
   return states(force(i).bodies(), forceUsed_.at(i.value), q);
 }
 
+std::string System::describeEquation(int row) const {
+  for (int c = numConstraints() - 1; c >= 0; --c) {
+    const ConstraintIndex ci(c);
+    if (row >= constraintOffset(ci)) {
+      const Constraint& con = constraint(ci);
+      return std::string(con.isDriver() ? "driver '" : "joint '") + con.name() + "' (" + con.typeName() +
+             ", equation " + std::to_string(row - constraintOffset(ci)) + ")";
+    }
+  }
+  return "?";
+}
+
 std::vector<int> System::frameCoordinates() const {
   requireFinalized("frameCoordinates");
   std::vector<int> idx;

@@ -89,6 +89,8 @@ class System {
   /// restricted to the coordinates it uses.
   std::vector<BodyState> constraintStates(ConstraintIndex i, const double* q) const;
   std::vector<BodyState> forceStates(ForceIndex i, const double* q) const;
+  /// "joint 'O2' (revolute, equation 1)": the constraint that owns global equation `row`.
+  std::string describeEquation(int row) const;
   /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
   std::vector<int> frameCoordinates() const;
   /// "crank.x", ... for every coordinate, in order.

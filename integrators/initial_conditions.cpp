@@ -16,25 +16,12 @@ constexpr int kMaxProjectionIterations = 50;
 /// Above this size the augmented system is solved with a sparse LU.
 constexpr int kDenseAugmentedLimit = 200;
 
-/// Names the constraint (joint or driver) that owns global equation `row`.
-std::string constraintOfRow(const System& sys, int row) {
-  for (int c = sys.numConstraints() - 1; c >= 0; --c) {
-    const ConstraintIndex ci(c);
-    if (row >= sys.constraintOffset(ci)) {
-      const Constraint& con = sys.constraint(ci);
-      return std::string(con.isDriver() ? "driver '" : "joint '") + con.name() + "' (" +
-             con.typeName() + ", equation " + std::to_string(row - sys.constraintOffset(ci)) + ")";
-    }
-  }
-  return "?";
-}
-
 void throwIfRedundant(const System& sys, const MatX& G) {
   const std::vector<int> rows = dependentRows(G);
   if (rows.empty()) return;
   std::ostringstream os;
   os << "redundant or conflicting constraints: ";
-  for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << constraintOfRow(sys, rows[k]);
+  for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << sys.describeEquation(rows[k]);
   os << (rows.size() == 1 ? " depends" : " depend")
      << " on the joints and drivers defined before (the constraint Jacobian loses rank at the given "
         "positions); remove it or free a coordinate, or start away from a singular position";
@@ -134,7 +121,7 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
        << " after " << it << " Newton iterations; largest violations: ";
     for (int k = 0; k < std::min(m, 3); ++k) {
       if (!(std::abs(g[rows[k]]) > tol) && k > 0) break;
-      os << (k ? ", " : "") << constraintOfRow(sys, rows[k]) << " = " << g[rows[k]];
+      os << (k ? ", " : "") << sys.describeEquation(rows[k]) << " = " << g[rows[k]];
     }
     throw ModelError(os.str());
   }

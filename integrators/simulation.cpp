@@ -54,19 +54,6 @@ class ProgressReporter {
   bool shown_ = false;
 };
 
-/// Names the constraint (joint or driver) that owns global equation `row`.
-std::string constraintOfRow(const System& sys, int row) {
-  for (int c = sys.numConstraints() - 1; c >= 0; --c) {
-    const ConstraintIndex ci(c);
-    if (row >= sys.constraintOffset(ci)) {
-      const Constraint& con = sys.constraint(ci);
-      return std::string(con.isDriver() ? "driver '" : "joint '") + con.name() + "' (" +
-             con.typeName() + ", equation " + std::to_string(row - sys.constraintOffset(ci)) + ")";
-    }
-  }
-  return "?";
-}
-
 /// A constraint row whose Gram-Schmidt remainder falls below this fraction of its norm
 /// counts as dependent in a failure diagnosis. Measured (tests/test_stability.cpp): where
 /// IDA stops at the lock-up of examples/slider_crank_lockup.json the smallest/largest
@@ -107,7 +94,7 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
     return os.str();
   }
   os << ", nearly rank-deficient: ";
-  for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << constraintOfRow(sys, rows[k]);
+  for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << sys.describeEquation(rows[k]);
   os << (rows.size() == 1 ? " becomes" : " become")
      << " dependent on the joints and drivers defined before: the mechanism reaches a singular position "
         "(lock-up, dead centre or change point) where the drivers do not determine its motion";
