@@ -26,14 +26,28 @@ class MatrixSink {
   /// Block B at (i0, j0), every entry (dense blocks: frame rows and columns).
   template <class Derived>
   void addBlock(int i0, int j0, const Eigen::MatrixBase<Derived>& B) const {
-    for (Eigen::Index j = 0; j < B.cols(); ++j) {
-      for (Eigen::Index i = 0; i < B.rows(); ++i) add(i0 + static_cast<int>(i), j0 + static_cast<int>(j), B(i, j));
+    const Eigen::Matrix<double, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime> b = B;  // column-major
+    for (Eigen::Index j = 0; j < b.cols(); ++j) {
+      const int rows = static_cast<int>(b.rows());
+      if (dense_) {
+        dense_->block(i0, j0 + j, rows, 1) += scale_ * b.col(j);
+      } else {
+        jacobian_->addColumn(col0_ + j0 + static_cast<int>(j), row0_ + i0, nullptr, b.col(j).data(), rows, scale_);
+      }
     }
   }
   /// s * S at (i0, j0), its stored entries only.
   void addSparse(int i0, int j0, const SpMat& S, double s = 1.0) const {
+    if (dense_ || !S.isCompressed()) {
+      for (int j = 0; j < S.outerSize(); ++j) {
+        for (SpMat::InnerIterator it(S, j); it; ++it) add(i0 + static_cast<int>(it.row()), j0 + j, s * it.value());
+      }
+      return;
+    }
+    const int* outer = S.outerIndexPtr();
     for (int j = 0; j < S.outerSize(); ++j) {
-      for (SpMat::InnerIterator it(S, j); it; ++it) add(i0 + static_cast<int>(it.row()), j0 + j, s * it.value());
+      jacobian_->addColumn(col0_ + j0 + j, row0_ + i0, S.innerIndexPtr() + outer[j], S.valuePtr() + outer[j],
+                           outer[j + 1] - outer[j], scale_ * s);
     }
   }
 

@@ -60,6 +60,24 @@ class JacobianSink {
     if (k < 0) throwOutsidePattern(row, col);
     data_[k] += value;
   }
+  /// J(row0 + rows[k], col) += s * values[k], k < n, rows ascending (rows null: rows
+  /// 0..n-1). In a sparse pattern one merge walk down the column replaces n searches.
+  void addColumn(int col, int row0, const int* rows, const double* values, int n, double s) {
+    auto rowOf = [&](int k) { return row0 + (rows ? rows[k] : k); };
+    if (entries_ || !pattern_) {
+      for (int k = 0; k < n; ++k) add(rowOf(k), col, s * values[k]);
+      return;
+    }
+    const auto& ri = pattern_->rowIndex();
+    int64_t p = pattern_->colStart()[col];
+    const int64_t end = pattern_->colStart()[col + 1];
+    for (int k = 0; k < n; ++k) {
+      const int r = rowOf(k);
+      while (p < end && ri[p] < r) ++p;
+      if (p == end || ri[p] != r) throwOutsidePattern(r, col);
+      data_[p] += s * values[k];
+    }
+  }
 
  private:
   JacobianSink(double* d, int n, const SparsePattern* p) : data_(d), n_(n), pattern_(p) {}
