@@ -164,6 +164,7 @@ IdaSolver::IdaSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX
   if (o.maxStepSize > 0.0) d.check(IDASetMaxStep(d.mem, o.maxStepSize), "IDASetMaxStep");
   if (o.minStepSize > 0.0) d.check(IDASetMinStep(d.mem, o.minStepSize), "IDASetMinStep");
   if (o.maxOrder != 5) d.check(IDASetMaxOrd(d.mem, o.maxOrder), "IDASetMaxOrd");
+  if (o.initialStepSize > 0.0) d.check(IDASetInitStep(d.mem, o.initialStepSize), "IDASetInitStep");
 
   LinearSolverKind kind = o.linearSolver;
   if (kind == LinearSolverKind::Automatic) {

@@ -36,6 +36,7 @@ struct IntegratorOptions {
   double maxStepSize = 0.0;      ///< 0: no limit
   double minStepSize = 0.0;      ///< IDA fails (IDA_ERR_FAIL/IDA_CONV_FAIL) below this
   int maxOrder = 5;              ///< highest BDF order, 1..5
+  double initialStepSize = 0.0;  ///< first step tried; 0: IDA's estimate from y'
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;  ///< IDA's own difference quotients (dense only)
 };

@@ -120,6 +120,8 @@ void SolverSettings::validate() const {
     requireSetting(*minStepSize >= 0.0 && std::isfinite(*minStepSize), "min_step",
                    "a non-negative number", *minStepSize);
   }
+  requireSetting(initialStepSize >= 0.0 && std::isfinite(initialStepSize), "initial_step",
+                 "a non-negative number (0: IDA's estimate)", initialStepSize);
   requireSetting(maxOrder >= 1 && maxOrder <= 5, "max_order", "an integer from 1 to 5",
                  static_cast<double>(maxOrder));
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
@@ -179,6 +181,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
+  o.initialStepSize = settings.initialStepSize;
   o.minStepSize = settings.minStepSize.value_or(1e-12 * (tEnd - t0));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;

@@ -27,6 +27,8 @@ struct SolverSettings {
   /// Highest BDF order (1..5). Orders 1 and 2 are A-stable: undamped high-frequency
   /// modes cannot force small steps for stability (docs/formulations.md).
   int maxOrder = 5;
+  /// First step size tried (0: IDA's estimate, h0 ~ 1 / |y'| in the error weights).
+  double initialStepSize = 0.0;
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;
   bool progress = true;           ///< progress on stderr for long runs (if a terminal)

@@ -402,7 +402,7 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
   r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
-               "min_step", "max_steps", "linear_solver", "fd_jacobian"});
+               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian"});
   SolverSettings s;
   if (r.has("formulation")) {
     const std::string f = r.string("formulation");
@@ -430,6 +430,7 @@ SolverSettings parseSolver(const json& j) {
   if (r.has("min_step")) s.minStepSize = r.number("min_step", 0.0);
   s.maxSteps = r.integer("max_steps", s.maxSteps, 1);
   s.maxOrder = static_cast<int>(r.integer("max_order", s.maxOrder, 1));
+  s.initialStepSize = r.number("initial_step", s.initialStepSize);
   s.finiteDifferenceJacobian = r.boolean("fd_jacobian", s.finiteDifferenceJacobian);
   checkSolverSettings(s);
   return s;

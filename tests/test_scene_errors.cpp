@@ -267,6 +267,18 @@ TEST(SceneErrors, WrongTypes) {
   }
   {
     json j = baseScene();
+    j["solver"]["max_order"] = 7;
+    EXPECT_TRUE(Mentions(errorOf(j), {"max_order", "1 to 5", "7"}));
+    j["solver"]["max_order"] = 2;
+    j["solver"]["initial_step"] = -1e-3;
+    EXPECT_TRUE(Mentions(errorOf(j), {"initial_step", "non-negative"}));
+    j["solver"]["initial_step"] = 1e-6;
+    const Scene s = parseScene(j);  // both keys accepted and carried to the settings
+    EXPECT_EQ(s.solver.maxOrder, 2);
+    EXPECT_EQ(s.solver.initialStepSize, 1e-6);
+  }
+  {
+    json j = baseScene();
     j["bodies"][0] = json::array();
     EXPECT_TRUE(Mentions(errorOf(j), {"bodies[0]", "expected an object"}));
   }
