@@ -65,6 +65,15 @@ struct BenchModel {
 /// velocities in m/s; the models' lengths are 0.15 m to 2 m).
 inline double atolFor(double rtol) { return 1e-2 * rtol; }
 
+/// The run settings every sweep point shares: tolerances, span, one output per checkpoint.
+inline void setRun(SolverSettings& solver, double rtol, double atol, double span, int checkpoints) {
+  solver.rtol = rtol;
+  solver.atol = atol;
+  solver.tEnd = span;
+  solver.outputStep = span / checkpoints;
+  solver.progress = false;
+}
+
 inline std::string sourcePath(const std::string& rel) { return std::string(FLEXMBD_SOURCE_DIR) + "/" + rel; }
 
 /// Body-frame position of a material point of a flexible body: u0 + N q_f.
@@ -105,11 +114,7 @@ inline BenchModel rigidSliderCrank() {
   m.positionsDoc = "slider x, rod midpoint (x, y); length = crank l1 = 1 m";
   m.build = [span = m.span, k = m.checkpoints](double rtol, double atol) {
     Scene s = loadScene(sourcePath("examples/slider_crank_rigid.json"));
-    s.solver.rtol = rtol;
-    s.solver.atol = atol;
-    s.solver.tEnd = span;
-    s.solver.outputStep = span / k;
-    s.solver.progress = false;
+    setRun(s.solver, rtol, atol, span, k);
     return s;
   };
   m.probe = [](const Scene& s, const OutputSample& o) {
@@ -195,11 +200,7 @@ inline BenchModel freeBeam(int elements = 8, int modes = 0) {
     s.name = "free_beam";
     s.system.addBody(std::move(body));
     s.system.finalize();
-    s.solver.rtol = rtol;
-    s.solver.atol = atol;
-    s.solver.tEnd = span;
-    s.solver.outputStep = span / k;
-    s.solver.progress = false;
+    setRun(s.solver, rtol, atol, span, k);
     return s;
   };
   m.probe = [](const Scene& s, const OutputSample& o) {
