@@ -95,13 +95,15 @@ void jacobianBench(benchmark::State& st, int elements) {
   st.counters["jac_in_residuals"] = tJac / tRes;
 }
 
-void kluRefactorBench(benchmark::State& st, int elements) {
+/// engineOrdering: as the engine's IdaSolver (configureKluOrdering); else KLU's
+/// defaults (AMD after BTF, pivot threshold 1e-3), for comparison.
+void kluRefactorBench(benchmark::State& st, int elements, bool engineOrdering) {
   Fixture& f = fixture(elements);
   assembleJacobian(f);
   klu_l_common common;
   klu_l_defaults(&common);
   const std::vector<int64_t> groups = f.dae->eliminationGroups();
-  configureKluOrdering(common, groups);  // as the engine's IdaSolver does
+  if (engineOrdering) configureKluOrdering(common, groups);
   const SuiteSparse_long n = f.dae->layout().size;
   klu_l_symbolic* sym = klu_l_analyze(n, f.colStart.data(), f.rowIndex.data(), &common);
   klu_l_numeric* num = sym ? klu_l_factor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, &common)
@@ -172,7 +174,9 @@ int main(int argc, char** argv) {
     const std::string suffix = "/elements:" + std::to_string(n);
     benchmark::RegisterBenchmark(("residual" + suffix).c_str(), residualBench, n)->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("jacobian" + suffix).c_str(), jacobianBench, n)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("klu_refactor" + suffix).c_str(), kluRefactorBench, n)
+    benchmark::RegisterBenchmark(("klu_refactor" + suffix).c_str(), kluRefactorBench, n, true)
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("klu_refactor_default_ordering" + suffix).c_str(), kluRefactorBench, n, false)
         ->Unit(benchmark::kMicrosecond);
   }
   CollectingReporter reporter;
@@ -181,9 +185,9 @@ int main(int argc, char** argv) {
 
   CsvWriter csv(opt.csvPath("bench_micro.csv"),
                 {"elements", "dae_size", "jacobian_nonzeros", "residual_us", "jacobian_us", "klu_refactor_us",
-                 "jacobian_in_residuals", "klu_refactor_in_residuals"});
-  std::printf("\n%8s %8s %10s %12s %12s %14s %10s %10s\n", "elements", "size", "nnz(J)", "residual[us]",
-              "jacobian[us]", "klu_refac[us]", "jac/res", "klu/res");
+                 "jacobian_in_residuals", "klu_refactor_in_residuals", "klu_refactor_default_ordering_us"});
+  std::printf("\n%8s %8s %10s %12s %12s %14s %10s %10s %16s\n", "elements", "size", "nnz(J)", "residual[us]",
+              "jacobian[us]", "klu_refac[us]", "jac/res", "klu/res", "klu_default[us]");
   for (int n : meshes) {
     const std::string suffix = "/elements:" + std::to_string(n);
     const auto get = [&](const std::string& name) {
@@ -191,11 +195,13 @@ int main(int argc, char** argv) {
       return it == reporter.seconds.end() ? NAN : it->second;
     };
     const double tr = get("residual"), tj = get("jacobian"), tk = get("klu_refactor");
+    const double tkd = get("klu_refactor_default_ordering");
     const Fixture& f = fixture(n);
-    std::printf("%8d %8d %10lld %12.3f %12.3f %14.3f %10.2f %10.2f\n", n, f.dae->layout().size,
-                static_cast<long long>(f.dae->pattern().nonZeros()), 1e6 * tr, 1e6 * tj, 1e6 * tk, tj / tr, tk / tr);
+    std::printf("%8d %8d %10lld %12.3f %12.3f %14.3f %10.2f %10.2f %16.3f\n", n, f.dae->layout().size,
+                static_cast<long long>(f.dae->pattern().nonZeros()), 1e6 * tr, 1e6 * tj, 1e6 * tk, tj / tr, tk / tr,
+                1e6 * tkd);
     csv.row({std::to_string(n), std::to_string(f.dae->layout().size), std::to_string(f.dae->pattern().nonZeros()),
-             fmt(1e6 * tr), fmt(1e6 * tj), fmt(1e6 * tk), fmt(tj / tr, "%.3f"), fmt(tk / tr, "%.3f")});
+             fmt(1e6 * tr), fmt(1e6 * tj), fmt(1e6 * tk), fmt(tj / tr, "%.3f"), fmt(tk / tr, "%.3f"), fmt(1e6 * tkd)});
   }
   std::printf("jac/res, klu/res: the cost of one Jacobian assembly and of one KLU refactorisation in residual "
               "evaluations (target: a Jacobian costs at most a few residuals).\nCSV written to %s\n",

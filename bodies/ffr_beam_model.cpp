@@ -181,6 +181,7 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
     B = (B * Phi).sparseView();
   }
   basis_ = B;
+  for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(makeElementBasis(static_cast<int>(e)));
   invariants_ = nodal.transformed(B);
   invariants_.points.clear();
   for (int n = 0; n < nn; ++n) {
@@ -199,7 +200,7 @@ VecX FfrBeamModel::naturalFrequencies() const {
   return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
-FfrBeamModel::ElementBasis FfrBeamModel::elementBasis(int e) const {
+FfrBeamModel::ElementBasis FfrBeamModel::makeElementBasis(int e) const {
   const auto& el = mesh_.elements[e];
   const int rows[6] = {dof(el.node1, 0), dof(el.node1, 1), dof(el.node1, 2),
                        dof(el.node2, 0), dof(el.node2, 1), dof(el.node2, 2)};
@@ -229,7 +230,7 @@ double FfrBeamModel::strainEnergy(const VecX& qf) const {
   if (!options_.geometricStiffening) return 0.5 * qf.dot(invariants_.kff * qf);
   double U = 0.0;
   for (size_t e = 0; e < elements_.size(); ++e) {
-    U += elements_[e].strainEnergy(elementCoordinates(e, elementBasis(e), qf), true);
+    U += elements_[e].strainEnergy(elementCoordinates(e, elementBases_[e], qf), true);
   }
   return U;
 }
@@ -238,7 +239,7 @@ VecX FfrBeamModel::strainEnergyGradient(const VecX& qf) const {
   if (!options_.geometricStiffening) return invariants_.kff * qf;
   VecX g = VecX::Zero(qf.size());
   for (size_t e = 0; e < elements_.size(); ++e) {
-    const ElementBasis eb = elementBasis(e);
+    const ElementBasis& eb = elementBases_[e];
     const auto& T = elements_[e].transformation();
     const VecX ge = eb.B.transpose() * (T.transpose() * elements_[e].strainEnergyGradient(elementCoordinates(e, eb, qf), true));
     for (size_t k = 0; k < eb.cols.size(); ++k) g[eb.cols[k]] += ge[k];
@@ -250,7 +251,7 @@ SpMat FfrBeamModel::strainEnergyHessian(const VecX& qf) const {
   if (!options_.geometricStiffening) return invariants_.kff;
   std::vector<Eigen::Triplet<double>> t;
   for (size_t e = 0; e < elements_.size(); ++e) {
-    const ElementBasis eb = elementBasis(e);
+    const ElementBasis& eb = elementBases_[e];
     const MatX TB = elements_[e].transformation() * eb.B;
     const MatX He = TB.transpose() * elements_[e].strainEnergyHessian(elementCoordinates(e, eb, qf), true) * TB;
     for (size_t j = 0; j < eb.cols.size(); ++j) {
@@ -279,7 +280,7 @@ bool FfrBeamModel::locate(const Vec2& point, int& element, double& xi) const {
 FfrPoint FfrBeamModel::materialPoint(int e, double xi) const {
   const BeamElement2d& el = elements_.at(e);
   const Mat2 R = rotation(el.angle());
-  const ElementBasis eb = elementBasis(e);
+  const ElementBasis& eb = elementBases_[e];
   const MatX TB = el.transformation() * eb.B;
   FfrPoint p;
   p.position = el.start() + R * Vec2(xi * el.length(), 0.0);
@@ -296,7 +297,7 @@ FfrPoint FfrBeamModel::materialPoint(int e, double xi) const {
 
 Vec2 FfrBeamModel::sectionForces(const VecX& qf, int e, double xi) const {
   const BeamElement2d& el = elements_.at(e);
-  return el.sectionForces(elementCoordinates(e, elementBasis(e), qf), xi, options_.geometricStiffening);
+  return el.sectionForces(elementCoordinates(e, elementBases_[e], qf), xi, options_.geometricStiffening);
 }
 
 }  // namespace flexmbd

@@ -87,7 +87,7 @@ class FfrBeamModel {
     std::vector<int> cols;
     Eigen::Matrix<double, 6, Eigen::Dynamic> B;
   };
-  ElementBasis elementBasis(int element) const;
+  ElementBasis makeElementBasis(int element) const;
   /// Element nodal displacements in element axes (T B q_f).
   BeamElement2d::Vec6 elementCoordinates(int element, const ElementBasis& eb, const VecX& qf) const;
 
@@ -95,6 +95,7 @@ class FfrBeamModel {
   FfrBeamOptions options_;
   std::vector<BeamElement2d> elements_;
   SpMatRow basis_;
+  std::vector<ElementBasis> elementBases_;  // per element, built once with basis_
   FfrInvariants invariants_;
 };
 

@@ -24,9 +24,9 @@ int64_t camdOrdering(int64_t n, int64_t* Ap, int64_t* Ai, int64_t* perm, klu_l_c
 /// elastic coordinates, made KLU pick pivots off the fill-reducing order. The elastic
 /// 2 x 2 blocks [cj, -1; K, cj M] have positive Schur complements cj M + K / cj, so
 /// their diagonal pivots are safe; a threshold of 1e-6 still rejects the (near-)zero
-/// diagonals of the small last group (1e-12 made rigid mechanisms fail to converge).
-/// Measured on the elastic slider-crank, 256 elements (1572 unknowns), nnz(U):
-/// 263,000 with the defaults, 317,000-603,000 with CAMD at 1e-3, 12,900 at 1e-6.
+/// diagonals of the small last group (a threshold of 1e-12 let the rigid slider-crank
+/// tests fail to converge). bench_micro compares both orderings: elastic slider-crank,
+/// 256 elements, nnz(L + U) 311,373 with KLU's defaults and 28,658 with this one.
 constexpr double kKluPivotTolerance = 1e-6;
 
 }  // namespace

@@ -63,6 +63,16 @@ inline std::string join(const std::vector<std::string>& items) {
 
 inline std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
 
+/// nlohmann's message without its "[json.exception.xxx.nnn] " prefix.
+inline std::string plainMessage(const json::exception& e) {
+  std::string m = e.what();
+  if (!m.empty() && m[0] == '[') {
+    const auto close = m.find("] ");
+    if (close != std::string::npos) m = m.substr(close + 2);
+  }
+  return m;
+}
+
 // ----- reading one JSON object ---------------------------------------------------------
 
 /// Typed, checked access to the keys of one JSON object at a location of the scene.

@@ -137,15 +137,6 @@ class DuplicateKeyCheck {
   std::vector<std::set<std::string>> keys_;
 };
 
-std::string plainMessage(const json::exception& e) {
-  std::string m = e.what();
-  if (!m.empty() && m[0] == '[') {
-    const auto close = m.find("] ");
-    if (close != std::string::npos) m = m.substr(close + 2);
-  }
-  return m;
-}
-
 }  // namespace
 
 KinematicsScene parseKinematicsScene(const json& j) {

@@ -498,16 +498,6 @@ class PathTracker {
   std::vector<Frame> stack_;
 };
 
-/// nlohmann's message without its "[json.exception.xxx.nnn] " prefix.
-std::string plainMessage(const json::exception& e) {
-  std::string m = e.what();
-  if (!m.empty() && m[0] == '[') {
-    const auto close = m.find("] ");
-    if (close != std::string::npos) m = m.substr(close + 2);
-  }
-  return m;
-}
-
 }  // namespace
 
 // ----- public API ------------------------------------------------------------------------------

@@ -19,16 +19,17 @@
 #include "core/errors.hpp"
 #include "elements/beam_element_2d.hpp"
 #include "elements/beam_section.hpp"
+#include "tests/test_support.hpp"
 
 namespace flexmbd {
 namespace {
+
+using namespace testsupport;
 
 using Vec6 = BeamElement2d::Vec6;
 using Row6 = BeamElement2d::Row6;
 using Mat6 = BeamElement2d::Mat6;
 using Mat26 = BeamElement2d::Mat26;
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Fixed seed: the random states are the same on every run (reproducible).
 constexpr unsigned kSeed = 20240611u;
@@ -60,37 +61,6 @@ constexpr double kFdStepFraction = 1e-5;
 // a missing term of the stiffening (v'^2/2 ~ 5e-5 against strains ~ 1e-3) or a wrong
 // factor is >= ~1e-3 relative (dropping eps b^T b from the Hessian was checked to fail).
 constexpr double kFdTol = 1e-7;
-
-/// Seeded random numbers.
-class Random {
- public:
-  explicit Random(unsigned seed) : gen_(seed) {}
-  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(gen_); }
-
- private:
-  std::mt19937 gen_;
-};
-
-std::string show(const MatX& A) {
-  std::ostringstream os;
-  os.precision(12);
-  os << A;
-  return os.str();
-}
-
-/// max |A - B| <= tol * max(floor, max |A|, max |B|); prints both on failure.
-double expectMatrixNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what,
-                        double floor = 0.0) {
-  EXPECT_EQ(analytic.rows(), reference.rows()) << what;
-  EXPECT_EQ(analytic.cols(), reference.cols()) << what;
-  if (analytic.rows() != reference.rows() || analytic.cols() != reference.cols()) return 1.0;
-  const double scale = std::max({floor, analytic.cwiseAbs().maxCoeff(), reference.cwiseAbs().maxCoeff(), 1e-300});
-  const double err = (analytic - reference).cwiseAbs().maxCoeff();
-  EXPECT_LE(err, tol * scale) << what << " (relative error " << err / scale << ")\nanalytic:\n"
-                              << show(analytic) << "\nreference:\n"
-                              << show(reference);
-  return err / scale;
-}
 
 /// Gauss-Legendre rule with n points on [0, 1] (Golub-Welsch: eigenvalues of the
 /// Jacobi matrix of the Legendre polynomials), independent of the element's own rule.
@@ -501,16 +471,6 @@ TEST(BeamElement2d, SectionForcesOfStretchAndConstantCurvature) {
 }
 
 // ----- input checks -------------------------------------------------------------------
-
-void expectInputError(const std::function<void()>& f, const std::vector<std::string>& fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown; expected one mentioning '" << fragments.front() << "'";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    for (const std::string& frag : fragments) EXPECT_NE(msg.find(frag), std::string::npos) << "message: " << msg;
-  }
-}
 
 TEST(BeamElement2d, RejectsBadInputNamingTheOwner) {
   const std::string owner = "body 'rod': element 3";

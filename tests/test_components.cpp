@@ -22,11 +22,13 @@
 #include "integrators/initial_conditions.hpp"
 #include "joints/drivers.hpp"
 #include "joints/prismatic_joint.hpp"
+#include "tests/test_support.hpp"
 
 namespace flexmbd {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace testsupport;
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -50,23 +52,6 @@ constexpr double kSolveTol = 1e-10;
 // kinematic sensitivity of the slider (<= ~10 for l2 / l1 = 2 away from dead
 // centres) and by the velocity / acceleration solves: 1e-9 is safe.
 constexpr double kClosedFormTol = 1e-9;
-
-class Random {
- public:
-  explicit Random(unsigned seed) : gen_(seed) {}
-  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(gen_); }
-  double angle() { return uniform(-kPi, kPi); }
-  Vec2 vec2(double a, double b) { return Vec2(uniform(a, b), uniform(a, b)); }
-  VecX frame() { return Eigen::Vector3d(uniform(-3.0, 3.0), uniform(-3.0, 3.0), angle()); }
-  VecX vector(int n, double a, double b) {
-    VecX x(n);
-    for (int k = 0; k < n; ++k) x[k] = uniform(a, b);
-    return x;
-  }
-
- private:
-  std::mt19937 gen_;
-};
 
 RigidBodyProperties randomProperties(Random& rnd) {
   RigidBodyProperties p;

@@ -30,11 +30,12 @@
 #include "bodies/ffr_invariants.hpp"
 #include "core/errors.hpp"
 #include "elements/beam_element_2d.hpp"
+#include "tests/test_support.hpp"
 
 namespace flexmbd {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace testsupport;
 
 // Fixed seed: the random configurations are the same on every run (reproducible).
 constexpr unsigned kSeed = 20240611u;
@@ -77,63 +78,6 @@ constexpr double kFdTol = 1e-7;
 constexpr double kLagrangeStep = 1e-5;
 constexpr double kLagrangeTol = 1e-8;
 
-/// Seeded random numbers.
-class Random {
- public:
-  explicit Random(unsigned seed) : gen_(seed) {}
-  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(gen_); }
-  VecX vector(int n, double a, double b) {
-    VecX x(n);
-    for (int k = 0; k < n; ++k) x[k] = uniform(a, b);
-    return x;
-  }
-
- private:
-  std::mt19937 gen_;
-};
-
-std::string show(const MatX& A) {
-  std::ostringstream os;
-  os.precision(10);
-  os << A;
-  return os.str();
-}
-
-/// max |A - B| <= tol * max(floor, max |A|, max |B|); returns the relative error.
-double expectMatrixNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what,
-                        double floor = 0.0) {
-  EXPECT_EQ(analytic.rows(), reference.rows()) << what;
-  EXPECT_EQ(analytic.cols(), reference.cols()) << what;
-  if (analytic.rows() != reference.rows() || analytic.cols() != reference.cols()) return 1.0;
-  if (analytic.size() == 0) return 0.0;
-  const double scale = std::max({floor, analytic.cwiseAbs().maxCoeff(), reference.cwiseAbs().maxCoeff(), 1e-300});
-  const double err = (analytic - reference).cwiseAbs().maxCoeff();
-  EXPECT_LE(err, tol * scale) << what << " (relative error " << err / scale << ")\nanalytic:\n"
-                              << show(analytic) << "\nreference:\n"
-                              << show(reference);
-  return err / scale;
-}
-
-/// Row by row: max_j |A_ij - B_ij| <= tol * max(1, max_j |A_ij|, max_j |B_ij|).
-/// Rows of very different size (frame rows ~1, elastic rows ~ stiffness) are each
-/// compared on their own scale. Returns the largest relative error.
-double expectRowsNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what) {
-  EXPECT_EQ(analytic.rows(), reference.rows()) << what;
-  EXPECT_EQ(analytic.cols(), reference.cols()) << what;
-  if (analytic.rows() != reference.rows() || analytic.cols() != reference.cols()) return 1.0;
-  double worst = 0.0;
-  for (int i = 0; i < analytic.rows(); ++i) {
-    const double scale =
-        std::max({1.0, analytic.row(i).cwiseAbs().maxCoeff(), reference.row(i).cwiseAbs().maxCoeff()});
-    const double err = (analytic.row(i) - reference.row(i)).cwiseAbs().maxCoeff() / scale;
-    worst = std::max(worst, err);
-    EXPECT_LE(err, tol) << what << ", row " << i << "\nanalytic:\n"
-                        << show(analytic.row(i)) << "\nreference:\n"
-                        << show(reference.row(i));
-  }
-  return worst;
-}
-
 /// Steps for differences with respect to the coordinates q = (x, y, theta, q_f).
 VecX coordinateSteps(const VecX& q) {
   VecX h(q.size());
@@ -145,24 +89,6 @@ VecX coordinateSteps(const VecX& q) {
 /// Steps for differences with respect to the velocities (functions quadratic in v).
 VecX velocitySteps(const VecX& v) { return kFdVelocityStep * (VecX::Ones(v.size()) + v.cwiseAbs()); }
 
-/// Central-difference Jacobian (m x n) of f at x with the steps h.
-MatX fdJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x, const VecX& steps) {
-  const VecX f0 = f(x);
-  MatX J(f0.size(), x.size());
-  for (int k = 0; k < x.size(); ++k) {
-    const double h = steps[k];
-    VecX xp = x, xm = x;
-    xp[k] += h;
-    xm[k] -= h;
-    J.col(k) = (f(xp) - f(xm)) / (2.0 * h);
-  }
-  return J;
-}
-
-VecX fdGradient(const std::function<double(const VecX&)>& f, const VecX& x, const VecX& steps) {
-  return fdJacobian([&](const VecX& z) { return VecX::Constant(1, f(z)); }, x, steps).transpose();
-}
-
 /// Gauss-Legendre rule with n points on [0, 1] (Golub-Welsch), exact to degree 2n-1.
 void gaussRule(int n, std::vector<double>& xi, std::vector<double>& w) {
   MatX J = MatX::Zero(n, n);
@@ -173,16 +99,6 @@ void gaussRule(int n, std::vector<double>& xi, std::vector<double>& w) {
   for (int k = 0; k < n; ++k) {
     xi[k] = 0.5 * (es.eigenvalues()[k] + 1.0);
     w[k] = es.eigenvectors()(0, k) * es.eigenvectors()(0, k);
-  }
-}
-
-void expectInputError(const std::function<void()>& f, const std::vector<std::string>& fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "no InputError thrown; expected one mentioning '" << fragments.front() << "'";
-  } catch (const InputError& e) {
-    const std::string msg = e.what();
-    for (const std::string& frag : fragments) EXPECT_NE(msg.find(frag), std::string::npos) << "message: " << msg;
   }
 }
 

@@ -33,6 +33,7 @@
 #include "joints/fixed_joint.hpp"
 #include "joints/prismatic_joint.hpp"
 #include "joints/revolute_joint.hpp"
+#include "tests/test_support.hpp"
 
 namespace flexmbd {
 
@@ -41,7 +42,7 @@ void PrintTo(Formulation f, std::ostream* os) { *os << toString(f); }
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using namespace testsupport;
 
 // Fixed seed: the random configurations are the same on every run (reproducible).
 constexpr unsigned kSeed = 20240611u;
@@ -71,65 +72,18 @@ constexpr double kRoundoffTol = 1e-12;
 
 double fdStep(double x) { return kFdRelStep * (1.0 + std::abs(x)); }
 
-/// Central-difference Jacobian (m x n) of f: R^n -> R^m at x.
+/// Central differences with the steps fdStep.
 MatX fdJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x) {
-  const VecX f0 = f(x);
-  MatX J(f0.size(), x.size());
-  for (int k = 0; k < x.size(); ++k) {
-    const double h = fdStep(x[k]);
-    VecX xp = x, xm = x;
-    xp[k] += h;
-    xm[k] -= h;
-    J.col(k) = (f(xp) - f(xm)) / (2.0 * h);
-  }
-  return J;
+  return testsupport::fdJacobian(f, x, relativeSteps(x, kFdRelStep));
 }
-
-/// Central-difference gradient (as a column) of a scalar function.
 VecX fdGradient(const std::function<double(const VecX&)>& f, const VecX& x) {
-  return fdJacobian([&](const VecX& z) { return VecX::Constant(1, f(z)); }, x).transpose();
+  return testsupport::fdGradient(f, x, relativeSteps(x, kFdRelStep));
 }
 
-std::string show(const MatX& A) {
-  std::ostringstream os;
-  os.precision(10);
-  os << A;
-  return os.str();
+/// Entries compared relative to max(1, largest entry): the values here are O(1..1e3).
+void expectNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what) {
+  expectMatrixNear(analytic, reference, tol, what, 1.0);
 }
-
-/// max |A - B| <= tol * max(1, max |A|, max |B|); prints both on failure.
-void expectMatrixNear(const MatX& analytic, const MatX& reference, double tol,
-                      const std::string& what) {
-  ASSERT_EQ(analytic.rows(), reference.rows()) << what;
-  ASSERT_EQ(analytic.cols(), reference.cols()) << what;
-  if (analytic.size() == 0) return;
-  const double scale =
-      std::max({1.0, analytic.cwiseAbs().maxCoeff(), reference.cwiseAbs().maxCoeff()});
-  const double err = (analytic - reference).cwiseAbs().maxCoeff();
-  EXPECT_LE(err, tol * scale) << what << "\nanalytic:\n"
-                              << show(analytic) << "\nreference:\n"
-                              << show(reference);
-}
-
-/// Seeded random numbers for configurations.
-class Random {
- public:
-  explicit Random(unsigned seed) : gen_(seed) {}
-  double uniform(double a, double b) { return std::uniform_real_distribution<double>(a, b)(gen_); }
-  /// An angle anywhere on the circle.
-  double angle() { return uniform(-kPi, kPi); }
-  Vec2 vec2(double a, double b) { return Vec2(uniform(a, b), uniform(a, b)); }
-  /// A frame state (x, y, theta) with the origin off the world origin.
-  VecX frame() { return Eigen::Vector3d(uniform(-3.0, 3.0), uniform(-3.0, 3.0), angle()); }
-  VecX vector(int n, double a, double b) {
-    VecX x(n);
-    for (int k = 0; k < n; ++k) x[k] = uniform(a, b);
-    return x;
-  }
-
- private:
-  std::mt19937 gen_;
-};
 
 RigidBodyProperties randomProperties(Random& rnd) {
   RigidBodyProperties p;
@@ -160,8 +114,8 @@ TEST(RigidBodyJacobians, PointKinematicsFirstAndSecondDerivatives) {
           return VecX(Eigen::Vector3d(p.r.x(), p.r.y(), p.phi));
         },
         q);
-    expectMatrixNear(pk.Jr, Jfd.topRows(2), kFdTol, "Jr, " + at);
-    expectMatrixNear(pk.Jphi, Jfd.row(2), kFdTol, "Jphi, " + at);
+    expectNear(pk.Jr, Jfd.topRows(2), kFdTol, "Jr, " + at);
+    expectNear(pk.Jphi, Jfd.row(2), kFdTol, "Jphi, " + at);
 
     // Hessians = d(J rows)/dq
     auto rowOf = [&](int which) {
@@ -171,12 +125,12 @@ TEST(RigidBodyJacobians, PointKinematicsFirstAndSecondDerivatives) {
         return p.Jphi.transpose();
       };
     };
-    expectMatrixNear(pk.Hrx, fdJacobian(rowOf(0), q), kFdTol, "Hrx, " + at);
-    expectMatrixNear(pk.Hry, fdJacobian(rowOf(1), q), kFdTol, "Hry, " + at);
-    expectMatrixNear(pk.Hphi, fdJacobian(rowOf(2), q), kFdTol, "Hphi, " + at);
+    expectNear(pk.Hrx, fdJacobian(rowOf(0), q), kFdTol, "Hrx, " + at);
+    expectNear(pk.Hry, fdJacobian(rowOf(1), q), kFdTol, "Hry, " + at);
+    expectNear(pk.Hphi, fdJacobian(rowOf(2), q), kFdTol, "Hphi, " + at);
     // hessianR(w) is the w-weighted sum
     const Vec2 w = rnd.vec2(-2.0, 2.0);
-    expectMatrixNear(pk.hessianR(w), w.x() * pk.Hrx + w.y() * pk.Hry, kRoundoffTol,
+    expectNear(pk.hessianR(w), w.x() * pk.Hrx + w.y() * pk.Hry, kRoundoffTol,
                      "hessianR, " + at);
   }
 }
@@ -192,7 +146,7 @@ TEST(RigidBodyJacobians, MassMatrixDerivative) {
     MatX K = K0;
     body.addMassMatrixDerivative(q, a, K);
     const MatX Kfd = fdJacobian([&](const VecX& z) -> VecX { return body.massMatrix(z) * a; }, q);
-    expectMatrixNear(K - K0, Kfd, kFdTol, "d(M a)/dq, sample " + std::to_string(s));
+    expectNear(K - K0, Kfd, kFdTol, "d(M a)/dq, sample " + std::to_string(s));
   }
 }
 
@@ -210,9 +164,9 @@ TEST(RigidBodyJacobians, InternalForceJacobians) {
     MatX dQdq = MatX::Zero(3, 3), dQdv = MatX::Zero(3, 3);
     body.addInternalForceJacobians(q, v, dQdq, dQdv);
     const std::string at = "sample " + std::to_string(s);
-    expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, v); }, q), kFdTol,
+    expectNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, v); }, q), kFdTol,
                      "dQ/dq, " + at);
-    expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return Q(q, z); }, v), kFdTol,
+    expectNear(dQdv, fdJacobian([&](const VecX& z) { return Q(q, z); }, v), kFdTol,
                      "dQ/dv, " + at);
   }
 }
@@ -231,10 +185,10 @@ TEST(RigidBodyJacobians, GravityJacobianAndPotential) {
     MatX K = MatX::Zero(3, 3);
     body.addGravityJacobian(q, g, K);
     const std::string at = "sample " + std::to_string(s);
-    expectMatrixNear(K, fdJacobian(Q, q), kFdTol, "d(gravity)/dq, " + at);
+    expectNear(K, fdJacobian(Q, q), kFdTol, "d(gravity)/dq, " + at);
     // A conservative force: Q_g = -dV/dq.
     const VecX gradV = fdGradient([&](const VecX& z) { return body.gravityPotential(z, g); }, q);
-    expectMatrixNear(Q(q), -gradV, kFdTol, "gravity force vs -dV/dq, " + at);
+    expectNear(Q(q), -gradV, kFdTol, "gravity force vs -dV/dq, " + at);
   }
 }
 
@@ -273,15 +227,15 @@ void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const Vec
     con.evaluate(sys.constraintStates(ci, qg.data()), false, e);
     return e;
   };
-  expectMatrixNear(ev.G, fdJacobian([&](const VecX& z) { return evalAt(z).h; }, ql), kFdTol,
+  expectNear(ev.G, fdJacobian([&](const VecX& z) { return evalAt(z).h; }, ql), kFdTol,
                    "G vs FD of h, " + who);
   for (int a = 0; a < me; ++a) {
     ASSERT_EQ(ev.H[a].rows(), nl) << who;
     ASSERT_EQ(ev.H[a].cols(), nl) << who;
     const MatX Hfd = fdJacobian(
         [&](const VecX& z) -> VecX { return evalAt(z).G.row(a).transpose(); }, ql);
-    expectMatrixNear(ev.H[a], Hfd, kFdTol, "H_" + std::to_string(a) + " vs FD of G row, " + who);
-    expectMatrixNear(ev.H[a], ev.H[a].transpose(), kSymmetryTol,
+    expectNear(ev.H[a], Hfd, kFdTol, "H_" + std::to_string(a) + " vs FD of G row, " + who);
+    expectNear(ev.H[a], ev.H[a].transpose(), kSymmetryTol,
                      "H_" + std::to_string(a) + " symmetric, " + who);
   }
 }
@@ -371,9 +325,9 @@ void checkForceDerivatives(const System& sys, ForceIndex fi, double t, const Vec
   force.addForce(t, sys.forceStates(fi, q.data()), vl, Qj, &dQdq, &dQdv);
   // The force itself does not depend on whether Jacobians are requested.
   EXPECT_TRUE(Qj == Q(ql, vl)) << who;
-  expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, vl); }, ql), kFdTol,
+  expectNear(dQdq, fdJacobian([&](const VecX& z) { return Q(z, vl); }, ql), kFdTol,
                    "dQ/dq, " + who);
-  expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return Q(ql, z); }, vl), kFdTol,
+  expectNear(dQdv, fdJacobian([&](const VecX& z) { return Q(ql, z); }, vl), kFdTol,
                    "dQ/dv, " + who);
 }
 
@@ -400,7 +354,7 @@ void checkForceIsEnergyGradient(const System& sys, ForceIndex fi, const VecX& q,
         return force.potentialEnergy(sys.forceStates(fi, qg.data()));
       },
       ql);
-  expectMatrixNear(Q, -gradV, kFdTol, "Q vs -dV/dq, " + who);
+  expectNear(Q, -gradV, kFdTol, "Q vs -dV/dq, " + who);
 }
 
 struct ForceCase {
@@ -509,7 +463,7 @@ TEST(ForceJacobians, AppliedLoadIsTheVirtualWorkOfForceAndTorque) {
                   std::sin(th) * u.x() + std::cos(th) * u.y());
     const Vec2 f(F->evaluate(t).f, Fy->evaluate(t).f);
     const VecX expected = Eigen::Vector3d(f.x(), f.y(), au.x() * f.y() - au.y() * f.x() + tau->evaluate(t).f);
-    expectMatrixNear(Q, expected, kRoundoffTol, "applied load, sample " + std::to_string(s));
+    expectNear(Q, expected, kRoundoffTol, "applied load, sample " + std::to_string(s));
   }
 }
 
@@ -634,26 +588,6 @@ MatX fdIterationMatrix(const DaeSystem& dae, double t, const VecX& y, const VecX
     J.col(k) += cj * (Fp - Fm) / (2.0 * hp);
   }
   return J;
-}
-
-/// Row by row: |A - B| <= tol * max(1, largest entry of the row in A or B) (the rows
-/// of the DAE have very different scales: cj, masses, stiffnesses).
-void expectRowsNear(const MatX& analytic, const MatX& reference, double tol, const std::string& what) {
-  ASSERT_EQ(analytic.rows(), reference.rows());
-  ASSERT_EQ(analytic.cols(), reference.cols());
-  int failures = 0;
-  for (int i = 0; i < analytic.rows(); ++i) {
-    const double scale = std::max({1.0, analytic.row(i).cwiseAbs().maxCoeff(),
-                                   reference.row(i).cwiseAbs().maxCoeff()});
-    for (int j = 0; j < analytic.cols(); ++j) {
-      const double err = std::abs(analytic(i, j) - reference(i, j));
-      if (!(err <= tol * scale) && failures++ < 10) {
-        ADD_FAILURE() << what << ": entry (" << i << ", " << j << ") analytic " << analytic(i, j)
-                      << " vs finite differences " << reference(i, j) << " (row scale " << scale << ")";
-      }
-    }
-  }
-  EXPECT_EQ(failures, 0) << what << ": entries outside tolerance";
 }
 
 class DaeJacobian : public ::testing::TestWithParam<Formulation> {};
