@@ -13,6 +13,7 @@
 
 #include "benchmarks/bench_common.hpp"
 #include "benchmarks/bench_scenes.hpp"
+#include "integrators/ida_solver.hpp"
 #include "integrators/initial_conditions.hpp"
 
 using namespace flexmbd;
@@ -37,7 +38,7 @@ void runCase(Case& c, double rtol, double span, LinearSolverKind solver) {
   dae.packState(init.q, init.v, init.a, init.lambda, y0, yp0);
   IntegratorOptions o;
   o.rtol = rtol;
-  o.atolPosition = o.atolVelocity = atolFor(rtol);
+  o.atol = absoluteTolerances(dae, s.solver);
   o.maxSteps = 100000000;
   o.minStepSize = 1e-12 * span;
   o.linearSolver = solver;

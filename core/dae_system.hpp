@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/dae_problem.hpp"
 #include "core/sparse_pattern.hpp"
 #include "core/system.hpp"
 
@@ -35,7 +36,7 @@ struct DaeLayout {
 /// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985):
 ///   F_q  = q' - v + G^T mu,  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),  F_gv = G v + g_t.
 /// Index 3 drops mu and F_gv; index 1 replaces F_g by G v' + (G v)_q v + g_tt.
-class DaeSystem {
+class DaeSystem final : public DaeProblem {
  public:
   /// @throws InputError if the system is not finalized.
   DaeSystem(const System& sys, Formulation formulation);
@@ -44,18 +45,19 @@ class DaeSystem {
   Formulation formulation() const { return formulation_; }
   const DaeLayout& layout() const { return layout_; }
   /// Pattern of dF/dy + cj dF/dy', fixed for the whole run.
-  const SparsePattern& pattern() const { return pattern_; }
+  int size() const override { return layout_.size; }
+  const SparsePattern& pattern() const override { return pattern_; }
   /// 1 for differential, 0 for variables excluded from the error test (multipliers;
   /// for index 3 also the velocities, which are index-2 variables there).
-  VecX differentialIds() const;
+  VecX differentialIds() const override;
 
-  void residual(double t, const double* y, const double* yp, double* F) const;
-  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const;
+  void residual(double t, const double* y, const double* yp, double* F) const override;
+  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const override;
 
   /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
   /// the positions and velocities of elastic coordinates, 1 for frame coordinates
   /// (coupled to their whole body) and multipliers (zero diagonal), to be eliminated last.
-  std::vector<int64_t> eliminationGroups() const;
+  std::vector<int64_t> eliminationGroups() const override;
 
   /// y and y' from positions, velocities, accelerations and multipliers (mu = 0).
   void packState(const VecX& q, const VecX& v, const VecX& a, const VecX& lambda, VecX& y,

@@ -18,23 +18,6 @@
 
 namespace flexmbd {
 
-std::string toString(LinearSolverKind k) {
-  switch (k) {
-    case LinearSolverKind::Automatic: return "auto";
-    case LinearSolverKind::Dense: return "dense";
-    case LinearSolverKind::Klu: return "klu";
-  }
-  return "?";
-}
-
-LinearSolverKind parseLinearSolver(const std::string& name) {
-  if (name == "auto") return LinearSolverKind::Automatic;
-  if (name == "dense") return LinearSolverKind::Dense;
-  if (name == "klu") return LinearSolverKind::Klu;
-  throw InputError("solver.linear_solver: unknown linear solver '" + name +
-                   "' (expected one of: auto, dense, klu)");
-}
-
 namespace {
 
 std::string flagName(long flag) {
@@ -47,7 +30,7 @@ std::string flagName(long flag) {
 }  // namespace
 
 struct IdaSolver::Impl {
-  const DaeSystem* dae = nullptr;
+  const DaeProblem* dae = nullptr;
   SUNContext ctx = nullptr;
   void* mem = nullptr;
   N_Vector yy = nullptr, yp = nullptr, atol = nullptr, id = nullptr;
@@ -125,19 +108,17 @@ struct IdaSolver::Impl {
 
 static_assert(sizeof(sunindextype) == sizeof(int64_t), "SUNDIALS built with 64-bit indices expected");
 
-IdaSolver::IdaSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX& yp0,
+IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0,
                      const IntegratorOptions& o)
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   d.dae = &dae;
-  const DaeLayout& L = dae.layout();
-  const int n = L.size;
+  const int n = dae.size();
   if (y0.size() != n || yp0.size() != n) {
     throw InputError("IdaSolver: y0 and yp0 must have the DAE size " + std::to_string(n));
   }
-  if (!(o.rtol > 0.0) || !(o.atolPosition > 0.0) || !(o.atolVelocity > 0.0) || !(o.atolMultiplier > 0.0)) {
-    throw InputError("solver: tolerances must be positive");
-  }
+  if (o.atol.size() != n) throw InputError("IdaSolver: atol must have the DAE size " + std::to_string(n));
+  if (!(o.rtol > 0.0) || !(o.atol.minCoeff() > 0.0)) throw InputError("solver: tolerances must be positive");
   d.check(SUNContext_Create(nullptr, &d.ctx), "SUNContext_Create");
   d.yy = N_VNew_Serial(n, d.ctx);
   d.yp = N_VNew_Serial(n, d.ctx);
@@ -146,10 +127,7 @@ IdaSolver::IdaSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX
   if (!d.yy || !d.yp || !d.atol || !d.id) throw SolverError("IDA set-up: out of memory", t0, 0.0);
   Eigen::Map<VecX>(N_VGetArrayPointer(d.yy), n) = y0;
   Eigen::Map<VecX>(N_VGetArrayPointer(d.yp), n) = yp0;
-  Eigen::Map<VecX> atol(N_VGetArrayPointer(d.atol), n);
-  atol.setConstant(o.atolMultiplier);
-  atol.segment(L.q, L.nq).setConstant(o.atolPosition);
-  atol.segment(L.v, L.nq).setConstant(o.atolVelocity);
+  Eigen::Map<VecX>(N_VGetArrayPointer(d.atol), n) = o.atol;
   Eigen::Map<VecX>(N_VGetArrayPointer(d.id), n) = dae.differentialIds();
 
   d.mem = IDACreate(d.ctx);

@@ -127,6 +127,18 @@ void SolverSettings::validate() const {
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
 }
 
+/// Multipliers: large, so that the algebraic variables (already out of the error test)
+/// stay out of the Newton convergence test too.
+constexpr double kAtolMultiplier = 1e10;
+
+VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
+  const DaeLayout& L = dae.layout();
+  VecX atol = VecX::Constant(L.size, kAtolMultiplier);
+  atol.segment(L.q, L.nq).setConstant(settings.atol);
+  atol.segment(L.v, L.nq).setConstant(settings.atolVelocity.value_or(settings.atol));
+  return atol;
+}
+
 SimulationSummary simulate(const System& sys, const SolverSettings& settings,
                            const OutputCallback& onOutput) {
   settings.validate();
@@ -176,8 +188,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
 
   IntegratorOptions o;
   o.rtol = settings.rtol;
-  o.atolPosition = settings.atol;
-  o.atolVelocity = settings.atolVelocity.value_or(settings.atol);
+  o.atol = absoluteTolerances(dae, settings);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
@@ -185,7 +196,8 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.minStepSize = settings.minStepSize.value_or(1e-12 * (tEnd - t0));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
-  IdaSolver ida(dae, t0, y0, yp0, o);
+  const std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(settings.integrator, dae, t0, y0, yp0, o);
+  DaeIntegrator& ida = *integrator;
   summary.usedKlu = ida.usesKlu();
 
   ProgressReporter progress(settings.progress, t0, tEnd);

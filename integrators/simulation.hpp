@@ -7,12 +7,13 @@
 #include <string>
 
 #include "core/dae_system.hpp"
-#include "integrators/ida_solver.hpp"
+#include "integrators/dae_integrator.hpp"
 
 namespace flexmbd {
 
 struct SolverSettings {
   Formulation formulation = Formulation::Ggl;
+  IntegratorKind integrator = IntegratorKind::Ida;
   double rtol = 1e-8;
   double atol = 1e-10;            ///< positions; velocities too unless atolVelocity set
   std::optional<double> atolVelocity;
@@ -35,6 +36,10 @@ struct SolverSettings {
   /// @throws InputError naming the solver key that is out of range.
   void validate() const;
 };
+
+/// Absolute tolerance of every unknown of the DAE for these settings (positions,
+/// velocities; multipliers out of the error and convergence tests).
+VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings);
 
 /// One output instant: positions, velocities, accelerations, multipliers.
 struct OutputSample {

@@ -402,8 +402,16 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
   r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
-               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian"});
+               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian", "integrator"});
   SolverSettings s;
+  if (r.has("integrator")) {
+    const std::string name = r.string("integrator");
+    try {
+      s.integrator = parseIntegrator(name);
+    } catch (const InputError&) {
+      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: ida, radau5)");
+    }
+  }
   if (r.has("formulation")) {
     const std::string f = r.string("formulation");
     try {

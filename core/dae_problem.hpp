@@ -1,0 +1,37 @@
+// The interface the time integrators see: a DAE F(t, y, y') = 0 with a fixed sparse
+// Jacobian pattern. The engine's assembled model (DaeSystem) is one; the hand-coded
+// benchmark problems are others, integrated by the same integrators.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/sparse_pattern.hpp"
+#include "core/types.hpp"
+
+namespace flexmbd {
+
+class DaeProblem {
+ public:
+  virtual ~DaeProblem() = default;
+
+  /// Number of unknowns n of y (and of equations in F).
+  virtual int size() const = 0;
+  /// Pattern of dF/dy + cj dF/dy' (square, n), fixed for the whole run.
+  virtual const SparsePattern& pattern() const = 0;
+  /// Per unknown: 1 if it takes part in the local error test (differential), 0 if not
+  /// (multipliers and other algebraic variables).
+  virtual VecX differentialIds() const = 0;
+  /// Elimination groups for KLU's constrained ordering (see klu_ordering.hpp); size n.
+  /// Default: one group (KLU's own ordering).
+  virtual std::vector<int64_t> eliminationGroups() const { return {}; }
+
+  /// F = F(t, y, y'); y, y', F of size n. Must not allocate after the first call.
+  virtual void residual(double t, const double* y, const double* yp, double* F) const = 0;
+  /// J += dF/dy + cj dF/dy' at the pattern's positions. J(cj = 0) is dF/dy, and
+  /// J(1) - J(0) is dF/dy' (used by integrators that need the two apart).
+  virtual void jacobian(double t, const double* y, const double* yp, double cj,
+                        JacobianSink& J) const = 0;
+};
+
+}  // namespace flexmbd
