@@ -4,12 +4,21 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/sparse_pattern.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
+
+/// Scratch memory of one evaluating thread (an integrator owns one): what a residual or
+/// Jacobian needs besides its arguments, sized from the model once, so that evaluations
+/// allocate nothing and the problem itself holds no mutable state.
+class DaeScratch {
+ public:
+  virtual ~DaeScratch() = default;
+};
 
 class DaeProblem {
  public:
@@ -26,12 +35,23 @@ class DaeProblem {
   /// Default: one group (KLU's own ordering).
   virtual std::vector<int64_t> eliminationGroups() const { return {}; }
 
-  /// F = F(t, y, y'); y, y', F of size n. Must not allocate after the first call.
-  virtual void residual(double t, const double* y, const double* yp, double* F) const = 0;
+  /// Scratch for residual() and jacobian(), made once per integrator (or thread).
+  virtual std::unique_ptr<DaeScratch> makeScratch() const { return std::make_unique<DaeScratch>(); }
+
+  /// F = F(t, y, y'); y, y', F of size n. Allocates nothing (scratch from makeScratch()).
+  virtual void residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const = 0;
   /// J += dF/dy + cj dF/dy' at the pattern's positions. J(cj = 0) is dF/dy, and
   /// J(1) - J(0) is dF/dy' (used by integrators that need the two apart).
-  virtual void jacobian(double t, const double* y, const double* yp, double cj,
-                        JacobianSink& J) const = 0;
+  virtual void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                        DaeScratch& scratch) const = 0;
+
+  /// The same with a scratch made for the call (tests, tools; allocates).
+  void residual(double t, const double* y, const double* yp, double* F) const {
+    residual(t, y, yp, F, *makeScratch());
+  }
+  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const {
+    jacobian(t, y, yp, cj, J, *makeScratch());
+  }
 };
 
 }  // namespace flexmbd

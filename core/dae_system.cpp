@@ -95,7 +95,7 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
   yp.segment(L.v, L.nq) = a;
 }
 
-void DaeSystem::residual(double t, const double* y, const double* yp, double* F) const {
+void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch&) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), qp(yp + L.q, L.nq), vp(yp + L.v, L.nq);
@@ -158,8 +158,8 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F)
   }
 }
 
-void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
-                         JacobianSink& J) const {
+void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                         DaeScratch&) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), vp(yp + L.v, L.nq);

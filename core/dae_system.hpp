@@ -51,8 +51,11 @@ class DaeSystem final : public DaeProblem {
   /// for index 3 also the velocities, which are index-2 variables there).
   VecX differentialIds() const override;
 
-  void residual(double t, const double* y, const double* yp, double* F) const override;
-  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J) const override;
+  using DaeProblem::jacobian;
+  using DaeProblem::residual;
+  void residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const override;
+  void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                DaeScratch& scratch) const override;
 
   /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
   /// the positions and velocities of elastic coordinates, 1 for frame coordinates

@@ -31,6 +31,7 @@ std::string flagName(long flag) {
 
 struct IdaSolver::Impl {
   const DaeProblem* dae = nullptr;
+  std::unique_ptr<DaeScratch> scratch;
   SUNContext ctx = nullptr;
   void* mem = nullptr;
   N_Vector yy = nullptr, yp = nullptr, atol = nullptr, id = nullptr;
@@ -60,7 +61,7 @@ struct IdaSolver::Impl {
   static int residual(realtype t, N_Vector y, N_Vector yp, N_Vector r, void* user) {
     auto* self = static_cast<Impl*>(user);
     try {
-      self->dae->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r));
+      self->dae->residual(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(r), *self->scratch);
       const double* F = N_VGetArrayPointer(r);
       const auto n = N_VGetLength(r);
       for (sunindextype k = 0; k < n; ++k) {
@@ -87,11 +88,11 @@ struct IdaSolver::Impl {
         double* values = SUNSparseMatrix_Data(J);
         std::fill(values, values + p.nonZeros(), 0.0);
         JacobianSink sink = JacobianSink::sparse(values, p);
-        self->dae->jacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), cj, sink);
+        self->dae->jacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), cj, sink, *self->scratch);
       } else {
         SUNMatZero(J);
         JacobianSink sink = JacobianSink::dense(SUNDenseMatrix_Data(J), p.size());
-        self->dae->jacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), cj, sink);
+        self->dae->jacobian(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), cj, sink, *self->scratch);
       }
       return 0;
     } catch (...) {
@@ -113,6 +114,7 @@ IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const Vec
     : impl_(std::make_unique<Impl>()) {
   Impl& d = *impl_;
   d.dae = &dae;
+  d.scratch = dae.makeScratch();
   const int n = dae.size();
   if (y0.size() != n || yp0.size() != n) {
     throw InputError("IdaSolver: y0 and yp0 must have the DAE size " + std::to_string(n));
