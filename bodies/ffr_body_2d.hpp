@@ -39,6 +39,13 @@ class FfrBody2d final : public Body {
   int numCoordinates() const override { return 3 + inv_.numElastic(); }
   int numFrameCoordinates() const override { return 3; }
   std::vector<std::string> coordinateNames() const override;
+  /// x, y: positions; theta: angle; q_1..q_nf: elastic.
+  std::vector<CoordinateKind> coordinateKinds() const override {
+    std::vector<CoordinateKind> k(numCoordinates(), CoordinateKind::Elastic);
+    k[0] = k[1] = CoordinateKind::Position;
+    k[2] = CoordinateKind::Angle;
+    return k;
+  }
   VecX initialCoordinates() const override;
   VecX initialVelocities() const override;
   double mass() const override { return inv_.mass; }

@@ -32,6 +32,9 @@ class RigidBody2d final : public Body {
 
   int numCoordinates() const override { return 3; }
   std::vector<std::string> coordinateNames() const override { return {"x", "y", "theta"}; }
+  std::vector<CoordinateKind> coordinateKinds() const override {
+    return {CoordinateKind::Position, CoordinateKind::Position, CoordinateKind::Angle};
+  }
   VecX initialCoordinates() const override;
   VecX initialVelocities() const override;
   double mass() const override { return props_.mass; }

@@ -24,6 +24,9 @@ struct PointKinematics {
   MatX hessianR(const Vec2& w) const { return w.x() * Hrx + w.y() * Hry; }
 };
 
+/// What a coordinate measures; integrators scale their absolute tolerances by it.
+enum class CoordinateKind { Position, Angle, Elastic };
+
 /// A body contributes to the equations of motion  M(q) v' = Q(t, q, v) + ...
 /// All methods are const and pure: a body holds only constant data.
 class Body {
@@ -43,6 +46,13 @@ class Body {
   /// the rest are elastic. Consistent initialisation keeps the given elastic values and
   /// moves the frame coordinates (a body is not deformed to assemble the mechanism).
   virtual int numFrameCoordinates() const { return numCoordinates(); }
+  /// The kind of each coordinate (default: frame coordinates are positions, the others
+  /// elastic).
+  virtual std::vector<CoordinateKind> coordinateKinds() const {
+    std::vector<CoordinateKind> k(numCoordinates(), CoordinateKind::Elastic);
+    for (int i = 0; i < numFrameCoordinates(); ++i) k[i] = CoordinateKind::Position;
+    return k;
+  }
   /// Coordinates and velocities given at construction (initial guess).
   virtual VecX initialCoordinates() const = 0;
   virtual VecX initialVelocities() const = 0;

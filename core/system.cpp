@@ -1,5 +1,7 @@
 #include "core/system.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <set>
@@ -331,6 +333,32 @@ std::vector<int> System::frameCoordinates() const {
     for (int k = 0; k < bodies_[b]->numFrameCoordinates(); ++k) idx.push_back(bodyOffset_[b] + k);
   }
   return idx;
+}
+
+std::vector<CoordinateKind> System::coordinateKinds() const {
+  std::vector<CoordinateKind> kinds;
+  for (const auto& b : bodies_) {
+    for (CoordinateKind k : b->coordinateKinds()) kinds.push_back(k);
+  }
+  return kinds;
+}
+
+double System::characteristicLength() const {
+  double L = 0.0;
+  for (const auto& b : bodies_) {
+    const VecX q = b->initialCoordinates();
+    const auto kinds = b->coordinateKinds();
+    double r2 = 0.0;
+    for (int k = 0; k < q.size(); ++k) r2 += kinds[k] == CoordinateKind::Position ? q[k] * q[k] : 0.0;
+    L = std::max(L, std::sqrt(r2));
+  }
+  for (const auto& c : constraints_) {
+    for (const auto& [b, p] : c->attachments()) L = std::max(L, p.norm());
+  }
+  for (const auto& f : forces_) {
+    for (const auto& [b, p] : f->attachments()) L = std::max(L, p.norm());
+  }
+  return L > 0.0 ? L : 1.0;
 }
 
 std::vector<std::string> System::coordinateNames() const {

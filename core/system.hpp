@@ -93,6 +93,11 @@ class System {
   std::string describeEquation(int row) const;
   /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
   std::vector<int> frameCoordinates() const;
+  /// The kind of every coordinate, in order.
+  std::vector<CoordinateKind> coordinateKinds() const;
+  /// A length characteristic of the model: the largest distance of a body's initial
+  /// position or of an attachment point (body axes) from the origin; 1 if all are zero.
+  double characteristicLength() const;
   /// "crank.x", ... for every coordinate, in order.
   std::vector<std::string> coordinateNames() const;
 

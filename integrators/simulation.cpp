@@ -106,9 +106,9 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
 void SolverSettings::validate() const {
   requireSetting(rtol > 0.0 && std::isfinite(rtol), "rtol", "a positive number", rtol);
   requireSetting(atol > 0.0 && std::isfinite(atol), "atol", "a positive number", atol);
-  if (atolVelocity) {
-    requireSetting(*atolVelocity > 0.0 && std::isfinite(*atolVelocity), "atol_velocity",
-                   "a positive number", *atolVelocity);
+  for (const auto& [key, value] : {std::pair{"atol_velocity", atolVelocity}, std::pair{"atol_angle", atolAngle},
+                                    std::pair{"atol_elastic", atolElastic}}) {
+    if (value) requireSetting(*value > 0.0 && std::isfinite(*value), key, "a positive number", *value);
   }
   requireSetting(std::isfinite(tStart), "t_start", "a finite number", tStart);
   requireSetting(std::isfinite(tEnd) && tEnd > tStart, "t_end", "a number greater than t_start", tEnd);
@@ -133,9 +133,18 @@ constexpr double kAtolMultiplier = 1e10;
 
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
   const DaeLayout& L = dae.layout();
+  const System& sys = dae.system();
+  const double position = settings.atol;
+  const double angle = settings.atolAngle.value_or(position);
+  const double elastic = settings.atolElastic.value_or(position);
+  const double velocityRatio = settings.atolVelocity.value_or(position) / position;
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
   VecX atol = VecX::Constant(L.size, kAtolMultiplier);
-  atol.segment(L.q, L.nq).setConstant(settings.atol);
-  atol.segment(L.v, L.nq).setConstant(settings.atolVelocity.value_or(settings.atol));
+  for (int k = 0; k < L.nq; ++k) {
+    const double a = kinds[k] == CoordinateKind::Position ? position : kinds[k] == CoordinateKind::Angle ? angle : elastic;
+    atol[L.q + k] = a;
+    atol[L.v + k] = a * velocityRatio;
+  }
   return atol;
 }
 

@@ -15,8 +15,14 @@ struct SolverSettings {
   Formulation formulation = Formulation::Ggl;
   IntegratorKind integrator = IntegratorKind::Ida;
   double rtol = 1e-8;
-  double atol = 1e-10;            ///< positions; velocities too unless atolVelocity set
+  /// Absolute tolerances by coordinate class (see absoluteTolerances): frame positions;
+  /// angles (default atol); elastic coordinates (default atol: a nodal or modal
+  /// coordinate moves material points by its own value); velocities of each class: its
+  /// position tolerance times atolVelocity / atol (atolVelocity defaults to atol).
+  double atol = 1e-10;
   std::optional<double> atolVelocity;
+  std::optional<double> atolAngle;
+  std::optional<double> atolElastic;
   double tStart = 0.0;
   double tEnd = 1.0;
   double outputStep = 0.01;
@@ -37,8 +43,9 @@ struct SolverSettings {
   void validate() const;
 };
 
-/// Absolute tolerance of every unknown of the DAE for these settings (positions,
-/// velocities; multipliers out of the error and convergence tests).
+/// Absolute tolerance of every unknown of the DAE for these settings: per coordinate
+/// class (frame positions, angles, elastic coordinates) and their velocities;
+/// multipliers out of the error and convergence tests.
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings);
 
 /// One output instant: positions, velocities, accelerations, multipliers.

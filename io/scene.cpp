@@ -16,6 +16,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -68,6 +69,32 @@ double initialJointAngle(const System& sys, ConstraintIndex joint) {
 
 // ----- sections --------------------------------------------------------------------------
 
+/// The optional initial elastic state of a flexible body (default zero): keys
+/// "elastic_coordinates" and "elastic_velocities", one number per elastic coordinate.
+struct ElasticState {
+  std::optional<VecX> q, qDot;
+};
+
+ElasticState readElasticState(const ObjectReader& r) {
+  ElasticState s;
+  if (r.has("elastic_coordinates")) s.q = r.vector("elastic_coordinates");
+  if (r.has("elastic_velocities")) s.qDot = r.vector("elastic_velocities");
+  return s;
+}
+
+/// Called inside located(): the message gets the body's location in front.
+void setInitialElasticState(const ElasticState& s, FfrBody2d& body) {
+  const int nf = body.numElastic();
+  auto sized = [&](const std::optional<VecX>& v, const char* key) -> VecX {
+    if (!v) return VecX::Zero(nf);
+    if (v->size() != nf) {
+      throw InputError("key " + inQuotes(key) + " must list " + std::to_string(nf) +
+                       " numbers (one per elastic coordinate of this body), got " + std::to_string(v->size()));
+    }
+    return *v;
+  };
+  body.setInitialElasticState(sized(s.q, "elastic_coordinates"), sized(s.qDot, "elastic_velocities"));
+}
 
 FrameState2d parseFrameState(const ObjectReader& r) {
   FrameState2d init;
@@ -135,7 +162,8 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
 
 void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
   r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "section", "beam", "nodes",
-               "elements", "reference", "modes", "geometric_stiffening"}, " for a flexible body");
+               "elements", "reference", "modes", "geometric_stiffening", "elastic_coordinates", "elastic_velocities"},
+              " for a flexible body");
   const BeamSection section = parseSection(r.object("section"), r.where() + ": section");
   BeamMesh2d mesh;
   if (r.has("beam")) {
@@ -159,14 +187,18 @@ void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& s
   }
   const FfrBeamOptions options = parseBeamOptions(r, static_cast<int>(mesh.nodes.size()));
   const FrameState2d init = parseFrameState(r);
+  const ElasticState elastic = readElasticState(r);
   located(r.where(), [&] {
     auto model = std::make_shared<FfrBeamModel>(std::move(mesh), options, "body '" + name + "'");
-    return sys.addBody(std::make_unique<FfrBody2d>(name, model, init));
+    auto body = std::make_unique<FfrBody2d>(name, model, init);
+    setInitialElasticState(elastic, *body);
+    return sys.addBody(std::move(body));
   });
 }
 
 void parseInvariantBody(const ObjectReader& r, const std::string& name, System& sys) {
-  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "invariants"},
+  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "invariants",
+               "elastic_coordinates", "elastic_velocities"},
               " for a flexible_invariants body");
   const ObjectReader iv(r.object("invariants"), r.where() + ": invariants");
   iv.allowOnly({"mass", "first_moment", "polar_moment", "s_bar", "i1", "j0", "m_ff", "s_tilde", "k_ff", "d_ff", "points"});
@@ -205,7 +237,12 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
     inv.points.push_back(fp);
   }
   const FrameState2d init = parseFrameState(r);
-  located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody2d>(name, std::move(inv), init)); });
+  const ElasticState elastic = readElasticState(r);
+  located(r.where(), [&] {
+    auto body = std::make_unique<FfrBody2d>(name, std::move(inv), init);
+    setInitialElasticState(elastic, *body);
+    return sys.addBody(std::move(body));
+  });
 }
 
 void parseBody(const json& j, const std::string& where, System& sys) {
@@ -402,7 +439,8 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
   r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
-               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian", "integrator"});
+               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian", "integrator", "atol_angle",
+               "atol_elastic"});
   SolverSettings s;
   if (r.has("integrator")) {
     const std::string name = r.string("integrator");
@@ -431,6 +469,8 @@ SolverSettings parseSolver(const json& j) {
   s.rtol = r.number("rtol", s.rtol);
   s.atol = r.number("atol", s.atol);
   if (r.has("atol_velocity")) s.atolVelocity = r.number("atol_velocity");
+  if (r.has("atol_angle")) s.atolAngle = r.number("atol_angle");
+  if (r.has("atol_elastic")) s.atolElastic = r.number("atol_elastic");
   s.tStart = r.number("t_start", s.tStart);
   s.tEnd = r.number("t_end", s.tEnd);
   s.outputStep = r.number("output_step", s.outputStep);
