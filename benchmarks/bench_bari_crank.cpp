@@ -102,6 +102,8 @@ int main(int argc, char** argv) {
   opt.addString("--scene", "scene of the engine's model (default examples/bari_slider_crank.json)", &scenePath);
   opt.addDouble("--tol-loose", "loosest tolerance (default 1e-3)", &tolLoose);
   opt.addDouble("--tol-tight", "tightest tolerance (default 1e-12)", &tolTight);
+  double elasticMetric = kElasticStabilisationWeight;
+  opt.addDouble("--ggl-elastic-metric", "weight of the elastic coordinates in the GGL stabilisation metric (default: the engine's)", &elasticMetric);
   opt.addList("--config", "configurations to run (default: all)", &only);
   opt.parse(argc, argv);
   if (opt.quick) {
@@ -128,7 +130,12 @@ int main(int argc, char** argv) {
   for (double t = tolLoose; t >= tolTight * 0.999; t /= 10.0) tols.push_back(t);
 
   const EngineModel engine(scenePath);
-  const DaeSystem ggl(engine.scene.system, Formulation::Ggl), index1(engine.scene.system, Formulation::Index1);
+  VecX D = VecX::Ones(engine.scene.system.numCoordinates());
+  {
+    const auto kinds = engine.scene.system.coordinateKinds();
+    for (int k = 0; k < D.size(); ++k) D[k] = kinds[k] == CoordinateKind::Elastic ? elasticMetric : 1.0;
+  }
+  const DaeSystem ggl(engine.scene.system, Formulation::Ggl, D), index1(engine.scene.system, Formulation::Index1);
   const bari::HandCodedCrank hand;
   VecX handY0, handYp0;
   bari::HandCodedCrank::initialValues(handY0, handYp0);

@@ -46,9 +46,25 @@ Formulation parseFormulation(const std::string& name) {
                    "' (expected one of: ggl, index3, index1)");
 }
 
-DaeSystem::DaeSystem(const System& sys, Formulation formulation)
-    : sys_(sys), formulation_(formulation) {
+VecX defaultStabilisationMetric(const System& sys) {
   if (!sys.isFinalized()) throw InputError("DaeSystem: the system must be finalized first");
+  VecX D = VecX::Ones(sys.numCoordinates());
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  for (int k = 0; k < D.size(); ++k) {
+    if (kinds[k] == CoordinateKind::Elastic) D[k] = kElasticStabilisationWeight;
+  }
+  return D;
+}
+
+DaeSystem::DaeSystem(const System& sys, Formulation formulation)
+    : DaeSystem(sys, formulation, defaultStabilisationMetric(sys)) {}
+
+DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric)
+    : sys_(sys), formulation_(formulation), metric_(std::move(stabilisationMetric)) {
+  if (!sys.isFinalized()) throw InputError("DaeSystem: the system must be finalized first");
+  if (metric_.size() != sys.numCoordinates() || !(metric_.minCoeff() > 0.0) || !metric_.allFinite()) {
+    throw InputError("DaeSystem: the stabilisation metric must have one positive entry per coordinate");
+  }
   DaeLayout& L = layout_;
   L.nq = sys.numCoordinates();
   L.m = sys.numConstraintEquations();
@@ -139,7 +155,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
     switch (formulation_) {
       case Formulation::Ggl: {
         const VecX GtMu = ev.G.transpose() * ConstMap(y + L.mu + row, me);
-        for (size_t k = 0; k < cols.size(); ++k) Fq[cols[k]] += GtMu[k];
+        for (size_t k = 0; k < cols.size(); ++k) Fq[cols[k]] += metric_[cols[k]] * GtMu[k];
         Eigen::Map<VecX>(F + L.lambda + row, me) = ev.h - f;
         Eigen::Map<VecX>(F + L.mu + row, me) = ev.G * vl - df;
         break;
@@ -218,8 +234,13 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
       case Formulation::Ggl: {
         MatX Hm = MatX::Zero(nl, nl);
         for (int a = 0; a < me; ++a) Hm += y[L.mu + row + a] * ev.H[a];
+        MatX DGt = Gt;
+        for (int k = 0; k < nl; ++k) {
+          Hm.row(k) *= metric_[cols[k]];
+          DGt.row(k) *= metric_[cols[k]];
+        }
         addBlock(J, L.q, cols, L.q, cols, Hm);
-        addBlock(J, L.q, cols, L.mu, rows, Gt);
+        addBlock(J, L.q, cols, L.mu, rows, DGt);
         addBlock(J, L.lambda, rows, L.q, cols, ev.G);
         addBlock(J, L.mu, rows, L.q, cols, vH);
         addBlock(J, L.mu, rows, L.v, cols, ev.G);

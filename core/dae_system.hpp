@@ -33,6 +33,15 @@ struct DaeLayout {
   int size = 0;
 };
 
+/// Weight of the elastic coordinates in the GGL stabilisation metric D (frame
+/// coordinates: 1). The position-level correction D G^T mu goes into the frame
+/// coordinates, not into lightly damped elastic modes that would carry it to the end of
+/// the run; a small positive weight keeps G D G^T regular where the frame coordinates
+/// alone cannot satisfy a constraint. Derivation and measurements: docs/formulations.md.
+inline constexpr double kElasticStabilisationWeight = 1e-6;
+/// D = 1 on frame coordinates, kElasticStabilisationWeight on elastic ones.
+VecX defaultStabilisationMetric(const System& sys);
+
 /// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985):
 ///   F_q  = q' - v + G^T mu,  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),  F_gv = G v + g_t.
 /// Index 3 drops mu and F_gv; index 1 replaces F_g by G v' + (G v)_q v + g_tt.
@@ -40,6 +49,10 @@ class DaeSystem final : public DaeProblem {
  public:
   /// @throws InputError if the system is not finalized.
   DaeSystem(const System& sys, Formulation formulation);
+  /// GGL with the stabilisation metric D (diagonal, nq, positive): F_q = q' - v + D G^T mu.
+  /// The first constructor takes defaultStabilisationMetric(sys).
+  DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric);
+  const VecX& stabilisationMetric() const { return metric_; }
 
   const System& system() const { return sys_; }
   Formulation formulation() const { return formulation_; }
@@ -71,6 +84,7 @@ class DaeSystem final : public DaeProblem {
   Formulation formulation_;
   DaeLayout layout_;
   SparsePattern pattern_;
+  VecX metric_;  ///< D of the GGL stabilisation (nq)
 };
 
 }  // namespace flexmbd
