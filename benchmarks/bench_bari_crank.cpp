@@ -6,8 +6,8 @@
 // in scd) as ratios to the hand-coded equations under IDA, all from one run.
 //
 // Configurations: the engine's model of the mechanism (examples/bari_slider_crank.json,
-// the general engine with no per-problem tuning: tolerances from the scene's policy with
-// rtol = tol) under IDA (GGL, index 1) and Radau IIA, and the hand-coded equations of
+// the general engine with no per-problem tuning: rtol = atol = tol as in the classic
+// codes' runs, the elastic coordinates' atol in the scene's ratio to atol) under IDA (GGL, index 1) and Radau IIA, and the hand-coded equations of
 // the test set (benchmarks/problems/bari_crank.*) under the same integrators.
 #include <time.h>
 
@@ -104,6 +104,10 @@ int main(int argc, char** argv) {
   opt.addDouble("--tol-tight", "tightest tolerance (default 1e-12)", &tolTight);
   double elasticMetric = kElasticStabilisationWeight;
   opt.addDouble("--ggl-elastic-metric", "weight of the elastic coordinates in the GGL stabilisation metric (default: the engine's)", &elasticMetric);
+  double elasticRatio = 0.0;
+  opt.addDouble("--atol-elastic-ratio",
+                "atol of elastic coordinates / atol of the engine runs (default: the scene's atol_elastic / atol)",
+                &elasticRatio);
   opt.addList("--config", "configurations to run (default: all)", &only);
   opt.parse(argc, argv);
   if (opt.quick) {
@@ -130,6 +134,7 @@ int main(int argc, char** argv) {
   for (double t = tolLoose; t >= tolTight * 0.999; t /= 10.0) tols.push_back(t);
 
   const EngineModel engine(scenePath);
+  if (!(elasticRatio > 0.0)) elasticRatio = engine.scene.solver.atolElastic.value_or(engine.scene.solver.atol) / engine.scene.solver.atol;
   VecX D = VecX::Ones(engine.scene.system.numCoordinates());
   {
     const auto kinds = engine.scene.system.coordinateKinds();
@@ -156,8 +161,10 @@ int main(int argc, char** argv) {
             const DaeSystem& dae = c.formulation == Formulation::Ggl ? ggl : index1;
             SolverSettings s = engine.scene.solver;
             s.rtol = tol;
-            s.atol = tol;  // as the classic codes' runs: rtol = atol = tol
+            s.atol = tol;  // as the classic codes' runs: rtol = atol = tol, elastic atol as the scene's ratio
             s.atolVelocity.reset();
+            s.atolAngle.reset();
+            s.atolElastic = elasticRatio * tol;
             o.atol = absoluteTolerances(dae, s);
             VecX y0, yp0;
             dae.packState(engine.init.q, engine.init.v, engine.init.a, engine.init.lambda, y0, yp0);
