@@ -104,6 +104,9 @@ int main(int argc, char** argv) {
   opt.addDouble("--tol-tight", "tightest tolerance (default 1e-12)", &tolTight);
   double elasticMetric = kElasticStabilisationWeight;
   opt.addDouble("--ggl-elastic-metric", "weight of the elastic coordinates in the GGL stabilisation metric (default: the engine's)", &elasticMetric);
+  double velocityRatio = 0.0;
+  opt.addDouble("--atol-velocity-ratio",
+                "atol_velocity / atol of the engine runs (default: the scene's ratio)", &velocityRatio);
   double elasticRatio = 0.0;
   opt.addDouble("--atol-elastic-ratio",
                 "atol of elastic coordinates / atol of the engine runs (default: the scene's atol_elastic / atol)",
@@ -134,6 +137,7 @@ int main(int argc, char** argv) {
   for (double t = tolLoose; t >= tolTight * 0.999; t /= 10.0) tols.push_back(t);
 
   const EngineModel engine(scenePath);
+  if (!(velocityRatio > 0.0)) velocityRatio = engine.scene.solver.atolVelocity.value_or(engine.scene.solver.atol) / engine.scene.solver.atol;
   if (!(elasticRatio > 0.0)) elasticRatio = engine.scene.solver.atolElastic.value_or(engine.scene.solver.atol) / engine.scene.solver.atol;
   VecX D = VecX::Ones(engine.scene.system.numCoordinates());
   {
@@ -162,7 +166,7 @@ int main(int argc, char** argv) {
             SolverSettings s = engine.scene.solver;
             s.rtol = tol;
             s.atol = tol;  // as the classic codes' runs: rtol = atol = tol, elastic atol as the scene's ratio
-            s.atolVelocity.reset();
+            s.atolVelocity = velocityRatio * tol;
             s.atolAngle.reset();
             s.atolElastic = elasticRatio * tol;
             o.atol = absoluteTolerances(dae, s);
