@@ -138,3 +138,24 @@ TEST(BariCrank, GglReachesEightDigitsAtTightTolerances) {
   std::printf("[ measured ] engine ggl IDA tol 1e-11: scd %.2f\n", scd);
   EXPECT_GT(scd, kTightDigits);
 }
+
+TEST(BariCrank, AbsoluteTolerancesByCoordinateClass) {
+  // Positions, angles and elastic coordinates each get their class's tolerance; their
+  // velocities the same times atol_velocity / atol; multipliers are out of the tests.
+  Scene s = bariScene();
+  s.solver.atol = 1e-6;
+  s.solver.atolAngle = 1e-7;
+  s.solver.atolElastic = 1e-9;
+  s.solver.atolVelocity = 1e-4;
+  const DaeSystem dae(s.system, Formulation::Ggl);
+  const VecX atol = absoluteTolerances(dae, s.solver);
+  const DaeLayout& L = dae.layout();
+  const Offsets off(s.system);
+  EXPECT_EQ(atol[L.q + off.slider], 1e-6);
+  EXPECT_EQ(atol[L.q + off.rod + 2], 1e-7);
+  EXPECT_EQ(atol[L.q + off.rod + 3], 1e-9);
+  EXPECT_DOUBLE_EQ(atol[L.v + off.slider], 1e-4);
+  EXPECT_DOUBLE_EQ(atol[L.v + off.rod + 2], 1e-5);
+  EXPECT_DOUBLE_EQ(atol[L.v + off.rod + 6], 1e-7);
+  EXPECT_GE(atol.segment(L.lambda, 2 * L.m).minCoeff(), 1e9);
+}

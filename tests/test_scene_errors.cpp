@@ -510,5 +510,54 @@ TEST(SceneParse, DefaultsOfAMinimalScene) {
   EXPECT_TRUE(s.outputs.empty());
 }
 
+TEST(SceneParse, InitialElasticStateOfFlexibleBodies) {
+  // A pinned-pinned beam of 2 elements keeps 4 elastic coordinates (node rotations and
+  // the middle node's displacements); the given state is the body's initial state.
+  json j = json::parse(R"({"bodies": [{"name": "beam", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "density": 7850},
+      "beam": {"length": 1.0, "elements": 2}, "reference": {"type": "pinned_pinned"}}]})");
+  const Scene plain = parseScene(j);
+  const int nf = plain.system.numCoordinates() - 3;
+  ASSERT_GT(nf, 0);
+  VecX q(nf), qd(nf);
+  for (int k = 0; k < nf; ++k) {
+    q[k] = 1e-4 * (k + 1);
+    qd[k] = -0.1 * (k + 1);
+  }
+  j["bodies"][0]["elastic_coordinates"] = std::vector<double>(q.data(), q.data() + nf);
+  j["bodies"][0]["elastic_velocities"] = std::vector<double>(qd.data(), qd.data() + nf);
+  const Scene s = parseScene(j);
+  EXPECT_EQ(s.system.initialCoordinates().tail(nf), q);
+  EXPECT_EQ(s.system.initialVelocities().tail(nf), qd);
+  j["bodies"][0]["elastic_velocities"] = {1.0};
+  const std::string m = errorOf(j);
+  EXPECT_NE(m.find("bodies[0] (\"beam\")"), std::string::npos) << m;
+  EXPECT_NE(m.find("elastic_velocities"), std::string::npos) << m;
+  EXPECT_NE(m.find(std::to_string(nf) + " numbers"), std::string::npos) << m;
+  j["bodies"][0]["elastic_velocities"] = "fast";
+  EXPECT_NE(errorOf(j).find("elastic_velocities"), std::string::npos);
+  // only flexible bodies have an elastic state
+  json r = baseScene();
+  r["bodies"][0]["elastic_coordinates"] = {0.0};
+  EXPECT_NE(errorOf(r).find("unknown key \"elastic_coordinates\""), std::string::npos);
+}
+
+TEST(SceneParse, ToleranceClassesAndIntegrator) {
+  json j = baseScene();
+  j["solver"]["atol_angle"] = 1e-9;
+  j["solver"]["atol_elastic"] = 1e-12;
+  j["solver"]["integrator"] = "ida";
+  const Scene s = parseScene(j);
+  EXPECT_EQ(s.solver.atolAngle.value_or(0.0), 1e-9);
+  EXPECT_EQ(s.solver.atolElastic.value_or(0.0), 1e-12);
+  EXPECT_EQ(s.solver.integrator, IntegratorKind::Ida);
+  j["solver"]["atol_elastic"] = -1.0;
+  EXPECT_NE(errorOf(j).find("atol_elastic"), std::string::npos);
+  j["solver"]["atol_elastic"] = 1e-12;
+  j["solver"]["integrator"] = "rk4";
+  const std::string m = errorOf(j);
+  EXPECT_NE(m.find("unknown integrator \"rk4\" (expected one of: ida, radau5)"), std::string::npos) << m;
+}
+
 }  // namespace
 }  // namespace flexmbd
