@@ -16,6 +16,8 @@
 #include "integrators/ida_solver.hpp"
 #include "integrators/initial_conditions.hpp"
 
+#include <time.h>
+
 using namespace flexmbd;
 using namespace flexmbd::bench;
 
@@ -54,6 +56,99 @@ void runCase(Case& c, double rtol, double span, LinearSolverKind solver) {
   c.nonZeros = dae.pattern().nonZeros();
 }
 
+double cpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+/// Midpoint deflection of the rod at the checkpoints of one run (first entry t = 0).
+struct DeflectionRun {
+  std::vector<double> deflection;
+  double cpu = 0.0;
+  bool ok = false;
+  long steps = 0;
+};
+
+DeflectionRun runDeflection(int elements, IntegratorKind integrator, double rtol, double span, int checkpoints) {
+  const BenchModel m = elasticSliderCrank(elements, 0, span * 150.0 / (2 * M_PI), "scaling");
+  Scene s = m.build(rtol, atolFor(rtol));
+  setRun(s.solver, rtol, atolFor(rtol), span, checkpoints);
+  s.solver.integrator = integrator;
+  s.solver.maxSteps = 100000000;
+  DeflectionRun r;
+  const double c0 = cpuSeconds();
+  try {
+    const SimulationSummary sum = simulate(s.system, s.solver, [&](const OutputSample& o) {
+      r.deflection.push_back(m.probe(s, o).deflection);
+    });
+    r.ok = sum.ok;
+    r.steps = sum.stats.steps;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_scaling: %d elements, %s, rtol %.0e: %s\n", elements, toString(integrator).c_str(),
+                 rtol, e.what());
+  }
+  r.cpu = cpuSeconds() - c0;
+  return r;
+}
+
+/// Time per simulated second at a fixed accuracy: for each mesh and integrator the
+/// loosest rtol (decades from 1e-3, atol = rtol/100) whose midpoint deflection is within
+/// `accuracy` (relative to its largest value over the span) of a reference run of the
+/// same mesh at rtol 1e-10; the exponent of that time against the DAE size.
+int fixedAccuracy(const Options& opt, int minElements, int maxElements, double span, double accuracy,
+                  double budget, const std::vector<IntegratorKind>& integrators) {
+  const int checkpoints = 8;
+  CsvWriter csv(opt.csvPath("bench_scaling_fixed_accuracy.csv"),
+                {"integrator", "elements", "dae_size", "rtol", "deflection_error", "steps", "cpu_seconds",
+                 "seconds_per_unit_time"});
+  std::printf("Elastic slider-crank, nodal rod, GGL; first %g s; loosest rtol with midpoint deflection within %.0e "
+              "(relative) of the rtol 1e-10 run of the same mesh\n", span, accuracy);
+  std::printf("%-8s %6s %6s %8s %10s %9s %10s %12s\n", "integr.", "elem", "size", "rtol", "defl.err", "steps",
+              "cpu [s]", "t/t_sim [s]");
+  for (IntegratorKind kind : integrators) {
+    std::vector<double> lx, ly;
+    bool stop = false;
+    for (int n = minElements; n <= maxElements && !stop; n *= 2) {
+      const DeflectionRun ref = runDeflection(n, IntegratorKind::Radau5, 1e-10, span, checkpoints);
+      const DeflectionRun& reference = ref.ok ? ref : runDeflection(n, IntegratorKind::Ida, 1e-10, span, checkpoints);
+      double peak = 0.0;
+      for (double d : reference.deflection) peak = std::max(peak, std::abs(d));
+      const int size = daeSize(testmodels::elasticSliderCrank(n, 1.0, 0, 1.0, 1e-6, 1e-8).system, Formulation::Ggl);
+      bool met = false;
+      for (double rtol = 1e-3; rtol >= 1e-9 && !met; rtol /= 10) {
+        DeflectionRun r = runDeflection(n, kind, rtol, span, checkpoints);
+        double err = r.ok && r.deflection.size() == reference.deflection.size() ? 0.0 : INFINITY;
+        for (std::size_t k = 0; std::isfinite(err) && k < r.deflection.size(); ++k) {
+          err = std::max(err, std::abs(r.deflection[k] - reference.deflection[k]) / peak);
+        }
+        if (err > accuracy && r.cpu < budget && rtol > 1.5e-9) continue;
+        met = true;
+        for (int rep = 1; rep < opt.repeat && err <= accuracy; ++rep) {
+          r.cpu = std::min(r.cpu, runDeflection(n, kind, rtol, span, checkpoints).cpu);
+        }
+        std::printf("%-8s %6d %6d %8.0e %10.2e %9ld %10.3f %12.4g%s\n", toString(kind).c_str(), n, size, rtol, err,
+                    r.steps, r.cpu, r.cpu / span, err <= accuracy ? "" : "  (accuracy not reached within the budget or by rtol 1e-9: larger meshes skipped)");
+        csv.row({toString(kind), std::to_string(n), std::to_string(size), sci(rtol), sci(err), std::to_string(r.steps),
+                 fmt(r.cpu), fmt(r.cpu / span)});
+        if (err <= accuracy && n >= 16) {
+          lx.push_back(std::log(size));
+          ly.push_back(std::log(r.cpu / span));
+        }
+        stop = err > accuracy || r.cpu > budget;
+      }
+    }
+    if (lx.size() >= 2) {
+      const double b = fitLine(lx, ly).second;
+      std::printf("%s: time per simulated second at fixed accuracy ~ size^%.2f (%zu meshes from 16 elements)\n",
+                  toString(kind).c_str(), b, lx.size());
+      csv.comment(toString(kind) + " exponent_time_per_unit_time_fixed_accuracy," + fmt(b, "%.4f"));
+    }
+  }
+  std::printf("CSV written to %s\n", csv.path().c_str());
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -68,7 +163,23 @@ int main(int argc, char** argv) {
   opt.addDouble("--span", "simulated time from t = 0 [s] (default 2e-5)", &span);
   opt.addDouble("--rtol", "relative tolerance (default 1e-6; atol = rtol/100)", &rtol);
   opt.addString("--solver", "linear solver: klu, dense, auto (default klu)", &solverName);
+  bool fixed = false;
+  double accuracy = 1e-4, accuracySpan = 2 * M_PI / 150.0 / 8, budget = 120.0;
+  std::vector<std::string> integratorNames;
+  opt.flag("--fixed-accuracy", "time per simulated second at a fixed midpoint-deflection accuracy (issue 10)", &fixed);
+  opt.addDouble("--accuracy", "relative midpoint-deflection accuracy of --fixed-accuracy (default 1e-4)", &accuracy);
+  opt.addDouble("--accuracy-span", "simulated time of --fixed-accuracy (default 1/8 revolution)", &accuracySpan);
+  opt.addDouble("--budget", "CPU seconds per run above which larger meshes are skipped (default 120)", &budget);
+  opt.addList("--integrator", "ida, radau5 (default both) for --fixed-accuracy", &integratorNames);
   opt.parse(argc, argv);
+  if (fixed) {
+    std::vector<IntegratorKind> kinds;
+    for (const std::string& n : integratorNames) kinds.push_back(parseIntegrator(n));
+    if (kinds.empty()) kinds = {IntegratorKind::Radau5, IntegratorKind::Ida};
+    if (opt.quick) maxElements = std::min(maxElements, 16);
+    return fixedAccuracy(opt, std::max(8, minElements), std::min(maxElements, 256), accuracySpan, accuracy, budget,
+                         kinds);
+  }
   if (opt.quick) {
     maxElements = std::min(maxElements, 32);
     span = std::min(span, 1e-5);
