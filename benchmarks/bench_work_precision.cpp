@@ -115,7 +115,9 @@ int main(int argc, char** argv) {
               "Work-precision sweep: error against a reference vs CPU time and solver counters, per scene.", 3);
   std::vector<std::string> scenes;
   double minRtol = 1e-11, maxRtol = 1e-3, refRtol = 1e-13, repeatLimit = 2.0;
-  std::string refCache;
+  std::string refCache, integratorName = "ida";
+  opt.addString("--integrator", "integrator of the sweep: ida, radau5 (default ida; references always IDA)",
+                &integratorName);
   opt.addList("--scene", "scene groups to run: rigid_slider_crank, elastic_1rev, elastic_5rev, free_beam, "
               "pendulum (default: all)", &scenes);
   opt.addDouble("--min-rtol", "tightest rtol of the sweep (default 1e-11)", &minRtol);
@@ -126,6 +128,13 @@ int main(int argc, char** argv) {
   opt.addString("--ref-cache", "reuse engine references from this CSV file; missing ones are computed and "
                 "added (default: none, references always recomputed)", &refCache);
   opt.parse(argc, argv);
+  IntegratorKind integrator = IntegratorKind::Ida;
+  try {
+    integrator = parseIntegrator(integratorName);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_work_precision: %s\n", e.what());
+    return 2;
+  }
   if (opt.quick) {
     if (scenes.empty()) scenes = {"rigid_slider_crank", "pendulum", "free_beam", "elastic_1rev"};
     minRtol = std::max(minRtol, 1e-6);
@@ -161,7 +170,9 @@ int main(int argc, char** argv) {
                 {"group", "model", "rtol", "atol", "error", "error_deflection", "diff_next_rtol", "seconds", "steps",
                  "residual_evals", "jacobian_evals", "linear_setups", "dae_size", "ok", "energy_drift",
                  "momentum_drift", "reference"});
-  std::printf("Work-precision sweep, atol = rtol/100, GGL, default linear solver (auto: KLU above 8 unknowns).\n"
+  std::printf("Work-precision sweep, integrator %s, atol = rtol/100, GGL, default linear solver (auto: KLU above 8 "
+              "unknowns).\n", integratorName.c_str());
+  std::printf(
               "error: max over checkpoints (end time included) and positions of |p - p_ref| / L; time: median of "
               "up to %d runs (one if a run takes > %.3g s), simulate() wall time incl. initialisation.\n",
               opt.repeat, repeatLimit);
@@ -239,6 +250,7 @@ int main(int argc, char** argv) {
       for (int rep = 0; rep < opt.repeat; ++rep) {
         Scene s = m.build(rtol, atolFor(rtol));
         s.solver.maxSteps = 100000000;
+        s.solver.integrator = integrator;
         RunResult r = runModel(m, s);
         times.push_back(r.seconds);
         row.ok = r.summary.ok;
