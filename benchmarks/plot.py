@@ -8,6 +8,9 @@ python3-matplotlib):
   scaling.png                 time per step against the DAE size, log-log, with the
                               least-squares exponent from --fit-from elements up
                               (bench_scaling.csv)
+  bari_crank.png              Simeon's slider crank: CPU time against significant
+                              correct digits, one line per configuration, with the
+                              classic codes' published figures (bench_bari_crank.csv)
 
 usage: /usr/bin/python3 benchmarks/plot.py [--in-dir DIR] [--out-dir DIR] [--fit-from N]
 Missing CSV files are skipped with a message.
@@ -139,6 +142,37 @@ def scaling(rows, out_dir, fit_from):
     return [path]
 
 
+# CPU ms of the classic codes to reach scd 3, 5, 7 on this machine kind
+# (shared/benchmarks/simeon-slider-crank.md): drawn as markers for comparison.
+CLASSIC = {"MEBDFI": (4.5, 16.9, 28.4), "RADAU5 (Fortran)": (11.2, 53.8, 112),
+           "DASSL": (12.3, 44.1, 117)}
+
+
+def bari_crank(rows, out_dir):
+    fig, ax = plt.subplots(figsize=(7, 5))
+    configs = []
+    for r in rows:
+        if r["config"] not in configs:
+            configs.append(r["config"])
+    for c in configs:
+        pts = [(num(r["scd"]), num(r["cpu_ms"])) for r in rows if r["config"] == c and r.get("ok", "1") == "1"]
+        pts = [p for p in pts if p[0] is not None and p[1]]
+        if pts:
+            ax.semilogy([p[0] for p in pts], [p[1] for p in pts], "o-", label=c, markersize=4)
+    for name, ms in CLASSIC.items():
+        ax.semilogy([3, 5, 7], ms, "x--", label=name + " (published run)", alpha=0.6)
+    ax.set_xlabel("significant correct digits (positions at t = 0.1)")
+    ax.set_ylabel("CPU time [ms]")
+    ax.set_title("Simeon's flexible slider crank: work-precision")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    path = os.path.join(out_dir, "bari_crank.png")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -157,6 +191,9 @@ def main():
     rows = read_csv(os.path.join(a.in_dir, "bench_scaling.csv"))
     if rows:
         written += scaling(rows, a.out_dir, a.fit_from)
+    rows = read_csv(os.path.join(a.in_dir, "bench_bari_crank.csv"))
+    if rows:
+        written += bari_crank(rows, a.out_dir)
     for w in written:
         print("wrote", w)
     return 0 if written else 1
