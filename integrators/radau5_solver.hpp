@@ -29,6 +29,9 @@ struct Radau5Coefficients {
   /// Collocation polynomial: u(t0 + s h) = y0 + sum_j L_j(s) Z_j with
   /// (L_1, L_2, L_3)(s) = P^T (s, s^2, s^3) (Lagrange basis on the nodes 0, c_1, c_2, c_3).
   Eigen::Matrix3d P;
+  /// Where the interpolation error factor s (s - c1)(s - c2)(s - 1) of the collocation
+  /// polynomial peaks on [0, 1] (s = 0.86): the point of the dense-output error estimate.
+  double sDense = 0.0;
   static const Radau5Coefficients& get();
 };
 

