@@ -2,6 +2,7 @@
 
 #include "core/errors.hpp"
 #include "integrators/ida_solver.hpp"
+#include "integrators/radau5_solver.hpp"
 
 namespace flexmbd {
 
@@ -40,9 +41,9 @@ std::unique_ptr<DaeIntegrator> makeIntegrator(IntegratorKind kind, const DaeProb
                                               const VecX& y0, const VecX& yp0, const IntegratorOptions& options) {
   switch (kind) {
     case IntegratorKind::Ida: return std::make_unique<IdaSolver>(dae, t0, y0, yp0, options);
-    case IntegratorKind::Radau5: break;
+    case IntegratorKind::Radau5: return std::make_unique<Radau5Solver>(dae, t0, y0, yp0, options);
   }
-  throw InputError("solver.integrator: radau5 is not built yet");
+  throw InputError("solver.integrator: unknown integrator kind");
 }
 
 }  // namespace flexmbd
