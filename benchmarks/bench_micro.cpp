@@ -1,10 +1,14 @@
-// Micro-benchmarks (Google Benchmark): one residual evaluation (DaeSystem::residual),
-// one Jacobian assembly (DaeSystem::jacobian into a JacobianSink::sparse of the DAE's
-// pattern) and one KLU refactorisation (klu_l_analyze and klu_l_factor once, then
-// klu_l_refactor on the pattern's CSC arrays) for the elastic slider-crank (GGL) with 8
-// and 256 rod elements, at its consistent initial state, cj = 1e6 (about 1/h of the
-// runs at rtol 1e-6). After the runs: the cost of a Jacobian and of a refactorisation
-// in residual evaluations (target: a Jacobian costs at most a few residuals).
+// Micro-benchmarks (Google Benchmark): one residual evaluation, one Jacobian assembly
+// (into a JacobianSink::sparse of the DAE's pattern, as the integrators use it, with the
+// scratch of one integrator) and one KLU refactorisation (klu_l_analyze and klu_l_factor
+// once, then klu_l_refactor on the pattern's CSC arrays), at the consistent initial
+// state, cj = 1e6 (about 1/h of the runs at rtol 1e-6), for these models:
+//   crank<N>     the elastic slider-crank (GGL) with N nodal rod elements (--elements)
+//   bari_ggl     Simeon's crank of the Bari test set (examples/bari_slider_crank.json), GGL
+//   bari_index1  the same, index 1
+//   bari_hand    the test set's hand-coded equations (benchmarks/problems/bari_crank.hpp)
+// After the runs: the cost of a Jacobian and of a refactorisation in residual evaluations
+// (target: a Jacobian costs at most a few residuals).
 //
 // Options of its own (--elements, --quick, --repeat, --csv, --out-dir); any other
 // argument goes to Google Benchmark (--benchmark_filter=..., ...).
@@ -21,6 +25,7 @@
 
 #include "benchmarks/bench_common.hpp"
 #include "benchmarks/bench_scenes.hpp"
+#include "benchmarks/problems/bari_crank.hpp"
 #include "integrators/initial_conditions.hpp"
 
 using namespace flexmbd;
@@ -30,26 +35,37 @@ namespace {
 
 constexpr double kTime = 0.0, kCj = 1e6;
 
-/// The DAE of one mesh at its consistent initial state, built once per mesh.
+/// One model's DAE at its consistent initial state, built once per model.
 struct Fixture {
   Scene scene;
-  std::unique_ptr<DaeSystem> dae;
+  std::unique_ptr<DaeProblem> dae;
+  std::unique_ptr<DaeScratch> scratch;
   VecX y, yp, F;
   std::vector<double> values;
   std::vector<SuiteSparse_long> colStart, rowIndex;
 };
 
-Fixture& fixture(int elements) {
-  static std::map<int, std::unique_ptr<Fixture>> all;
-  auto& f = all[elements];
+/// "crank<N>", "bari_ggl", "bari_index1" or "bari_hand".
+Fixture& fixture(const std::string& model) {
+  static std::map<std::string, std::unique_ptr<Fixture>> all;
+  auto& f = all[model];
   if (!f) {
     f = std::make_unique<Fixture>();
-    f->scene = testmodels::elasticSliderCrank(elements, 1.0, 0, 1.0, 1e-6, 1e-8);
-    const System& sys = f->scene.system;
-    const ConsistentState cs = computeConsistentState(sys, kTime, sys.initialCoordinates(), sys.initialVelocities());
-    f->dae = std::make_unique<DaeSystem>(sys, Formulation::Ggl);
-    f->dae->packState(cs.q, cs.v, cs.a, cs.lambda, f->y, f->yp);
-    f->F.resize(f->dae->layout().size);
+    if (model == "bari_hand") {
+      f->dae = std::make_unique<bari::HandCodedCrank>();
+      bari::HandCodedCrank::initialValues(f->y, f->yp);
+    } else {
+      const bool bari = model.rfind("bari", 0) == 0;
+      f->scene = bari ? loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json")
+                      : testmodels::elasticSliderCrank(std::stoi(model.substr(5)), 1.0, 0, 1.0, 1e-6, 1e-8);
+      const System& sys = f->scene.system;
+      const ConsistentState cs = computeConsistentState(sys, kTime, sys.initialCoordinates(), sys.initialVelocities());
+      auto dae = std::make_unique<DaeSystem>(sys, model == "bari_index1" ? Formulation::Index1 : Formulation::Ggl);
+      dae->packState(cs.q, cs.v, cs.a, cs.lambda, f->y, f->yp);
+      f->dae = std::move(dae);
+    }
+    f->scratch = f->dae->makeScratch();
+    f->F.resize(f->dae->size());
     const SparsePattern& p = f->dae->pattern();
     f->values.assign(p.nonZeros(), 0.0);
     f->colStart.assign(p.colStart().begin(), p.colStart().end());
@@ -58,32 +74,33 @@ Fixture& fixture(int elements) {
   return *f;
 }
 
+void residual(Fixture& f) { f.dae->residual(kTime, f.y.data(), f.yp.data(), f.F.data(), *f.scratch); }
+
 void sizeCounters(benchmark::State& st, const Fixture& f) {
-  st.counters["dae_size"] = f.dae->layout().size;
+  st.counters["dae_size"] = f.dae->size();
   st.counters["nnz"] = static_cast<double>(f.dae->pattern().nonZeros());
 }
 
 void assembleJacobian(Fixture& f) {
   std::fill(f.values.begin(), f.values.end(), 0.0);
   JacobianSink sink = JacobianSink::sparse(f.values.data(), f.dae->pattern());
-  f.dae->jacobian(kTime, f.y.data(), f.yp.data(), kCj, sink);
+  f.dae->jacobian(kTime, f.y.data(), f.yp.data(), kCj, sink, *f.scratch);
 }
 
-void residualBench(benchmark::State& st, int elements) {
-  Fixture& f = fixture(elements);
+void residualBench(benchmark::State& st, const std::string& model) {
+  Fixture& f = fixture(model);
   for (auto _ : st) {
-    f.dae->residual(kTime, f.y.data(), f.yp.data(), f.F.data());
+    residual(f);
     benchmark::DoNotOptimize(f.F.data());
     benchmark::ClobberMemory();
   }
   sizeCounters(st, f);
 }
 
-void jacobianBench(benchmark::State& st, int elements) {
-  Fixture& f = fixture(elements);
+void jacobianBench(benchmark::State& st, const std::string& model) {
+  Fixture& f = fixture(model);
   // a residual's cost measured alongside, for the ratio counter
-  const double tRes = timePerCall([&] { f.dae->residual(kTime, f.y.data(), f.yp.data(), f.F.data()); },
-                                  std::max(1, 20000 / f.dae->layout().size), 5);
+  const double tRes = timePerCall([&] { residual(f); }, std::max(1, 20000 / f.dae->size()), 5);
   const auto t0 = Clock::now();
   for (auto _ : st) {
     assembleJacobian(f);
@@ -97,14 +114,14 @@ void jacobianBench(benchmark::State& st, int elements) {
 
 /// engineOrdering: as the engine's IdaSolver (configureKluOrdering); else KLU's
 /// defaults (AMD after BTF, pivot threshold 1e-3), for comparison.
-void kluRefactorBench(benchmark::State& st, int elements, bool engineOrdering) {
-  Fixture& f = fixture(elements);
+void kluRefactorBench(benchmark::State& st, const std::string& model, bool engineOrdering) {
+  Fixture& f = fixture(model);
   assembleJacobian(f);
   klu_l_common common;
   klu_l_defaults(&common);
   const std::vector<int64_t> groups = f.dae->eliminationGroups();
   if (engineOrdering) configureKluOrdering(common, groups);
-  const SuiteSparse_long n = f.dae->layout().size;
+  const SuiteSparse_long n = f.dae->size();
   klu_l_symbolic* sym = klu_l_analyze(n, f.colStart.data(), f.rowIndex.data(), &common);
   klu_l_numeric* num = sym ? klu_l_factor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, &common)
                            : nullptr;
@@ -147,15 +164,16 @@ class CollectingReporter : public benchmark::ConsoleReporter {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Options opt("bench_micro", "Residual, Jacobian and KLU refactorisation of the elastic slider-crank (Google Benchmark).",
+  Options opt("bench_micro", "Residual, Jacobian and KLU refactorisation of the elastic slider-crank and the Bari crank (Google Benchmark).",
               1);
   std::vector<std::string> elementList;
   opt.addList("--elements", "rod meshes (default 8,256; --quick: 8,32)", &elementList);
   std::vector<std::string> gbArgs;
   opt.parse(argc, argv, &gbArgs);
   if (elementList.empty()) elementList = opt.quick ? std::vector<std::string>{"8", "32"} : std::vector<std::string>{"8", "256"};
-  std::vector<int> meshes;
-  for (const std::string& e : elementList) meshes.push_back(Options::toInt(e, "--elements"));
+  std::vector<std::string> models;
+  for (const std::string& e : elementList) models.push_back("crank" + std::to_string(Options::toInt(e, "--elements")));
+  for (const char* m : {"bari_ggl", "bari_index1", "bari_hand"}) models.push_back(m);
 
   std::vector<std::string> args = {argv[0]};
   if (opt.quick) args.push_back("--benchmark_min_time=0.02");
@@ -170,13 +188,13 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&cargc, cargs.data());
   if (benchmark::ReportUnrecognizedArguments(cargc, cargs.data())) return 2;
 
-  for (int n : meshes) {
-    const std::string suffix = "/elements:" + std::to_string(n);
-    benchmark::RegisterBenchmark(("residual" + suffix).c_str(), residualBench, n)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("jacobian" + suffix).c_str(), jacobianBench, n)->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("klu_refactor" + suffix).c_str(), kluRefactorBench, n, true)
+  for (const std::string& m : models) {
+    const std::string suffix = "/" + m;
+    benchmark::RegisterBenchmark(("residual" + suffix).c_str(), residualBench, m)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("jacobian" + suffix).c_str(), jacobianBench, m)->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("klu_refactor" + suffix).c_str(), kluRefactorBench, m, true)
         ->Unit(benchmark::kMicrosecond);
-    benchmark::RegisterBenchmark(("klu_refactor_default_ordering" + suffix).c_str(), kluRefactorBench, n, false)
+    benchmark::RegisterBenchmark(("klu_refactor_default_ordering" + suffix).c_str(), kluRefactorBench, m, false)
         ->Unit(benchmark::kMicrosecond);
   }
   CollectingReporter reporter;
@@ -184,23 +202,23 @@ int main(int argc, char** argv) {
   benchmark::Shutdown();
 
   CsvWriter csv(opt.csvPath("bench_micro.csv"),
-                {"elements", "dae_size", "jacobian_nonzeros", "residual_us", "jacobian_us", "klu_refactor_us",
+                {"model", "dae_size", "jacobian_nonzeros", "residual_us", "jacobian_us", "klu_refactor_us",
                  "jacobian_in_residuals", "klu_refactor_in_residuals", "klu_refactor_default_ordering_us"});
-  std::printf("\n%8s %8s %10s %12s %12s %14s %10s %10s %16s\n", "elements", "size", "nnz(J)", "residual[us]",
+  std::printf("\n%12s %8s %10s %12s %12s %14s %10s %10s %16s\n", "model", "size", "nnz(J)", "residual[us]",
               "jacobian[us]", "klu_refac[us]", "jac/res", "klu/res", "klu_default[us]");
-  for (int n : meshes) {
-    const std::string suffix = "/elements:" + std::to_string(n);
+  for (const std::string& m : models) {
+    const std::string suffix = "/" + m;
     const auto get = [&](const std::string& name) {
       const auto it = reporter.seconds.find(name + suffix);
       return it == reporter.seconds.end() ? NAN : it->second;
     };
     const double tr = get("residual"), tj = get("jacobian"), tk = get("klu_refactor");
     const double tkd = get("klu_refactor_default_ordering");
-    const Fixture& f = fixture(n);
-    std::printf("%8d %8d %10lld %12.3f %12.3f %14.3f %10.2f %10.2f %16.3f\n", n, f.dae->layout().size,
+    const Fixture& f = fixture(m);
+    std::printf("%12s %8d %10lld %12.3f %12.3f %14.3f %10.2f %10.2f %16.3f\n", m.c_str(), f.dae->size(),
                 static_cast<long long>(f.dae->pattern().nonZeros()), 1e6 * tr, 1e6 * tj, 1e6 * tk, tj / tr, tk / tr,
                 1e6 * tkd);
-    csv.row({std::to_string(n), std::to_string(f.dae->layout().size), std::to_string(f.dae->pattern().nonZeros()),
+    csv.row({m, std::to_string(f.dae->size()), std::to_string(f.dae->pattern().nonZeros()),
              fmt(1e6 * tr), fmt(1e6 * tj), fmt(1e6 * tk), fmt(tj / tr, "%.3f"), fmt(tk / tr, "%.3f"), fmt(1e6 * tkd)});
   }
   std::printf("jac/res, klu/res: the cost of one Jacobian assembly and of one KLU refactorisation in residual "

@@ -22,6 +22,26 @@ const FfrBeamModel& requireModel(const std::shared_ptr<const FfrBeamModel>& mode
   return *model;
 }
 
+/// x^T S y without temporaries.
+template <class X, class Y>
+double bilinear(const SpMat& S, const X& x, const Y& y) {
+  double sum = 0.0;
+  for (int j = 0; j < S.outerSize(); ++j) {
+    double col = 0.0;
+    for (SpMat::InnerIterator it(S, j); it; ++it) col += x[it.row()] * it.value();
+    sum += col * y[j];
+  }
+  return sum;
+}
+
+/// (column k of S) . x, i.e. (S^T x)_k.
+template <class X>
+double columnDot(const SpMat& S, int k, const X& x) {
+  double sum = 0.0;
+  for (SpMat::InnerIterator it(S, k); it; ++it) sum += it.value() * x[it.row()];
+  return sum;
+}
+
 }  // namespace
 
 FfrBody2d::FfrBody2d(std::string name, FfrInvariants invariants, const FrameState2d& initial)
@@ -77,104 +97,128 @@ Eigen::Matrix3d FfrBody2d::frameMass(const ConstVecRef& q) const {
   Eigen::Matrix3d M;
   M << inv_.mass, 0.0, sas.x(),  //
       0.0, inv_.mass, sas.y(),   //
-      sas.x(), sas.y(), inv_.polarMoment + 2.0 * inv_.i1.dot(qf) + qf.dot(inv_.mff * qf);
+      sas.x(), sas.y(), inv_.polarMoment + 2.0 * inv_.i1.dot(qf) + bilinear(inv_.mff, qf, qf);
   return M;
 }
 
-Eigen::Matrix<double, 3, Eigen::Dynamic> FfrBody2d::frameElasticMass(const ConstVecRef& q) const {
-  // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~
-  const int nf = numElastic();
-  Eigen::Matrix<double, 3, Eigen::Dynamic> M(3, nf);
-  M.topRows<2>() = rotation(q[2]) * inv_.sBar;
-  M.row(2) = inv_.j0.transpose() + (inv_.sTilde.transpose() * q.tail(nf)).transpose();
-  return M;
+Eigen::Vector3d FfrBody2d::frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const {
+  // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~ (column k)
+  Eigen::Vector3d c;
+  c.head<2>() = A * inv_.sBar.col(k);
+  c[2] = inv_.j0[k] + columnDot(inv_.sTilde, k, qf);
+  return c;
 }
 
 void FfrBody2d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
-  const auto Mrf = frameElasticMass(q);
+  const int nf = numElastic();
+  const auto qf = q.tail(nf);
+  const Mat2 A = rotation(q[2]);
   M.addBlock(0, 0, frameMass(q));
-  M.addBlock(0, 3, Mrf);
-  M.addBlock(3, 0, Mrf.transpose());
+  for (int k = 0; k < nf; ++k) M.addBlock(0, 3 + k, frameElasticMassColumn(A, qf, k));
+  for (int j = 0; j < 3; ++j) {
+    M.addColumn(3, j, nf, [&](int k) { return frameElasticMassColumn(A, qf, k)[j]; });
+  }
   M.addSparse(3, 3, inv_.mff);
 }
 
 void FfrBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const {
   const int nf = numElastic();
-  const auto Mrf = frameElasticMass(q);
-  out.head<3>() += frameMass(q) * a.head<3>() + Mrf * a.tail(nf);
-  out.tail(nf) += Mrf.transpose() * a.head<3>() + inv_.mff * a.tail(nf);
+  const auto qf = q.tail(nf), af = a.tail(nf);
+  const Mat2 A = rotation(q[2]);
+  const double at = a[2];
+  // frame rows: M_rr a_r + M_rf a_f with M_rf a_f = (A S-bar a_f, J0.a_f + qf^T S~ a_f)
+  Eigen::Vector3d mrf;
+  mrf.head<2>() = A * (inv_.sBar * af);
+  mrf[2] = inv_.j0.dot(af) + bilinear(inv_.sTilde, qf, af);
+  out.head<3>() += frameMass(q) * a.head<3>() + mrf;
+  // elastic rows: M_fr a_r + m_ff a_f = S-bar^T A^T a_R + (J0 + S~^T qf) a_t + m_ff a_f
+  auto of = out.tail(nf);
+  of.noalias() += inv_.sBar.transpose() * (A.transpose() * a.head<2>());
+  of += at * inv_.j0;
+  of.noalias() += at * (inv_.sTilde.transpose() * qf);
+  of.noalias() += inv_.mff * af;
 }
 
 void FfrBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, const MatrixSink& K) const {
+  // d(M(q) a)/dq; m_ff and S~ are (skew-)symmetric (validated), so their rows are
+  // read as (negated) columns.
   const int nf = numElastic();
-  const auto qf = q.tail(nf);
+  const auto qf = q.tail(nf), af = a.tail(nf);
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
-  const Mat2X ASb = A * inv_.sBar;
-  Mat2X SASb(2, nf);
-  for (int k = 0; k < nf; ++k) SASb.col(k) = perp(ASb.col(k));
   const Vec2 aR = a.head<2>();
   const double at = a[2];
-  const auto af = a.tail(nf);
+  auto SASb = [&](int k) -> Vec2 { return perp(A * inv_.sBar.col(k)); };  // S A S-bar, column k
   // row R: (S A s) a_t + A S-bar a_f
-  K.addBlock(0, 2, Vec2(-As * at + SASb * af));
-  K.addBlock(0, 3, SASb * at);
+  K.addBlock(0, 2, Vec2(-As * at + perp(A * (inv_.sBar * af))));
+  for (int k = 0; k < nf; ++k) K.addBlock(0, 3 + k, Vec2(SASb(k) * at));
   // row theta: (S A s)^T a_R + m_tt a_t + m_tf a_f
   K.add(2, 2, -As.dot(aR));
-  K.addBlock(2, 3, RowVecX(aR.transpose() * SASb + 2.0 * at * (inv_.i1 + inv_.mff * qf).transpose() +
-                           (inv_.sTilde * af).transpose()));
+  for (int k = 0; k < nf; ++k) {
+    K.add(2, 3 + k,
+          aR.dot(SASb(k)) + 2.0 * at * (inv_.i1[k] + columnDot(inv_.mff, k, qf)) - columnDot(inv_.sTilde, k, af));
+  }
   // rows f: S-bar^T A^T a_R + m_ft a_t + m_ff a_f;  d(S~^T qf a_t)/dqf = S~^T a_t = -S~ a_t
-  K.addBlock(3, 2, VecX(SASb.transpose() * aR));
+  K.addColumn(3, 2, nf, [&](int k) { return SASb(k).dot(aR); });
   K.addSparse(3, 3, inv_.sTilde, -at);
-}
-
-VecX FfrBody2d::elasticGradient(const VecX& qf) const {
-  return model_ ? model_->strainEnergyGradient(qf) : VecX(inv_.kff * qf);
 }
 
 void FfrBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const {
   const int nf = numElastic();
-  const VecX qf = q.tail(nf);
-  const auto p = v.tail(nf);
+  const auto qf = q.tail(nf), p = v.tail(nf);
   const double w = v[2];
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
   const Vec2 ASbp = A * (inv_.sBar * p);
-  const VecX iu = inv_.i1 + inv_.mff * qf;  // int rho N^T u dV
-  // Quadratic velocity vector Q_v = -int rho (dr/dq)^T (-A u w^2 + 2 S A N p w) dV
+  // Quadratic velocity vector Q_v = -int rho (dr/dq)^T (-A u w^2 + 2 S A N p w) dV, with
+  // iu = I1 + m_ff qf = int rho N^T u dV
   Q.head<2>() += As * w * w - 2.0 * perp(ASbp) * w;
-  Q[2] += -2.0 * w * iu.dot(p);
-  Q.tail(nf) += w * w * iu + 2.0 * w * (inv_.sTilde * p);
+  Q[2] += -2.0 * w * (inv_.i1.dot(p) + bilinear(inv_.mff, p, qf));
+  auto Qf = Q.tail(nf);
+  Qf += (w * w) * inv_.i1;
+  Qf.noalias() += (w * w) * (inv_.mff * qf);
+  Qf.noalias() += (2.0 * w) * (inv_.sTilde * p);
   // elastic and damping forces
-  Q.tail(nf) -= elasticGradient(qf) + inv_.dff * p;
+  if (model_ && model_->geometricStiffening()) {
+    Qf -= model_->strainEnergyGradient(qf);
+  } else {
+    Qf.noalias() -= inv_.kff * qf;
+  }
+  Qf.noalias() -= inv_.dff * p;
 }
 
 void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
                                           const MatrixSink& dQdv) const {
+  // m_ff symmetric and S~ skew (validated): rows read as (negated) columns.
   const int nf = numElastic();
-  const VecX qf = q.tail(nf);
-  const auto p = v.tail(nf);
+  const auto qf = q.tail(nf), p = v.tail(nf);
   const double w = v[2];
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
-  const Mat2X ASb = A * inv_.sBar;
-  const Vec2 ASbp = ASb * p;
-  Mat2X SASb(2, nf);
-  for (int k = 0; k < nf; ++k) SASb.col(k) = perp(ASb.col(k));
-  const VecX iu = inv_.i1 + inv_.mff * qf;
+  const Vec2 ASbp = A * (inv_.sBar * p);
+  auto ASb = [&](int k) -> Vec2 { return A * inv_.sBar.col(k); };
+  auto iu = [&](int k) { return inv_.i1[k] + columnDot(inv_.mff, k, qf); };  // I1 + m_ff qf
   // Q_R = A s w^2 - 2 S A S-bar p w
   dQdq.addBlock(0, 2, Vec2(perp(As) * w * w + 2.0 * ASbp * w));
-  dQdq.addBlock(0, 3, ASb * w * w);
   dQdv.addBlock(0, 2, Vec2(2.0 * As * w - 2.0 * perp(ASbp)));
-  dQdv.addBlock(0, 3, -2.0 * SASb * w);
+  for (int k = 0; k < nf; ++k) {
+    dQdq.addBlock(0, 3 + k, Vec2(ASb(k) * w * w));
+    dQdv.addBlock(0, 3 + k, Vec2(-2.0 * w * perp(ASb(k))));
+  }
   // Q_theta = -2 w iu^T p
-  dQdq.addBlock(2, 3, RowVecX(-2.0 * w * (inv_.mff * p).transpose()));
-  dQdv.add(2, 2, -2.0 * iu.dot(p));
-  dQdv.addBlock(2, 3, RowVecX(-2.0 * w * iu.transpose()));
+  dQdv.add(2, 2, -2.0 * (inv_.i1.dot(p) + bilinear(inv_.mff, p, qf)));
+  for (int k = 0; k < nf; ++k) {
+    dQdq.add(2, 3 + k, -2.0 * w * columnDot(inv_.mff, k, p));
+    dQdv.add(2, 3 + k, -2.0 * w * iu(k));
+  }
   // Q_f = w^2 iu + 2 w S~ p - dU/dqf - D p
   dQdq.addSparse(3, 3, inv_.mff, w * w);
-  dQdq.addSparse(3, 3, model_ ? model_->strainEnergyHessian(qf) : inv_.kff, -1.0);
-  dQdv.addBlock(3, 2, VecX(2.0 * w * iu + 2.0 * (inv_.sTilde * p)));
+  if (model_ && model_->geometricStiffening()) {
+    dQdq.addSparse(3, 3, model_->strainEnergyHessian(qf), -1.0);
+  } else {
+    dQdq.addSparse(3, 3, inv_.kff, -1.0);
+  }
+  dQdv.addColumn(3, 2, nf, [&](int k) { return 2.0 * w * iu(k) - 2.0 * columnDot(inv_.sTilde, k, p); });
   dQdv.addSparse(3, 3, inv_.sTilde, 2.0 * w);
   dQdv.addSparse(3, 3, inv_.dff, -1.0);
 }
@@ -185,19 +229,17 @@ void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) co
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * q.tail(nf));
   Q.head<2>() += inv_.mass * g;
   Q[2] += perp(As).dot(g);
-  Q.tail(nf) += (A * inv_.sBar).transpose() * g;
+  Q.tail(nf).noalias() += inv_.sBar.transpose() * (A.transpose() * g);
 }
 
 void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const {
   const int nf = numElastic();
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * q.tail(nf));
-  const Mat2X ASb = A * inv_.sBar;
-  Mat2X SASb(2, nf);
-  for (int k = 0; k < nf; ++k) SASb.col(k) = perp(ASb.col(k));
+  auto SASb = [&](int k) -> Vec2 { return perp(A * inv_.sBar.col(k)); };
   K.add(2, 2, -As.dot(g));
-  K.addBlock(2, 3, RowVecX(g.transpose() * SASb));
-  K.addBlock(3, 2, VecX(SASb.transpose() * g));
+  for (int k = 0; k < nf; ++k) K.add(2, 3 + k, g.dot(SASb(k)));
+  K.addColumn(3, 2, nf, [&](int k) { return SASb(k).dot(g); });
 }
 
 double FfrBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
@@ -205,8 +247,8 @@ double FfrBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
 }
 
 double FfrBody2d::internalPotential(const ConstVecRef& q) const {
-  const VecX qf = q.tail(numElastic());
-  return model_ ? model_->strainEnergy(qf) : 0.5 * qf.dot(inv_.kff * qf);
+  const auto qf = q.tail(numElastic());
+  return model_ ? model_->strainEnergy(qf) : 0.5 * bilinear(inv_.kff, qf, qf);
 }
 
 int FfrBody2d::findPoint(const Vec2& point) const {
@@ -238,40 +280,32 @@ std::vector<int> FfrBody2d::pointSupport(const Vec2& point) const {
   return cols;
 }
 
-PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, bool withHessians) const {
+void FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+                                bool withHessians, PointKinematics& out) const {
   const int k = findPoint(point);
   if (k < 0) checkAttachmentPoint(point, "attachment");
-  return pointKinematics(q, inv_.points[k], withHessians);
-}
-
-PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
-                                           bool withHessians) const {
-  const int k = findPoint(point);
-  if (k < 0) checkAttachmentPoint(point, "attachment");
-  return kinematicsOn(q, inv_.points[k], cols, withHessians);
+  kinematicsOn(q, inv_.points[k], cols, withHessians, out);
 }
 
 PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint& pt, bool withHessians) const {
-  std::vector<int> all(numCoordinates());
-  std::iota(all.begin(), all.end(), 0);
-  return kinematicsOn(q, pt, all, withHessians);
+  PointKinematics p;
+  kinematicsOn(q, pt, nullptr, withHessians, p);
+  return p;
 }
 
-PointKinematics FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt, const std::vector<int>& cols,
-                                        bool withHessians) const {
+void FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt, const std::vector<int>* cols,
+                             bool withHessians, PointKinematics& p) const {
   // r = R + A u,  u = u0 + N qf;  dr/dtheta = S A u;  dr/dqf = A N;
   // d2r/dtheta2 = -A u;  d2r/dtheta dqf = S A N;  phi = theta + Nphi qf.
-  const int nf = numElastic(), n = static_cast<int>(cols.size());
+  const int nf = numElastic(), n = cols ? static_cast<int>(cols->size()) : numCoordinates();
   const Mat2 A = rotation(q[2]);
   const Vec2 Au = A * (pt.position + pt.shape * q.tail(nf));
-  PointKinematics p;
   p.r = q.head<2>() + Au;
   p.phi = q[2] + pt.rotationShape.dot(q.tail(nf));
-  p.Jr = Mat2X::Zero(2, n);
-  p.Jphi = RowVecX::Zero(n);
+  p.reset(n, withHessians);
   int thetaCol = -1;
   for (int a = 0; a < n; ++a) {
-    const int c = cols[a];
+    const int c = cols ? (*cols)[a] : a;
     if (c < 2) {
       p.Jr(c, a) = 1.0;
     } else if (c == 2) {
@@ -283,20 +317,15 @@ PointKinematics FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt
       p.Jphi[a] = pt.rotationShape[c - 3];
     }
   }
-  if (!withHessians) return p;
-  p.Hrx = MatX::Zero(n, n);
-  p.Hry = MatX::Zero(n, n);
-  p.Hphi = MatX::Zero(n, n);
-  if (thetaCol < 0) return p;
+  if (!withHessians || thetaCol < 0) return;
   p.Hrx(thetaCol, thetaCol) = -Au.x();
   p.Hry(thetaCol, thetaCol) = -Au.y();
   for (int a = 0; a < n; ++a) {
-    if (cols[a] < 3) continue;
+    if ((cols ? (*cols)[a] : a) < 3) continue;
     const Vec2 s = perp(p.Jr.col(a));  // S A N_k
     p.Hrx(thetaCol, a) = p.Hrx(a, thetaCol) = s.x();
     p.Hry(thetaCol, a) = p.Hry(a, thetaCol) = s.y();
   }
-  return p;
 }
 
 Vec2 FfrBody2d::centreOfMass(const ConstVecRef& q) const {

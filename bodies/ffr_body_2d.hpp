@@ -62,12 +62,11 @@ class FfrBody2d final : public Body {
   bool isDissipative() const override { return inv_.dff.nonZeros() > 0 && inv_.dff.coeffs().cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
   /// phi = theta + Nphi q_f.
-  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
-                                  bool withHessians = true) const override;
+  using Body::pointKinematics;
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
+                       PointKinematics& out) const override;
   /// The frame coordinates and the elastic coordinates the node's shape depends on.
   std::vector<int> pointSupport(const Vec2& point) const override;
-  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
-                                  bool withHessians) const override;
   void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;
   /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
@@ -75,12 +74,11 @@ class FfrBody2d final : public Body {
 
  private:
   int findPoint(const Vec2& point) const;
-  /// Mass matrix blocks: frame-frame (3 x 3) and frame-elastic (3 x nf).
+  /// Mass matrix blocks: frame-frame (3 x 3) and column k of frame-elastic (3 x nf).
   Eigen::Matrix3d frameMass(const ConstVecRef& q) const;
-  Eigen::Matrix<double, 3, Eigen::Dynamic> frameElasticMass(const ConstVecRef& q) const;
-  PointKinematics kinematicsOn(const ConstVecRef& q, const FfrPoint& p, const std::vector<int>& cols,
-                               bool withHessians) const;
-  VecX elasticGradient(const VecX& qf) const;
+  Eigen::Vector3d frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const;
+  void kinematicsOn(const ConstVecRef& q, const FfrPoint& p, const std::vector<int>* cols, bool withHessians,
+                    PointKinematics& out) const;
 
   FfrInvariants ownInvariants_;                  // given directly; empty with a model
   std::shared_ptr<const FfrBeamModel> model_;    // generating mesh model, or null

@@ -23,16 +23,11 @@ class Ground final : public Body {
   void addGravityJacobian(const ConstVecRef&, const Vec2&, const MatrixSink&) const override {}
   double gravityPotential(const ConstVecRef&, const Vec2&) const override { return 0.0; }
   using Body::pointKinematics;
-  PointKinematics pointKinematics(const ConstVecRef&, const Vec2& point, bool = true) const override {
-    PointKinematics p;
-    p.r = point;
-    p.phi = 0.0;
-    p.Jr.resize(2, 0);
-    p.Jphi.resize(0);
-    p.Hrx.resize(0, 0);
-    p.Hry.resize(0, 0);
-    p.Hphi.resize(0, 0);
-    return p;
+  void pointKinematics(const ConstVecRef&, const Vec2& point, const std::vector<int>*, bool withHessians,
+                       PointKinematics& out) const override {
+    out.r = point;
+    out.phi = 0.0;
+    out.reset(0, withHessians);
   }
   Vec2 centreOfMass(const ConstVecRef&) const override { return Vec2::Zero(); }
 };

@@ -86,23 +86,26 @@ double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const 
   return -props_.mass * g.dot(centreOfMass(q));
 }
 
-PointKinematics RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point,
-                                             bool withHessians) const {
+void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+                                  bool withHessians, PointKinematics& p) const {
   // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta.
   const Vec2 au = rotation(q[2]) * point;
-  PointKinematics p;
+  const int n = cols ? static_cast<int>(cols->size()) : 3;
   p.r = q.head<2>() + au;
   p.phi = q[2];
-  p.Jr.resize(2, 3);
-  p.Jr << 1.0, 0.0, -au.y(), 0.0, 1.0, au.x();
-  p.Jphi = Eigen::RowVector3d(0.0, 0.0, 1.0);
-  if (!withHessians) return p;
-  p.Hrx = MatX::Zero(3, 3);
-  p.Hry = MatX::Zero(3, 3);
-  p.Hrx(2, 2) = -au.x();
-  p.Hry(2, 2) = -au.y();
-  p.Hphi = MatX::Zero(3, 3);
-  return p;
+  p.reset(n, withHessians);
+  for (int a = 0; a < n; ++a) {
+    const int c = cols ? (*cols)[a] : a;
+    if (c < 2) {
+      p.Jr(c, a) = 1.0;
+      continue;
+    }
+    p.Jr.col(a) = perp(au);
+    p.Jphi[a] = 1.0;
+    if (!withHessians) continue;
+    p.Hrx(a, a) = -au.x();
+    p.Hry(a, a) = -au.y();
+  }
 }
 
 Vec2 RigidBody2d::centreOfMass(const ConstVecRef& q) const {

@@ -52,8 +52,8 @@ class RigidBody2d final : public Body {
   void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const override;
   double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
   using Body::pointKinematics;
-  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
-                                  bool withHessians = true) const override;
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
+                       PointKinematics& out) const override;
   Vec2 centreOfMass(const ConstVecRef& q) const override;
 
  private:

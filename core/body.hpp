@@ -6,23 +6,10 @@
 #include <vector>
 
 #include "core/matrix_sink.hpp"
+#include "core/point_kinematics.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
-
-/// Position and material angle of one point of a body, with first and second
-/// derivatives with respect to the body's n coordinates q.
-/// Joints and forces are written once in terms of this, whatever the body type.
-struct PointKinematics {
-  Vec2 r = Vec2::Zero();  ///< world position of the point
-  double phi = 0.0;       ///< world angle of the material cross-section at the point
-  Mat2X Jr;               ///< dr/dq, 2 x n
-  RowVecX Jphi;           ///< dphi/dq, 1 x n
-  MatX Hrx, Hry;          ///< d2 r_x/dq2, d2 r_y/dq2, n x n
-  MatX Hphi;              ///< d2 phi/dq2, n x n
-  /// sum_k w_k d2 r_k/dq2 (n x n).
-  MatX hessianR(const Vec2& w) const { return w.x() * Hrx + w.y() * Hry; }
-};
 
 /// What a coordinate measures; integrators scale their absolute tolerances by it.
 enum class CoordinateKind { Position, Angle, Elastic };
@@ -88,19 +75,29 @@ class Body {
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 
-  /// Kinematics of the material point with body-frame coordinates `point`, over all n
-  /// coordinates; the Hessians (Hrx, Hry, Hphi) only if withHessians, else left empty.
+  /// Kinematics of the material point with body-frame coordinates `point` over the
+  /// coordinates `cols` (ascending, a superset of pointSupport(point); null: all n), into
+  /// `out` (Jr is 2 x cols.size(), and so on; see PointKinematics::reset). Joints on large
+  /// flexible bodies use only the support, so their Jacobians do not grow with the body.
+  /// The Hessians (Hrx, Hry, Hphi) only if withHessians. Allocates nothing once `out`
+  /// has been filled for as many coordinates.
   /// @throws InputError if the body has no material point there.
-  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point,
-                                          bool withHessians = true) const = 0;
+  virtual void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+                               bool withHessians, PointKinematics& out) const = 0;
+  /// The same, returned (allocates; outputs and tests).
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, bool withHessians = true) const {
+    PointKinematics p;
+    pointKinematics(q, point, nullptr, withHessians, p);
+    return p;
+  }
+  PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
+                                  bool withHessians) const {
+    PointKinematics p;
+    pointKinematics(q, point, &cols, withHessians, p);
+    return p;
+  }
   /// The body coordinates the kinematics of `point` depend on (ascending). Default: all.
   virtual std::vector<int> pointSupport(const Vec2& point) const;
-  /// The same kinematics over the coordinates `cols` only (ascending, a superset of
-  /// pointSupport(point)): Jr is 2 x cols.size(), and so on. Joints on large flexible
-  /// bodies use this, so their Jacobians do not grow with the body. Default: selects
-  /// the columns of the full kinematics.
-  virtual PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
-                                          bool withHessians) const;
   /// Checks at model build time that `point` is a valid attachment point.
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
     (void)point; (void)user;

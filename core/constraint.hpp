@@ -1,7 +1,9 @@
 // The interface of constraints: joints (scleronomic) and drivers (rheonomic).
 #pragma once
 
+#include <array>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,18 +23,47 @@ struct BodyState {
   const std::vector<int>* cols;
   /// Number of used coordinates.
   int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numCoordinates(); }
-  /// Kinematics of a body point over the used coordinates.
-  PointKinematics point(const Vec2& p, bool withHessians) const {
-    return cols ? body.pointKinematics(q, p, *cols, withHessians) : body.pointKinematics(q, p, withHessians);
+  /// Kinematics of a body point over the used coordinates, into `out` (no allocation
+  /// once `out` has been filled before).
+  void point(const Vec2& p, bool withHessians, PointKinematics& out) const {
+    body.pointKinematics(q, p, cols, withHessians, out);
   }
+  /// The same, returned (allocates).
+  PointKinematics point(const Vec2& p, bool withHessians) const {
+    PointKinematics out;
+    point(p, withHessians, out);
+    return out;
+  }
+};
+
+/// The bodies of one constraint or force element with their coordinates, in the
+/// element's order; a fixed-capacity list (made per evaluation, so it lives on the stack).
+class BodyStates {
+ public:
+  /// The most bodies one constraint or force element may connect.
+  static constexpr int kMaxBodies = 4;
+  /// @throws std::logic_error beyond kMaxBodies (System::addConstraint/addForce refuse
+  /// such elements first).
+  void add(const Body& b, const double* q, const std::vector<int>* used) {
+    if (n_ == kMaxBodies) throw std::logic_error("BodyStates: more than kMaxBodies bodies");
+    states_[n_++].emplace(b, q, used);
+  }
+  int size() const { return n_; }
+  const BodyState& operator[](int k) const { return *states_[k]; }
+
+ private:
+  std::array<std::optional<BodyState>, kMaxBodies> states_;
+  int n_ = 0;
 };
 
 /// Constraint equations g(q, t) = h(q) - f(t) = 0 over the local coordinates
 /// q_local = [used coordinates of body 0; of body 1; ...] of the constraint's bodies.
+/// The caller keeps one per constraint: evaluations into it reuse its memory.
 struct ConstraintEvaluation {
   VecX h;               ///< h(q), m
   MatX G;               ///< dh/dq, m x n_local
   std::vector<MatX> H;  ///< d2 h_a/dq2, m matrices n_local x n_local (only when asked)
+  KinematicsWork work;  ///< working memory of evaluate()
 };
 
 class Constraint {
@@ -63,10 +94,11 @@ class Constraint {
   /// Drivers prescribe motion (do work); joints do not.
   virtual bool isDriver() const { return false; }
 
-  /// h, G and, if withHessians, the Hessians of each equation.
-  virtual void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                        ConstraintEvaluation& out) const = 0;
+  /// h, G and, if withHessians, the Hessians of each equation (H is left as it was
+  /// otherwise). Allocates nothing when `out` was filled by this constraint before.
+  virtual void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const = 0;
   /// Prescribed part f(t) and its exact derivatives (zero for joints).
+  /// Allocates nothing when the vectors have the size m already.
   virtual void timeFunction(double t, VecX& f, VecX& df, VecX& ddf) const {
     (void)t;
     f.setZero(numEquations());
@@ -79,7 +111,7 @@ class Constraint {
   /// Reaction outputs from the multipliers lambda (m): for joints the force (world
   /// axes) and moment exerted on the last body at its joint point; for drivers the
   /// generalised force applied along the driven quantity.
-  virtual VecX reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const = 0;
+  virtual VecX reactions(const BodyStates& bodies, const VecX& lambda) const = 0;
 
  private:
   std::string name_;

@@ -7,10 +7,10 @@ namespace {
 
 using ConstMap = Eigen::Map<const VecX>;
 
-VecX gather(const std::vector<int>& cols, const double* x) {
-  VecX out(cols.size());
+/// out[k] = x[cols[k]]
+void gather(const std::vector<int>& cols, const double* x, VecX& out) {
+  out.resize(static_cast<Eigen::Index>(cols.size()));
   for (size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
-  return out;
 }
 
 /// J(rowOffset + rows[i], colOffset + cols[j]) += B(i, j)
@@ -21,10 +21,42 @@ void addBlock(JacobianSink& J, int rowOffset, const std::vector<int>& rows, int 
   }
 }
 
-std::vector<int> range(int start, int n) {
-  std::vector<int> r(n);
-  for (int k = 0; k < n; ++k) r[k] = start + k;
-  return r;
+/// J(row0 + i, colOffset + cols[j]) += B(i, j): a block on consecutive rows (constraint
+/// equations), one merge walk per column.
+void addRowsBlock(JacobianSink& J, int row0, int colOffset, const std::vector<int>& cols, const MatX& B) {
+  for (size_t j = 0; j < cols.size(); ++j) {
+    J.addColumn(colOffset + cols[j], row0, nullptr, B.col(static_cast<Eigen::Index>(j)).data(),
+                static_cast<int>(B.rows()), 1.0);
+  }
+}
+
+/// Working memory of one constraint's terms.
+struct ConstraintScratch {
+  ConstraintEvaluation ev, plus, minus;  ///< at q; at q +- h e_k (index-1 third derivatives)
+  VecX f, df, ddf;                       ///< prescribed motion and its derivatives
+  VecX vl, al, Gtx, Hv;                  ///< local velocities, accelerations, G^T x, H_a v
+  MatX Hx, vH, dFdq;                     ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq
+};
+
+/// Working memory of one force element.
+struct ForceScratch {
+  KinematicsWork work;
+  VecX vl, Q;
+  MatX dQdq, dQdv;
+};
+
+/// DaeSystem's scratch: one per integrator, so that evaluations allocate nothing.
+struct DaeSystemScratch final : DaeScratch {
+  std::vector<VecX> bodyForce;  ///< per body, its generalised forces
+  std::vector<ConstraintScratch> constraints;
+  std::vector<ForceScratch> forces;
+  VecX qPlus, qMinus;           ///< perturbed coordinates (index-1 Jacobian)
+};
+
+DaeSystemScratch& scratchOf(DaeScratch& s) {
+  auto* d = dynamic_cast<DaeSystemScratch*>(&s);
+  if (!d) throw std::logic_error("DaeSystem: the scratch was not made by DaeSystem::makeScratch()");
+  return *d;
 }
 
 }  // namespace
@@ -99,6 +131,37 @@ std::vector<int64_t> DaeSystem::eliminationGroups() const {
   return groups;
 }
 
+std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
+  const System& sys = sys_;
+  auto s = std::make_unique<DaeSystemScratch>();
+  for (int b = 0; b < sys.numBodies(); ++b) s->bodyForce.emplace_back(sys.body(BodyIndex(b)).numCoordinates());
+  s->constraints.resize(sys.numConstraints());
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const int nl = static_cast<int>(sys.constraintColumns(ci).size()), me = sys.constraint(ci).numEquations();
+    ConstraintScratch& cs = s->constraints[c];
+    cs.vl.resize(nl);
+    cs.al.resize(nl);
+    cs.Gtx.resize(nl);
+    cs.Hv.resize(nl);
+    cs.Hx.resize(nl, nl);
+    cs.vH.resize(me, nl);
+    cs.dFdq.resize(me, nl);
+  }
+  s->forces.resize(sys.numForces());
+  for (int f = 0; f < sys.numForces(); ++f) {
+    const int nl = static_cast<int>(sys.forceColumns(ForceIndex(f)).size());
+    ForceScratch& fs = s->forces[f];
+    fs.vl.resize(nl);
+    fs.Q.resize(nl);
+    fs.dQdq.resize(nl, nl);
+    fs.dQdv.resize(nl, nl);
+  }
+  s->qPlus.resize(sys.numCoordinates());
+  s->qMinus.resize(sys.numCoordinates());
+  return s;
+}
+
 void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const VecX& lambda,
                           VecX& y, VecX& yp) const {
   const DaeLayout& L = layout_;
@@ -111,9 +174,10 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
   yp.segment(L.v, L.nq) = a;
 }
 
-void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch&) const {
+void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
+  DaeSystemScratch& S = scratchOf(scratch);
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), qp(yp + L.q, L.nq), vp(yp + L.v, L.nq);
   Eigen::Map<VecX> Fq(F + L.q, L.nq), Fv(F + L.v, L.nq);
   Fq = qp - v;
@@ -124,7 +188,8 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
     if (nb == 0) continue;
     const int off = sys.coordinateOffset(BodyIndex(b));
     const auto qb = q.segment(off, nb);
-    VecX Qb = VecX::Zero(nb);
+    VecX& Qb = S.bodyForce[b];
+    Qb.setZero();
     body.addInternalForces(qb, v.segment(off, nb), Qb);
     body.addGravityForce(qb, sys.gravity(), Qb);
     Fv.segment(off, nb) -= Qb;
@@ -132,41 +197,48 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
-    const Force& force = sys.force(fi);
     const auto& cols = sys.forceColumns(fi);
-    VecX Ql = VecX::Zero(cols.size());
-    force.addForce(t, sys.forceStates(fi, q.data()), gather(cols, v.data()), Ql,
-                   nullptr, nullptr);
-    for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] -= Ql[k];
+    ForceScratch& fs = S.forces[f];
+    gather(cols, v.data(), fs.vl);
+    fs.Q.setZero();
+    sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, nullptr, nullptr, fs.work);
+    for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] -= fs.Q[k];
   }
-  ConstraintEvaluation ev;
-  VecX f, df, ddf;
   const bool needH = formulation_ == Formulation::Index1;
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
     const int row = sys.constraintOffset(ci), me = con.numEquations();
-    con.evaluate(sys.constraintStates(ci, q.data()), needH, ev);
-    con.timeFunction(t, f, df, ddf);
-    const VecX GtLambda = ev.G.transpose() * ConstMap(y + L.lambda + row, me);
-    for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] += GtLambda[k];
-    const VecX vl = gather(cols, v.data());
+    ConstraintScratch& cs = S.constraints[c];
+    const ConstraintEvaluation& ev = cs.ev;
+    con.evaluate(sys.constraintStates(ci, q.data()), needH, cs.ev);
+    con.timeFunction(t, cs.f, cs.df, cs.ddf);
+    // F_v += G^T lambda
+    cs.Gtx.noalias() = ev.G.transpose() * ConstMap(y + L.lambda + row, me);
+    for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] += cs.Gtx[k];
+    gather(cols, v.data(), cs.vl);
+    Eigen::Map<VecX> Fc(F + L.lambda + row, me);
     switch (formulation_) {
       case Formulation::Ggl: {
-        const VecX GtMu = ev.G.transpose() * ConstMap(y + L.mu + row, me);
-        for (size_t k = 0; k < cols.size(); ++k) Fq[cols[k]] += metric_[cols[k]] * GtMu[k];
-        Eigen::Map<VecX>(F + L.lambda + row, me) = ev.h - f;
-        Eigen::Map<VecX>(F + L.mu + row, me) = ev.G * vl - df;
+        // F_q += D G^T mu;  F_g = h - f;  F_gv = G v - f'
+        cs.Gtx.noalias() = ev.G.transpose() * ConstMap(y + L.mu + row, me);
+        for (size_t k = 0; k < cols.size(); ++k) Fq[cols[k]] += metric_[cols[k]] * cs.Gtx[k];
+        Fc = ev.h - cs.f;
+        Eigen::Map<VecX> Fcv(F + L.mu + row, me);
+        Fcv.noalias() = ev.G * cs.vl;
+        Fcv -= cs.df;
         break;
       }
       case Formulation::Index3:
-        Eigen::Map<VecX>(F + L.lambda + row, me) = ev.h - f;
+        Fc = ev.h - cs.f;
         break;
       case Formulation::Index1: {
-        const VecX al = gather(cols, vp.data());
+        // F_a = G a + v^T H_a v - f''
+        gather(cols, vp.data(), cs.al);
         for (int a = 0; a < me; ++a) {
-          F[L.lambda + row + a] = ev.G.row(a).dot(al) + vl.dot(ev.H[a] * vl) - ddf[a];
+          cs.Hv.noalias() = ev.H[a] * cs.vl;
+          Fc[a] = ev.G.row(a).dot(cs.al) + cs.vl.dot(cs.Hv) - cs.ddf[a];
         }
         break;
       }
@@ -175,9 +247,10 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
 }
 
 void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
-                         DaeScratch&) const {
+                         DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
+  DaeSystemScratch& S = scratchOf(scratch);
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), vp(yp + L.v, L.nq);
   // F_q = q' - v (+ G^T mu): dF_q/dq' = I, dF_q/dv = -I
   for (int k = 0; k < L.nq; ++k) {
@@ -201,77 +274,82 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
-    const Force& force = sys.force(fi);
     const auto& cols = sys.forceColumns(fi);
-    const int nl = static_cast<int>(cols.size());
-    VecX Ql = VecX::Zero(nl);
-    MatX dQdq = MatX::Zero(nl, nl), dQdv = MatX::Zero(nl, nl);
-    force.addForce(t, sys.forceStates(fi, q.data()), gather(cols, v.data()), Ql, &dQdq,
-                   &dQdv);
-    addBlock(J, L.v, cols, L.q, cols, -dQdq);
-    addBlock(J, L.v, cols, L.v, cols, -dQdv);
+    ForceScratch& fs = S.forces[f];
+    gather(cols, v.data(), fs.vl);
+    fs.Q.setZero();
+    fs.dQdq.setZero();
+    fs.dQdv.setZero();
+    sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, &fs.dQdq, &fs.dQdv, fs.work);
+    fs.dQdq *= -1.0;
+    fs.dQdv *= -1.0;
+    addBlock(J, L.v, cols, L.q, cols, fs.dQdq);
+    addBlock(J, L.v, cols, L.v, cols, fs.dQdv);
   }
-  ConstraintEvaluation ev;
-  VecX f, df, ddf;
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
     const int nl = static_cast<int>(cols.size());
     const int row = sys.constraintOffset(ci), me = con.numEquations();
-    const std::vector<int> rows = range(row, me);
-    con.evaluate(sys.constraintStates(ci, q.data()), true, ev);
-    const VecX vl = gather(cols, v.data());
-    const MatX Gt = ev.G.transpose();
+    ConstraintScratch& cs = S.constraints[c];
+    const ConstraintEvaluation& ev = cs.ev;
+    con.evaluate(sys.constraintStates(ci, q.data()), true, cs.ev);
+    gather(cols, v.data(), cs.vl);
     // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
-    MatX Hl = MatX::Zero(nl, nl);
-    for (int a = 0; a < me; ++a) Hl += y[L.lambda + row + a] * ev.H[a];
-    addBlock(J, L.v, cols, L.q, cols, Hl);
-    addBlock(J, L.v, cols, L.lambda, rows, Gt);
-    MatX vH(me, nl);  // rows v^T H_a = d(G v)/dq
-    for (int a = 0; a < me; ++a) vH.row(a) = vl.transpose() * ev.H[a];
+    cs.Hx.setZero();
+    for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];
+    addBlock(J, L.v, cols, L.q, cols, cs.Hx);
+    for (int a = 0; a < me; ++a) {
+      for (int k = 0; k < nl; ++k) J.add(L.v + cols[k], L.lambda + row + a, ev.G(a, k));
+    }
+    for (int a = 0; a < me; ++a) cs.vH.row(a).noalias() = cs.vl.transpose() * ev.H[a];  // d(G v)/dq
     switch (formulation_) {
       case Formulation::Ggl: {
-        MatX Hm = MatX::Zero(nl, nl);
-        for (int a = 0; a < me; ++a) Hm += y[L.mu + row + a] * ev.H[a];
-        MatX DGt = Gt;
-        for (int k = 0; k < nl; ++k) {
-          Hm.row(k) *= metric_[cols[k]];
-          DGt.row(k) *= metric_[cols[k]];
+        // F_q += D G^T mu: d/dq = D sum_a mu_a H_a, d/dmu = D G^T
+        cs.Hx.setZero();
+        for (int a = 0; a < me; ++a) cs.Hx += y[L.mu + row + a] * ev.H[a];
+        for (int j = 0; j < nl; ++j) {
+          for (int i = 0; i < nl; ++i) J.add(L.q + cols[i], L.q + cols[j], metric_[cols[i]] * cs.Hx(i, j));
         }
-        addBlock(J, L.q, cols, L.q, cols, Hm);
-        addBlock(J, L.q, cols, L.mu, rows, DGt);
-        addBlock(J, L.lambda, rows, L.q, cols, ev.G);
-        addBlock(J, L.mu, rows, L.q, cols, vH);
-        addBlock(J, L.mu, rows, L.v, cols, ev.G);
+        for (int a = 0; a < me; ++a) {
+          for (int k = 0; k < nl; ++k) J.add(L.q + cols[k], L.mu + row + a, metric_[cols[k]] * ev.G(a, k));
+        }
+        addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+        addRowsBlock(J, L.mu + row, L.q, cols, cs.vH);
+        addRowsBlock(J, L.mu + row, L.v, cols, ev.G);
         break;
       }
       case Formulation::Index3:
-        addBlock(J, L.lambda, rows, L.q, cols, ev.G);
+        addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
         break;
       case Formulation::Index1: {
         // F_a = G a + v^T H v - f'': d/dq = a^T H_a + d(v^T H_a v)/dq, d/dv = 2 v^T H_a,
         // d/da = G. The third-derivative term d(v^T H_a v)/dq is the one block taken
         // by central differences of the analytic Hessians (docs/formulations.md).
-        const VecX al = gather(cols, vp.data());
-        MatX dFdq(me, nl);
-        for (int a = 0; a < me; ++a) dFdq.row(a) = al.transpose() * ev.H[a];
-        VecX qp = q, qm = q;
-        ConstraintEvaluation ep, em;
+        gather(cols, vp.data(), cs.al);
+        for (int a = 0; a < me; ++a) cs.dFdq.row(a).noalias() = cs.al.transpose() * ev.H[a];
+        S.qPlus = q;
+        S.qMinus = q;
         for (int k = 0; k < nl; ++k) {
           const int c = cols[k];
           const double h = 1e-6 * (1.0 + std::abs(q[c]));
-          qp[c] = q[c] + h;
-          qm[c] = q[c] - h;
-          con.evaluate(sys.constraintStates(ci, qp.data()), true, ep);
-          con.evaluate(sys.constraintStates(ci, qm.data()), true, em);
-          qp[c] = qm[c] = q[c];
+          S.qPlus[c] = q[c] + h;
+          S.qMinus[c] = q[c] - h;
+          con.evaluate(sys.constraintStates(ci, S.qPlus.data()), true, cs.plus);
+          con.evaluate(sys.constraintStates(ci, S.qMinus.data()), true, cs.minus);
+          S.qPlus[c] = S.qMinus[c] = q[c];
           for (int a = 0; a < me; ++a) {
-            dFdq(a, k) += (vl.dot(ep.H[a] * vl) - vl.dot(em.H[a] * vl)) / (2.0 * h);
+            cs.Hv.noalias() = cs.plus.H[a] * cs.vl;
+            const double plus = cs.vl.dot(cs.Hv);
+            cs.Hv.noalias() = cs.minus.H[a] * cs.vl;
+            cs.dFdq(a, k) += (plus - cs.vl.dot(cs.Hv)) / (2.0 * h);
           }
         }
-        addBlock(J, L.lambda, rows, L.q, cols, dFdq);
-        addBlock(J, L.lambda, rows, L.v, cols, 2.0 * vH + cj * ev.G);
+        addRowsBlock(J, L.lambda + row, L.q, cols, cs.dFdq);
+        cs.vH *= 2.0;
+        cs.vH += cj * ev.G;
+        addRowsBlock(J, L.lambda + row, L.v, cols, cs.vH);
         break;
       }
     }

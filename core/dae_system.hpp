@@ -64,6 +64,9 @@ class DaeSystem final : public DaeProblem {
   /// for index 3 also the velocities, which are index-2 variables there).
   VecX differentialIds() const override;
 
+  /// Working memory of one integrator: per body, constraint and force (sized from the
+  /// model; evaluations with it allocate nothing after the first).
+  std::unique_ptr<DaeScratch> makeScratch() const override;
   using DaeProblem::jacobian;
   using DaeProblem::residual;
   void residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const override;

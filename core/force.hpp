@@ -25,10 +25,17 @@ class Force {
   virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
 
   /// Q += generalised force; if dQdq / dQdv are given, they receive += its derivatives.
-  virtual void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v,
-                        VecX& Q, MatX* dQdq, MatX* dQdv) const = 0;
+  /// `work` is the caller's working memory for this force: with it kept between calls,
+  /// evaluations allocate nothing.
+  virtual void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                        KinematicsWork& work) const = 0;
+  /// The same with working memory made for the call (allocates; outputs and tests).
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv) const {
+    KinematicsWork work;
+    addForce(t, bodies, v, Q, dQdq, dQdv, work);
+  }
   /// Potential energy, for forces deriving from one (springs).
-  virtual double potentialEnergy(const std::vector<BodyState>& bodies) const {
+  virtual double potentialEnergy(const BodyStates& bodies) const {
     (void)bodies;
     return 0.0;
   }

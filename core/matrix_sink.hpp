@@ -23,7 +23,8 @@ class MatrixSink {
       jacobian_->add(row0_ + i, col0_ + j, scale_ * value);
     }
   }
-  /// Block B at (i0, j0), every entry (dense blocks: frame rows and columns).
+  /// Block B at (i0, j0), every entry (dense blocks: frame rows and columns). B is
+  /// evaluated into a matrix of its compile-time size: of fixed size it allocates nothing.
   template <class Derived>
   void addBlock(int i0, int j0, const Eigen::MatrixBase<Derived>& B) const {
     const Eigen::Matrix<double, Derived::RowsAtCompileTime, Derived::ColsAtCompileTime> b = B;  // column-major
@@ -34,6 +35,16 @@ class MatrixSink {
       } else {
         jacobian_->addColumn(col0_ + j0 + static_cast<int>(j), row0_ + i0, nullptr, b.col(j).data(), rows, scale_);
       }
+    }
+  }
+  /// Column j, rows i0 .. i0 + n - 1: += value(k) (a column computed on the fly, e.g. the
+  /// transpose of a row block, without forming it).
+  template <class Fn>
+  void addColumn(int i0, int j, int n, Fn&& value) const {
+    if (dense_) {
+      for (int k = 0; k < n; ++k) (*dense_)(i0 + k, j) += scale_ * value(k);
+    } else {
+      jacobian_->addColumnSegment(col0_ + j, row0_ + i0, n, value, scale_);
     }
   }
   /// s * S at (i0, j0), its stored entries only.

@@ -60,6 +60,24 @@ class JacobianSink {
     if (k < 0) throwOutsidePattern(row, col);
     data_[k] += value;
   }
+  /// J(row0 + k, col) += s * value(k) for k < n: a column segment computed on the fly
+  /// (one merge walk down the column in a sparse pattern).
+  template <class Fn>
+  void addColumnSegment(int col, int row0, int n, Fn&& value, double s) {
+    if (entries_ || !pattern_) {
+      for (int k = 0; k < n; ++k) add(row0 + k, col, s * value(k));
+      return;
+    }
+    const auto& ri = pattern_->rowIndex();
+    int64_t p = pattern_->colStart()[col];
+    const int64_t end = pattern_->colStart()[col + 1];
+    for (int k = 0; k < n; ++k) {
+      const int r = row0 + k;
+      while (p < end && ri[p] < r) ++p;
+      if (p == end || ri[p] != r) throwOutsidePattern(r, col);
+      data_[p] += s * value(k);
+    }
+  }
   /// J(row0 + rows[k], col) += s * values[k], k < n, rows ascending (rows null: rows
   /// 0..n-1). In a sparse pattern one merge walk down the column replaces n searches.
   void addColumn(int col, int row0, const int* rows, const double* values, int n, double s) {

@@ -70,6 +70,10 @@ ConstraintIndex System::addConstraint(std::unique_ptr<Constraint> c) {
   if (!c) throw InputError("addConstraint: null constraint");
   const std::string kind = c->isDriver() ? "driver" : "joint";
   checkNewName(c->name(), kind);
+  if (c->bodies().size() > static_cast<size_t>(BodyStates::kMaxBodies)) {
+    throw InputError(kind + " '" + c->name() + "': connects " + std::to_string(c->bodies().size()) +
+                     " bodies; at most " + std::to_string(BodyStates::kMaxBodies) + " are supported");
+  }
   for (BodyIndex b : c->bodies()) checkBody(b, kind + " '" + c->name() + "'");
   constraints_.push_back(std::move(c));
   return ConstraintIndex(numConstraints() - 1);
@@ -79,6 +83,10 @@ ForceIndex System::addForce(std::unique_ptr<Force> f) {
   requireBuildPhase("force");
   if (!f) throw InputError("addForce: null force");
   checkNewName(f->name(), "force");
+  if (f->bodies().size() > static_cast<size_t>(BodyStates::kMaxBodies)) {
+    throw InputError("force '" + f->name() + "': connects " + std::to_string(f->bodies().size()) +
+                     " bodies; at most " + std::to_string(BodyStates::kMaxBodies) + " are supported");
+  }
   for (BodyIndex b : f->bodies()) checkBody(b, "force '" + f->name() + "'");
   forces_.push_back(std::move(f));
   return ForceIndex(numForces() - 1);
@@ -296,21 +304,20 @@ VecX System::initialVelocities() const {
   return v;
 }
 
-std::vector<BodyState> System::states(const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
-                                      const double* q) const {
-  std::vector<BodyState> out;
-  out.reserve(bs.size());
+BodyStates System::states(const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
+                          const double* q) const {
+  BodyStates out;
   for (size_t slot = 0; slot < bs.size(); ++slot) {
-    out.emplace_back(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot]);
+    out.add(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot]);
   }
   return out;
 }
 
-std::vector<BodyState> System::constraintStates(ConstraintIndex i, const double* q) const {
+BodyStates System::constraintStates(ConstraintIndex i, const double* q) const {
   return states(constraint(i).bodies(), constraintUsed_.at(i.value), q);
 }
 
-std::vector<BodyState> System::forceStates(ForceIndex i, const double* q) const {
+BodyStates System::forceStates(ForceIndex i, const double* q) const {
   return states(force(i).bodies(), forceUsed_.at(i.value), q);
 }
 

@@ -87,8 +87,8 @@ class System {
   VecX initialVelocities() const;
   /// Views of a constraint's / force's bodies at the global coordinates q (size nq),
   /// restricted to the coordinates it uses.
-  std::vector<BodyState> constraintStates(ConstraintIndex i, const double* q) const;
-  std::vector<BodyState> forceStates(ForceIndex i, const double* q) const;
+  BodyStates constraintStates(ConstraintIndex i, const double* q) const;
+  BodyStates forceStates(ForceIndex i, const double* q) const;
   /// "joint 'O2' (revolute, equation 1)": the constraint that owns global equation `row`.
   std::string describeEquation(int row) const;
   /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
@@ -119,8 +119,8 @@ class System {
   std::vector<std::vector<int>> constraintCols_, forceCols_;
   // per constraint / force, per body slot: the body-local coordinates used
   std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_;
-  std::vector<BodyState> states(const std::vector<BodyIndex>& bodies,
-                                const std::vector<std::vector<int>>& used, const double* q) const;
+  BodyStates states(const std::vector<BodyIndex>& bodies,
+                    const std::vector<std::vector<int>>& used, const double* q) const;
 };
 
 }  // namespace flexmbd

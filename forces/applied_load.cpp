@@ -15,13 +15,16 @@ AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, Ti
   requireFinite(point.y(), "force '" + this->name() + "': point[1]");
 }
 
-void AppliedLoad::addForce(double t, const std::vector<BodyState>& b, const VecX&, VecX& Q,
-                           MatX* dQdq, MatX*) const {
-  const PointKinematics p = b[0].point(point_, dQdq != nullptr);
+void AppliedLoad::addForce(double t, const BodyStates& b, const VecX&, VecX& Q, MatX* dQdq, MatX*,
+                           KinematicsWork& w) const {
+  // Q = Jr^T F + tau Jphi^T (virtual work of a force F at the point and a torque tau)
+  b[0].point(point_, dQdq != nullptr, w.pi);
+  const PointKinematics& p = w.pi;
   const Vec2 F(forceX_ ? forceX_->evaluate(t).f : 0.0, forceY_ ? forceY_->evaluate(t).f : 0.0);
   const double tau = torque_ ? torque_->evaluate(t).f : 0.0;
-  Q += p.Jr.transpose() * F + tau * p.Jphi.transpose();
-  if (dQdq) *dQdq += p.hessianR(F) + tau * p.Hphi;
+  Q.noalias() += p.Jr.transpose() * F;
+  Q += tau * p.Jphi.transpose();
+  if (dQdq) *dQdq += F.x() * p.Hrx + F.y() * p.Hry + tau * p.Hphi;
 }
 
 }  // namespace flexmbd

@@ -12,8 +12,9 @@ class AppliedLoad final : public Force {
   AppliedLoad(std::string name, BodyIndex body, const Vec2& point, TimeLawPtr forceX,
               TimeLawPtr forceY, TimeLawPtr torque);
   std::string typeName() const override { return "applied_load"; }
-  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
-                MatX* dQdq, MatX* dQdv) const override;
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
   bool isConservative() const override { return false; }
   std::vector<std::pair<BodyIndex, Vec2>> attachments() const override { return {{bodies()[0], point_}}; }
 

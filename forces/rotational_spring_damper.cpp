@@ -23,23 +23,33 @@ RotationalSpringDamper::RotationalSpringDamper(std::string name, BodyIndex bodyI
   if (damping < 0.0) throw InputError(who + ": damping must be >= 0, got " + std::to_string(damping));
 }
 
-void RotationalSpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v,
-                                      VecX& Q, MatX* dQdq, MatX* dQdv) const {
+void RotationalSpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                                      KinematicsWork& w) const {
   const bool withHessians = dQdq != nullptr;
-  const PointPair p = makePointPair(b[0].point(pointI_, withHessians),
-                                    b[1].point(pointJ_, withHessians), withHessians);
-  const RowVecX J = p.JphiJ - p.JphiI;
+  b[0].point(pointI_, withHessians, w.pi);
+  b[1].point(pointJ_, withHessians, w.pj);
+  makePointPair(w.pi, w.pj, withHessians, w.pair);
+  const PointPair& p = w.pair;
+  // phi = phi_j - phi_i, J = dphi/dq, tau = k (phi - phi0) + c J v, Q = -tau J^T
+  RowVecX& J = w.row;
+  J = p.JphiJ - p.JphiI;
   const double phi = p.phiJ - p.phiI;
   const double tau = stiffness_ * (phi - freeAngle_) + damping_ * J.dot(v);
   Q -= tau * J.transpose();
   if (dQdq) {
-    const MatX H = p.HphiJ - p.HphiI;
-    *dQdq -= J.transpose() * (stiffness_ * J + damping_ * v.transpose() * H) + tau * H;
+    // dQ/dq = -J^T (k J + c v^T H) - tau H with H = d2phi/dq2
+    MatX& H = w.hessian;
+    H = p.HphiJ - p.HphiI;
+    RowVecX& dtau = w.row2;
+    dtau.noalias() = v.transpose() * H;
+    dtau = stiffness_ * J + damping_ * dtau;
+    dQdq->noalias() -= J.transpose() * dtau;
+    *dQdq -= tau * H;
   }
-  if (dQdv) *dQdv -= damping_ * J.transpose() * J;
+  if (dQdv) dQdv->noalias() -= damping_ * J.transpose() * J;
 }
 
-double RotationalSpringDamper::potentialEnergy(const std::vector<BodyState>& b) const {
+double RotationalSpringDamper::potentialEnergy(const BodyStates& b) const {
   const double phi = b[1].point(pointJ_, false).phi -
                      b[0].point(pointI_, false).phi;
   return 0.5 * stiffness_ * (phi - freeAngle_) * (phi - freeAngle_);

@@ -13,9 +13,10 @@ class RotationalSpringDamper final : public Force {
                          const Vec2& pointJ, double stiffness, double damping,
                          double freeAngle);
   std::string typeName() const override { return "rotational_spring_damper"; }
-  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
-                MatX* dQdq, MatX* dQdv) const override;
-  double potentialEnergy(const std::vector<BodyState>& bodies) const override;
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0; }
   std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
     return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};

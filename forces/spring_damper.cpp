@@ -28,37 +28,47 @@ SpringDamper::SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI
   if (freeLength < 0.0) throw InputError(who + ": free_length must be >= 0, got " + std::to_string(freeLength));
 }
 
-double SpringDamper::length(const std::vector<BodyState>& b) const {
-  return (b[1].point(pointJ_, false).r - b[0].point(pointI_, false).r)
-      .norm();
+double SpringDamper::length(const BodyStates& b) const {
+  return (b[1].point(pointJ_, false).r - b[0].point(pointI_, false).r).norm();
 }
 
-void SpringDamper::addForce(double, const std::vector<BodyState>& b, const VecX& v, VecX& Q,
-                            MatX* dQdq, MatX* dQdv) const {
+void SpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                            KinematicsWork& w) const {
   const bool withHessians = dQdq != nullptr;
-  const PointPair p = makePointPair(b[0].point(pointI_, withHessians),
-                                    b[1].point(pointJ_, withHessians), withHessians);
+  b[0].point(pointI_, withHessians, w.pi);
+  b[1].point(pointJ_, withHessians, w.pj);
+  makePointPair(w.pi, w.pj, withHessians, w.pair);
+  const PointPair& p = w.pair;
   const double l = p.d.norm();
   if (!(l > 1e-12)) {
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
   }
+  // l = |d|, e = d / l, dl/dq = e^T D, f = k (l - l0) + c dl/dt, Q = -f (dl/dq)^T
   const Vec2 e = p.d / l;
-  const RowVecX eD = e.transpose() * p.D;  // dl/dq
+  RowVecX& eD = w.row;
+  eD.noalias() = e.transpose() * p.D;
   const double ldot = eD.dot(v);
   const double f = stiffness_ * (l - freeLength_) + damping_ * ldot;
   Q -= f * eD.transpose();
   if (dQdq) {
-    const MatX He = p.hessianD(e);
-    const Mat2 P = Mat2::Identity() - e * e.transpose();
-    const MatX DPD = p.D.transpose() * P * p.D / l;  // d(D^T e)/dq without Hessian part
-    const RowVecX dldotdq = v.transpose() * DPD + v.transpose() * He;
-    const RowVecX dfdq = stiffness_ * eD + damping_ * dldotdq;
-    *dQdq -= eD.transpose() * dfdq + f * (He + DPD);
+    // d2l/dq2 = He + D^T P D / l with He = e_x Hdx + e_y Hdy, P = I - e e^T, and
+    // D^T P D = D^T D - eD^T eD; d(dl/dt)/dq = v^T d2l/dq2.
+    MatX& He = w.hessian;
+    He = e.x() * p.Hdx + e.y() * p.Hdy;
+    const Vec2 Dv = p.D * v;
+    RowVecX& dfdq = w.row2;
+    dfdq.noalias() = ((Dv - e * e.dot(Dv)) / l).transpose() * p.D;
+    dfdq.noalias() += v.transpose() * He;
+    dfdq = stiffness_ * eD + damping_ * dfdq;
+    dQdq->noalias() -= eD.transpose() * dfdq;
+    *dQdq -= f * He;
+    dQdq->noalias() -= (f / l) * p.D.transpose() * p.D;
+    dQdq->noalias() += (f / l) * eD.transpose() * eD;
   }
-  if (dQdv) *dQdv -= damping_ * eD.transpose() * eD;
+  if (dQdv) dQdv->noalias() -= damping_ * eD.transpose() * eD;
 }
 
-double SpringDamper::potentialEnergy(const std::vector<BodyState>& b) const {
+double SpringDamper::potentialEnergy(const BodyStates& b) const {
   const double s = length(b) - freeLength_;
   return 0.5 * stiffness_ * s * s;
 }

@@ -13,15 +13,16 @@ class SpringDamper final : public Force {
   SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
                const Vec2& pointJ, double stiffness, double damping, double freeLength);
   std::string typeName() const override { return "spring_damper"; }
-  void addForce(double t, const std::vector<BodyState>& bodies, const VecX& v, VecX& Q,
-                MatX* dQdq, MatX* dQdv) const override;
-  double potentialEnergy(const std::vector<BodyState>& bodies) const override;
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0; }
   std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
     return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
   }
   /// Current length (for outputs and tests).
-  double length(const std::vector<BodyState>& bodies) const;
+  double length(const BodyStates& bodies) const;
 
  private:
   Vec2 pointI_, pointJ_;

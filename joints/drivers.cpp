@@ -8,24 +8,27 @@ BodyCoordinateDriver::BodyCoordinateDriver(std::string name, BodyIndex body, int
       coordinate_(coordinate),
       coordinateName_(std::move(coordinateName)) {}
 
-void BodyCoordinateDriver::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                                    ConstraintEvaluation& out) const {
-  // local coordinates: only q_k (coordinatesUsed)
-  out.h = VecX::Constant(1, bodies[0].q[coordinate_]);
-  out.G = MatX::Ones(1, 1);
-  if (withHessians) out.H = {MatX::Zero(1, 1)};
+void BodyCoordinateDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // local coordinates: only q_k (coordinatesUsed); h = q_k
+  out.h.setConstant(1, bodies[0].q[coordinate_]);
+  out.G.setOnes(1, 1);
+  if (!withHessians) return;
+  out.H.resize(1);
+  out.H[0].setZero(1, 1);
 }
 
 JointAngleDriver::JointAngleDriver(std::string name, BodyIndex bodyI, const Vec2& pointI,
                                    BodyIndex bodyJ, const Vec2& pointJ, TimeLawPtr law)
     : LawDriver<TwoPointConstraint>(std::move(law), std::move(name), bodyI, pointI, bodyJ, pointJ) {}
 
-void JointAngleDriver::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                                ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies, withHessians);
-  out.h = VecX::Constant(1, p.phiJ - p.phiI);
+void JointAngleDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // h = phi_j - phi_i
+  const PointPair& p = pair(bodies, withHessians, out.work);
+  out.h.setConstant(1, p.phiJ - p.phiI);
   out.G = p.JphiJ - p.JphiI;
-  if (withHessians) out.H = {p.HphiJ - p.HphiI};
+  if (!withHessians) return;
+  out.H.resize(1);
+  out.H[0] = p.HphiJ - p.HphiI;
 }
 
 JointDisplacementDriver::JointDisplacementDriver(std::string name, BodyIndex bodyI,
@@ -37,16 +40,15 @@ JointDisplacementDriver::JointDisplacementDriver(std::string name, BodyIndex bod
   axis_ = axis.normalized();
 }
 
-void JointDisplacementDriver::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
+void JointDisplacementDriver::evaluate(const BodyStates& bodies, bool withHessians,
                                        ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies, withHessians);
+  // h = a_w^T (r_j - r_i)
+  const PointPair& p = pair(bodies, withHessians, out.work);
   double s = 0.0;
-  RowVecX grad;
-  MatX hess;
-  projectOnRotatingAxis(p, axis_, withHessians, s, grad, &hess);
-  out.h = VecX::Constant(1, s);
-  out.G = grad;
-  if (withHessians) out.H = {hess};
+  out.H.resize(1);
+  projectOnRotatingAxis(p, axis_, s, out.work.row, withHessians ? &out.H[0] : nullptr, out.work.row2);
+  out.h.setConstant(1, s);
+  out.G = out.work.row;
 }
 
 }  // namespace flexmbd

@@ -21,12 +21,12 @@ class LawDriver : public Base {
   bool isDriver() const override { return true; }
   void timeFunction(double t, VecX& f, VecX& df, VecX& ddf) const override {
     const LawValue v = law_->evaluate(t);
-    f = VecX::Constant(1, v.f);
-    df = VecX::Constant(1, v.df);
-    ddf = VecX::Constant(1, v.ddf);
+    f.setConstant(1, v.f);
+    df.setConstant(1, v.df);
+    ddf.setConstant(1, v.ddf);
   }
   std::vector<std::string> reactionNames() const override { return {"effort"}; }
-  VecX reactions(const std::vector<BodyState>&, const VecX& lambda) const override {
+  VecX reactions(const BodyStates&, const VecX& lambda) const override {
     return VecX::Constant(1, -lambda[0]);
   }
 
@@ -42,8 +42,7 @@ class BodyCoordinateDriver final : public LawDriver<Constraint> {
                        TimeLawPtr law);
   std::string typeName() const override { return "body_" + coordinateName_; }
   std::optional<std::vector<int>> coordinatesUsed(int) const override { return std::vector<int>{coordinate_}; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
 
  private:
   int coordinate_;
@@ -57,8 +56,7 @@ class JointAngleDriver final : public LawDriver<TwoPointConstraint> {
   JointAngleDriver(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
                    const Vec2& pointJ, TimeLawPtr law);
   std::string typeName() const override { return "joint_angle"; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
 };
 
 /// Prescribes the displacement of a prismatic joint: s = a_w^T (r_j - r_i), with a_w the
@@ -68,8 +66,7 @@ class JointDisplacementDriver final : public LawDriver<TwoPointConstraint> {
   JointDisplacementDriver(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
                           const Vec2& pointJ, const Vec2& axis, TimeLawPtr law);
   std::string typeName() const override { return "joint_displacement"; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
 
  private:
   Vec2 axis_;

@@ -9,18 +9,22 @@ FixedJoint::FixedJoint(std::string name, BodyIndex bodyI, const Vec2& pointI, Bo
   requireFinite(referenceAngle, "joint '" + this->name() + "': reference angle");
 }
 
-void FixedJoint::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                          ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies, withHessians);
+void FixedJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // h = (r_j - r_i, phi_j - phi_i - phi0)
+  const PointPair& p = pair(bodies, withHessians, out.work);
   out.h.resize(3);
   out.h << p.d, p.phiJ - p.phiI - referenceAngle_;
   out.G.resize(3, p.n());
   out.G.topRows(2) = p.D;
   out.G.row(2) = p.JphiJ - p.JphiI;
-  if (withHessians) out.H = {p.Hdx, p.Hdy, p.HphiJ - p.HphiI};
+  if (!withHessians) return;
+  out.H.resize(3);
+  out.H[0] = p.Hdx;
+  out.H[1] = p.Hdy;
+  out.H[2] = p.HphiJ - p.HphiI;
 }
 
-VecX FixedJoint::reactions(const std::vector<BodyState>&, const VecX& lambda) const {
+VecX FixedJoint::reactions(const BodyStates&, const VecX& lambda) const {
   return Eigen::Vector3d(-lambda[0], -lambda[1], -lambda[2]);
 }
 

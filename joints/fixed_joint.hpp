@@ -14,10 +14,9 @@ class FixedJoint final : public TwoPointConstraint {
              const Vec2& pointJ, double referenceAngle);
   int numEquations() const override { return 3; }
   std::string typeName() const override { return "fixed"; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
   std::vector<std::string> reactionNames() const override { return {"fx", "fy", "m"}; }
-  VecX reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const override;
+  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
 
  private:
   double referenceAngle_;

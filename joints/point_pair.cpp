@@ -1,54 +1,49 @@
 #include "joints/point_pair.hpp"
 
-namespace flexmbd {
-
-PointPair makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians) {
-  PointPair p;
-  p.ni = static_cast<int>(pi.Jr.cols());
-  p.nj = static_cast<int>(pj.Jr.cols());
-  const int n = p.n();
-  p.d = pj.r - pi.r;
-  p.D.setZero(2, n);
-  p.D.leftCols(p.ni) = -pi.Jr;
-  p.D.rightCols(p.nj) = pj.Jr;
-  p.phiI = pi.phi;
-  p.phiJ = pj.phi;
-  p.JphiI.setZero(n);
-  p.JphiJ.setZero(n);
-  p.JphiI.head(p.ni) = pi.Jphi;
-  p.JphiJ.tail(p.nj) = pj.Jphi;
-  if (!withHessians) return p;
-  p.Hdx.setZero(n, n);
-  p.Hdy.setZero(n, n);
-  p.Hdx.topLeftCorner(p.ni, p.ni) = -pi.Hrx;
-  p.Hdy.topLeftCorner(p.ni, p.ni) = -pi.Hry;
-  p.Hdx.bottomRightCorner(p.nj, p.nj) = pj.Hrx;
-  p.Hdy.bottomRightCorner(p.nj, p.nj) = pj.Hry;
-  p.HphiI.setZero(n, n);
-  p.HphiJ.setZero(n, n);
-  p.HphiI.topLeftCorner(p.ni, p.ni) = pi.Hphi;
-  p.HphiJ.bottomRightCorner(p.nj, p.nj) = pj.Hphi;
-  return p;
-}
-
-}  // namespace flexmbd
-
 #include "core/errors.hpp"
 
 namespace flexmbd {
 
-void projectOnRotatingAxis(const PointPair& p, const Vec2& axisLocal, bool withHessian,
-                           double& s, RowVecX& grad, MatX* hessian) {
+void makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians, PointPair& p) {
+  p.ni = pi.numCoordinates();
+  p.nj = pj.numCoordinates();
+  const int n = p.n(), ni = p.ni, nj = p.nj;
+  p.d = pj.r - pi.r;
+  p.D.resize(2, n);
+  p.D.leftCols(ni) = -pi.Jr;
+  p.D.rightCols(nj) = pj.Jr;
+  p.phiI = pi.phi;
+  p.phiJ = pj.phi;
+  p.JphiI.setZero(n);
+  p.JphiJ.setZero(n);
+  p.JphiI.head(ni) = pi.Jphi;
+  p.JphiJ.tail(nj) = pj.Jphi;
+  if (!withHessians) return;
+  for (MatX* H : {&p.Hdx, &p.Hdy, &p.HphiI, &p.HphiJ}) H->setZero(n, n);
+  p.Hdx.topLeftCorner(ni, ni) = -pi.Hrx;
+  p.Hdy.topLeftCorner(ni, ni) = -pi.Hry;
+  p.Hdx.bottomRightCorner(nj, nj) = pj.Hrx;
+  p.Hdy.bottomRightCorner(nj, nj) = pj.Hry;
+  p.HphiI.topLeftCorner(ni, ni) = pi.Hphi;
+  p.HphiJ.bottomRightCorner(nj, nj) = pj.Hphi;
+}
+
+void projectOnRotatingAxis(const PointPair& p, const Vec2& axisLocal, double& s, RowVecX& grad, MatX* hessian,
+                           RowVecX& saD) {
   const Vec2 a = rotation(p.phiI) * axisLocal;  // world axis
   const Vec2 sa = perp(a);                      // d a / d phi_i
   s = a.dot(p.d);
   const double sad = sa.dot(p.d);
-  grad = a.transpose() * p.D + sad * p.JphiI;
-  if (withHessian) {
-    const RowVecX saD = sa.transpose() * p.D;
-    *hessian = p.hessianD(a) + saD.transpose() * p.JphiI + p.JphiI.transpose() * saD -
-               a.dot(p.d) * p.JphiI.transpose() * p.JphiI + sad * p.HphiI;
-  }
+  grad.noalias() = a.transpose() * p.D;
+  grad += sad * p.JphiI;
+  if (!hessian) return;
+  // a_x Hdx + a_y Hdy + (S a)^T D (x) Jphi_i + Jphi_i (x) (S a)^T D - s Jphi_i^T Jphi_i + (S a . d) Hphi_i
+  saD.noalias() = sa.transpose() * p.D;
+  MatX& H = *hessian;
+  H = a.x() * p.Hdx + a.y() * p.Hdy + sad * p.HphiI;
+  H.noalias() += saD.transpose() * p.JphiI;
+  H.noalias() += p.JphiI.transpose() * saD;
+  H.noalias() -= s * p.JphiI.transpose() * p.JphiI;
 }
 
 TwoPointConstraint::TwoPointConstraint(std::string name, BodyIndex bodyI, const Vec2& pointI,
@@ -63,9 +58,11 @@ TwoPointConstraint::TwoPointConstraint(std::string name, BodyIndex bodyI, const 
   }
 }
 
-PointPair TwoPointConstraint::pair(const std::vector<BodyState>& bodies, bool withHessians) const {
-  return makePointPair(bodies[0].point(pointI_, withHessians),
-                       bodies[1].point(pointJ_, withHessians), withHessians);
+const PointPair& TwoPointConstraint::pair(const BodyStates& bodies, bool withHessians, KinematicsWork& w) const {
+  bodies[0].point(pointI_, withHessians, w.pi);
+  bodies[1].point(pointJ_, withHessians, w.pj);
+  makePointPair(w.pi, w.pj, withHessians, w.pair);
+  return w.pair;
 }
 
 }  // namespace flexmbd

@@ -17,22 +17,21 @@ PrismaticJoint::PrismaticJoint(std::string name, BodyIndex bodyI, const Vec2& po
   axis_ = axis.normalized();
 }
 
-void PrismaticJoint::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                              ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies, withHessians);
+void PrismaticJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // h = (a_w^T d, phi_j - phi_i - phi0) with a_w the normal to the sliding axis
+  const PointPair& p = pair(bodies, withHessians, out.work);
   double s = 0.0;
-  RowVecX grad;
-  MatX hess;
-  projectOnRotatingAxis(p, perp(axis_), withHessians, s, grad, &hess);
+  out.H.resize(2);
+  projectOnRotatingAxis(p, perp(axis_), s, out.work.row, withHessians ? &out.H[0] : nullptr, out.work.row2);
   out.h.resize(2);
   out.h << s, p.phiJ - p.phiI - referenceAngle_;
   out.G.resize(2, p.n());
-  out.G.row(0) = grad;
+  out.G.row(0) = out.work.row;
   out.G.row(1) = p.JphiJ - p.JphiI;
-  if (withHessians) out.H = {hess, p.HphiJ - p.HphiI};
+  if (withHessians) out.H[1] = p.HphiJ - p.HphiI;
 }
 
-VecX PrismaticJoint::reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const {
+VecX PrismaticJoint::reactions(const BodyStates& bodies, const VecX& lambda) const {
   const double phiI = bodies[0].point(pointI(), false).phi;
   const Vec2 n = rotation(phiI) * perp(axis_);
   const Vec2 f = -lambda[0] * n;

@@ -14,10 +14,9 @@ class PrismaticJoint final : public TwoPointConstraint {
                  const Vec2& pointJ, const Vec2& axis, double referenceAngle);
   int numEquations() const override { return 2; }
   std::string typeName() const override { return "prismatic"; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
   std::vector<std::string> reactionNames() const override { return {"fx", "fy", "m"}; }
-  VecX reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const override;
+  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
   /// Unit sliding axis in the frame of body i.
   const Vec2& axis() const { return axis_; }
 

@@ -2,15 +2,18 @@
 
 namespace flexmbd {
 
-void RevoluteJoint::evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                             ConstraintEvaluation& out) const {
-  const PointPair p = pair(bodies, withHessians);
+void RevoluteJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // h = r_j - r_i
+  const PointPair& p = pair(bodies, withHessians, out.work);
   out.h = p.d;
   out.G = p.D;
-  if (withHessians) out.H = {p.Hdx, p.Hdy};
+  if (!withHessians) return;
+  out.H.resize(2);
+  out.H[0] = p.Hdx;
+  out.H[1] = p.Hdy;
 }
 
-VecX RevoluteJoint::reactions(const std::vector<BodyState>&, const VecX& lambda) const {
+VecX RevoluteJoint::reactions(const BodyStates&, const VecX& lambda) const {
   // Constraint force on body j is -G_j^T lambda = force -lambda at point j.
   return Eigen::Vector3d(-lambda[0], -lambda[1], 0.0);
 }

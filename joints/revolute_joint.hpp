@@ -11,10 +11,9 @@ class RevoluteJoint final : public TwoPointConstraint {
   using TwoPointConstraint::TwoPointConstraint;
   int numEquations() const override { return 2; }
   std::string typeName() const override { return "revolute"; }
-  void evaluate(const std::vector<BodyState>& bodies, bool withHessians,
-                ConstraintEvaluation& out) const override;
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
   std::vector<std::string> reactionNames() const override { return {"fx", "fy", "m"}; }
-  VecX reactions(const std::vector<BodyState>& bodies, const VecX& lambda) const override;
+  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
 };
 
 }  // namespace flexmbd

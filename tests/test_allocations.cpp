@@ -1,0 +1,176 @@
+// The integrator's hot path allocates nothing: after a first call (which may size the
+// scratch), a residual and a Jacobian of DaeSystem make zero heap allocations, for
+// rigid, nodal-flexible, modal-flexible and given-invariants models and for every
+// joint, driver and force type, in every formulation.
+//
+// The global allocation functions of the process are replaced (malloc and friends;
+// operator new and Eigen's aligned allocation go through malloc) and count while a
+// window is open. Set FLEXMBD_ALLOC_TRACE=1 to print a backtrace of each counted
+// allocation (to find where one comes from).
+#include <execinfo.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <vector>
+
+#include "core/dae_system.hpp"
+#include "core/time_law.hpp"
+#include "ffr_test_models.hpp"
+#include "io/scene.hpp"
+
+extern "C" void* __libc_malloc(size_t);
+extern "C" void* __libc_calloc(size_t, size_t);
+extern "C" void* __libc_realloc(void*, size_t);
+extern "C" void* __libc_memalign(size_t, size_t);
+
+namespace {
+bool gCounting = false;
+bool gInHook = false;
+long gCount = 0;
+
+void counted() {
+  if (!gCounting || gInHook) return;
+  ++gCount;
+  if (std::getenv("FLEXMBD_ALLOC_TRACE")) {
+    gInHook = true;
+    void* frames[24];
+    const int n = backtrace(frames, 24);
+    backtrace_symbols_fd(frames, n, STDERR_FILENO);
+    write(STDERR_FILENO, "----\n", 5);
+    gInHook = false;
+  }
+}
+}  // namespace
+
+extern "C" void* malloc(size_t n) {
+  counted();
+  return __libc_malloc(n);
+}
+extern "C" void* calloc(size_t k, size_t n) {
+  counted();
+  return __libc_calloc(k, n);
+}
+extern "C" void* realloc(void* p, size_t n) {
+  counted();
+  return __libc_realloc(p, n);
+}
+extern "C" int posix_memalign(void** p, size_t a, size_t n) {
+  counted();
+  *p = __libc_memalign(a, n);
+  return *p ? 0 : 12;  // ENOMEM
+}
+extern "C" void* aligned_alloc(size_t a, size_t n) {
+  counted();
+  return __libc_memalign(a, n);
+}
+
+namespace flexmbd {
+namespace {
+
+/// Heap allocations made by fn().
+template <class Fn>
+long allocationsIn(Fn&& fn) {
+  gCount = 0;
+  gCounting = true;
+  fn();
+  gCounting = false;
+  return gCount;
+}
+
+/// A state that is not special (non-zero velocities, accelerations and multipliers),
+/// so that every term of the residual and the Jacobian is evaluated.
+void genericState(const DaeSystem& dae, VecX& y, VecX& yp) {
+  const System& sys = dae.system();
+  const int nq = sys.numCoordinates();
+  const VecX q = sys.initialCoordinates();
+  VecX v(nq), a(nq), lambda(sys.numConstraintEquations());
+  for (int k = 0; k < nq; ++k) {
+    v[k] = 0.3 + 0.01 * k;
+    a[k] = -0.2 + 0.02 * k;
+  }
+  for (int k = 0; k < lambda.size(); ++k) lambda[k] = 1.0 + 0.1 * k;
+  dae.packState(q, v, a, lambda, y, yp);
+  if (dae.layout().mu >= 0) {
+    for (int k = 0; k < dae.layout().m; ++k) y[dae.layout().mu + k] = 1e-3 * (k + 1);
+  }
+}
+
+/// Checks zero allocations per residual and per Jacobian (sparse sink, as the
+/// integrators use it) in each formulation, after one warm-up call of each.
+void expectAllocationFree(const System& sys, const std::string& model) {
+  for (Formulation f : {Formulation::Ggl, Formulation::Index3, Formulation::Index1}) {
+    SCOPED_TRACE(model + ", " + toString(f));
+    const DaeSystem dae(sys, f);
+    VecX y, yp;
+    genericState(dae, y, yp);
+    VecX F(dae.size());
+    std::vector<double> values(dae.pattern().nonZeros(), 0.0);
+    const auto scratch = dae.makeScratch();
+    JacobianSink J = JacobianSink::sparse(values.data(), dae.pattern());
+    dae.residual(0.01, y.data(), yp.data(), F.data(), *scratch);
+    dae.jacobian(0.01, y.data(), yp.data(), 1e3, J, *scratch);
+    EXPECT_EQ(allocationsIn([&] { dae.residual(0.02, y.data(), yp.data(), F.data(), *scratch); }), 0)
+        << "heap allocations in one residual";
+    EXPECT_EQ(allocationsIn([&] { dae.jacobian(0.02, y.data(), yp.data(), 1e3, J, *scratch); }), 0)
+        << "heap allocations in one Jacobian";
+    // the counter itself works (a test that cannot fail is no test)
+    EXPECT_GT(allocationsIn([&] { VecX tmp(dae.size()); tmp.setZero(); F[0] += tmp[0]; }), 0);
+  }
+}
+
+Scene loadExample(const std::string& name) {
+  return loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/" + name);
+}
+
+TEST(Allocations, RigidSliderCrank) {
+  const Scene s = loadExample("slider_crank_rigid.json");
+  expectAllocationFree(s.system, "rigid slider crank");
+}
+
+TEST(Allocations, NodalElasticSliderCrank) {
+  const Scene s = testmodels::elasticSliderCrank(8, 1.0, 0, 1.0, 1e-6, 1e-8, 1e-4);
+  expectAllocationFree(s.system, "nodal elastic slider crank (damped)");
+}
+
+TEST(Allocations, ModalElasticSliderCrank) {
+  const Scene s = testmodels::elasticSliderCrank(8, 1.0, 3, 1.0, 1e-6, 1e-8);
+  expectAllocationFree(s.system, "modal elastic slider crank");
+}
+
+TEST(Allocations, GivenInvariantsBariCrank) {
+  const Scene s = loadExample("bari_slider_crank.json");
+  expectAllocationFree(s.system, "Bari crank (given invariants)");
+}
+
+TEST(Allocations, EveryJointDriverAndForceType) {
+  // Not a meaningful mechanism: every component type once, evaluated at a generic state.
+  System sys;
+  RigidBodyProperties p;
+  p.mass = 2.0;
+  p.inertia = 0.1;
+  p.com = Vec2(0.1, 0.02);
+  FrameState2d sa, sb, sc;
+  sb.position = Vec2(1.0, 0.2);
+  sc.position = Vec2(2.0, -0.1);
+  sc.angle = 0.3;
+  const BodyIndex a = sys.addRigidBody("a", p, sa);
+  const BodyIndex b = sys.addRigidBody("b", p, sb);
+  const BodyIndex c = sys.addRigidBody("c", p, sc);
+  const ConstraintIndex rev = sys.addRevoluteJoint("rev", kGround, Vec2::Zero(), a, Vec2::Zero());
+  const ConstraintIndex pri = sys.addPrismaticJoint("pri", a, Vec2(0.5, 0.0), b, Vec2::Zero(), Vec2(1.0, 0.1));
+  sys.addFixedJoint("fix", b, Vec2(0.5, 0.0), c, Vec2(-0.5, 0.0));
+  sys.addJointDriver("angle", rev, makeHarmonicLaw(0.2, 3.0));
+  sys.addJointDriver("slide", pri, makeConstantSpeedLaw(0.1, 0.5));
+  sys.addBodyCoordinateDriver("cx", c, "x", makePolynomialLaw({2.0, 0.1}));
+  sys.addSpringDamper("spring", kGround, Vec2(0.0, 1.0), b, Vec2(0.1, 0.0), 100.0, 2.0, 0.5);
+  sys.addRotationalSpringDamper("torsion", rev, 10.0, 0.5, 0.1);
+  sys.addAppliedLoad("load", c, Vec2(0.2, 0.0), makeConstantLaw(1.0), makeHarmonicLaw(2.0, 1.0),
+                     makeConstantLaw(0.3));
+  sys.setGravity(Vec2(0.0, -9.81));
+  sys.finalize();
+  expectAllocationFree(sys, "every component type");
+}
+
+}  // namespace
+}  // namespace flexmbd
