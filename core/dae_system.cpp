@@ -13,6 +13,14 @@ void gather(const std::vector<int>& cols, const double* x, VecX& out) {
   for (size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
 }
 
+/// (column k of G) . x
+double columnDot(const MatX& G, int k, const double* x) {
+  const double* g = G.data() + static_cast<Eigen::Index>(k) * G.rows();
+  double s = 0.0;
+  for (Eigen::Index a = 0; a < G.rows(); ++a) s += g[a] * x[a];
+  return s;
+}
+
 /// J(rowOffset + rows[i], colOffset + cols[j]) += B(i, j)
 void addBlock(JacobianSink& J, int rowOffset, const std::vector<int>& rows, int colOffset,
               const std::vector<int>& cols, const MatX& B) {
@@ -34,7 +42,7 @@ void addRowsBlock(JacobianSink& J, int row0, int colOffset, const std::vector<in
 struct ConstraintScratch {
   ConstraintEvaluation ev, plus, minus;  ///< at q; at q +- h e_k (index-1 third derivatives)
   VecX f, df, ddf;                       ///< prescribed motion and its derivatives
-  VecX vl, al, Gtx, Hv;                  ///< local velocities, accelerations, G^T x, H_a v
+  VecX vl, al, Hv;                       ///< local velocities, accelerations, H_a v
   MatX Hx, vH, dFdq;                     ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq
 };
 
@@ -142,7 +150,6 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     ConstraintScratch& cs = s->constraints[c];
     cs.vl.resize(nl);
     cs.al.resize(nl);
-    cs.Gtx.resize(nl);
     cs.Hv.resize(nl);
     cs.Hx.resize(nl, nl);
     cs.vH.resize(me, nl);
@@ -209,25 +216,27 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
-    const int row = sys.constraintOffset(ci), me = con.numEquations();
+    const int row = sys.constraintOffset(ci), me = con.numEquations(), nl = static_cast<int>(cols.size());
     ConstraintScratch& cs = S.constraints[c];
     const ConstraintEvaluation& ev = cs.ev;
     con.evaluate(sys.constraintStates(ci, q.data()), needH, cs.ev);
     con.timeFunction(t, cs.f, cs.df, cs.ddf);
-    // F_v += G^T lambda
-    cs.Gtx.noalias() = ev.G.transpose() * ConstMap(y + L.lambda + row, me);
-    for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] += cs.Gtx[k];
-    gather(cols, v.data(), cs.vl);
+    // F_v += G^T lambda (G is m_c x n_c, a few entries: plain loops beat Eigen's GEMV)
+    const double* lambda = y + L.lambda + row;
+    for (int k = 0; k < nl; ++k) Fv[cols[k]] += columnDot(ev.G, k, lambda);
     Eigen::Map<VecX> Fc(F + L.lambda + row, me);
     switch (formulation_) {
       case Formulation::Ggl: {
         // F_q += D G^T mu;  F_g = h - f;  F_gv = G v - f'
-        cs.Gtx.noalias() = ev.G.transpose() * ConstMap(y + L.mu + row, me);
-        for (size_t k = 0; k < cols.size(); ++k) Fq[cols[k]] += metric_[cols[k]] * cs.Gtx[k];
+        const double* mu = y + L.mu + row;
+        for (int k = 0; k < nl; ++k) Fq[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
         Fc = ev.h - cs.f;
-        Eigen::Map<VecX> Fcv(F + L.mu + row, me);
-        Fcv.noalias() = ev.G * cs.vl;
-        Fcv -= cs.df;
+        double* Fcv = F + L.mu + row;
+        for (int a = 0; a < me; ++a) Fcv[a] = -cs.df[a];
+        for (int k = 0; k < nl; ++k) {
+          const double vk = v[cols[k]];
+          for (int a = 0; a < me; ++a) Fcv[a] += ev.G(a, k) * vk;
+        }
         break;
       }
       case Formulation::Index3:
@@ -235,6 +244,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
         break;
       case Formulation::Index1: {
         // F_a = G a + v^T H_a v - f''
+        gather(cols, v.data(), cs.vl);
         gather(cols, vp.data(), cs.al);
         for (int a = 0; a < me; ++a) {
           cs.Hv.noalias() = ev.H[a] * cs.vl;
