@@ -3,11 +3,15 @@
 python3-matplotlib):
 
   work_precision_<group>.png  error against CPU time, log-log, one line per model
-                              (bench_work_precision.csv), ends labelled with rtol
+                              (bench_work_precision.csv: IDA; bench_work_precision_radau5.csv:
+                              Radau IIA, dashed), ends labelled with rtol
   variants_<scene>.png        time ratios to the default variant (bench_variants.csv)
   scaling.png                 time per step against the DAE size, log-log, with the
                               least-squares exponent from --fit-from elements up
                               (bench_scaling.csv)
+  scaling_fixed_accuracy.png  time per simulated second at a fixed midpoint-deflection
+                              accuracy against the number of elements, per integrator,
+                              with least-squares exponents (bench_scaling_fixed_accuracy.csv)
   bari_crank.png              Simeon's slider crank: CPU time against significant
                               correct digits, one line per configuration, with the
                               classic codes' published figures (bench_bari_crank.csv)
@@ -64,7 +68,7 @@ def work_precision(rows, out_dir):
             if not pts:
                 continue
             reference = next(r["reference"] for r in rows if r["group"] == g)
-            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=m)
+            ax.loglog([p[0] for p in pts], [p[1] for p in pts], "s--" if "Radau" in m else "o-", label=m)
             for t, e, rtol in (pts if len(pts) <= 2 else [pts[0], pts[-1]]):  # loosest and tightest rtol
                 ax.annotate(rtol, (t, e), textcoords="offset points", xytext=(4, 3), fontsize=7)
         ax.set_xlabel("CPU time [s] (wall time of the run)")
@@ -78,6 +82,37 @@ def work_precision(rows, out_dir):
         plt.close(fig)
         written.append(path)
     return written
+
+
+def scaling_fixed_accuracy(rows, out_dir):
+    fig, ax = plt.subplots(figsize=(7, 5))
+    kinds = []
+    for r in rows:
+        if r["integrator"] not in kinds:
+            kinds.append(r["integrator"])
+    for k in kinds:
+        pts = [(num(r["elements"]), num(r["seconds_per_unit_time"])) for r in rows if r["integrator"] == k]
+        pts = [p for p in pts if p[0] and p[1]]
+        if not pts:
+            continue
+        label = k
+        if len(pts) >= 2:
+            xs = [math.log(p[0]) for p in pts]
+            ys = [math.log(p[1]) for p in pts]
+            mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+            b = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+            label += f" (exponent {b:.2f})"
+        ax.loglog([p[0] for p in pts], [p[1] for p in pts], "o-", label=label)
+    ax.set_xlabel("rod elements")
+    ax.set_ylabel("CPU seconds per simulated second")
+    ax.set_title("elastic slider crank, midpoint deflection within 1e-4 (relative)", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    path = os.path.join(out_dir, "scaling_fixed_accuracy.png")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return [path]
 
 
 def variants(rows, out_dir):
@@ -182,9 +217,15 @@ def main():
     a = p.parse_args()
     os.makedirs(a.out_dir, exist_ok=True)
     written = []
-    rows = read_csv(os.path.join(a.in_dir, "bench_work_precision.csv"))
+    rows = read_csv(os.path.join(a.in_dir, "bench_work_precision.csv")) or []
+    radau = read_csv(os.path.join(a.in_dir, "bench_work_precision_radau5.csv")) or []
+    for r in radau:
+        r["model"] += " (Radau IIA)"
+    if rows or radau:
+        written += work_precision(rows + radau, a.out_dir)
+    rows = read_csv(os.path.join(a.in_dir, "bench_scaling_fixed_accuracy.csv"))
     if rows:
-        written += work_precision(rows, a.out_dir)
+        written += scaling_fixed_accuracy(rows, a.out_dir)
     rows = read_csv(os.path.join(a.in_dir, "bench_variants.csv"))
     if rows:
         written += variants(rows, a.out_dir)
