@@ -18,10 +18,20 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Messages go to the terminal on one line.
+/// Longest message printed or written to a summary. Messages quote names and values
+/// shortened (io/json_reader.hpp); this bounds what a model error built elsewhere from a
+/// huge name could still carry.
+constexpr std::size_t kMaxMessageLength = 1000;
+
+/// Messages go to the terminal on one line of at most kMaxMessageLength characters.
 inline std::string oneLine(std::string s) {
   for (char& c : s) {
     if (c == '\n' || c == '\r') c = ' ';
+  }
+  if (s.size() > kMaxMessageLength) {
+    std::size_t n = kMaxMessageLength - 20;
+    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+    s = s.substr(0, n) + "... (message cut)";
   }
   return s;
 }

@@ -7,6 +7,7 @@
 #include <lcp_cst.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 
@@ -33,16 +34,22 @@ namespace {
 struct MatrixDeleter {
   void operator()(NumericsMatrix* m) const { NM_free(m); }
 };
-struct OptionsDeleter {
-  void operator()(SolverOptions* o) const { solver_options_delete(o); }
-};
-
 }  // namespace
+
+void LcpSolver::OptionsDeleter::operator()(SolverOptions* o) const {
+  solver_options_delete(o);  // frees iparam, dparam, internal solvers: not o itself
+  std::free(o);              // solver_options_create allocated it with malloc
+}
 
 LcpSolver::LcpSolver(const LcpOptions& options) : options_(options) {
   if (!(options_.tolerance > 0.0)) throw InputError("solver.lcp_tolerance must be > 0");
   if (options_.maxIterations < 1) throw InputError("solver.lcp_max_iterations must be >= 1");
+  const int id = options_.method == LcpMethod::Lemke ? SICONOS_LCP_LEMKE : SICONOS_LCP_PGS;
+  solverOptions_.reset(solver_options_create(id));
+  if (!solverOptions_) throw SolverError("LCP: Siconos could not create the solver options", 0.0, 0.0);
 }
+
+LcpSolver::~LcpSolver() = default;
 
 LcpSolution LcpSolver::solve(const MatX& M, const VecX& q) const {
   const int n = static_cast<int>(q.size());
@@ -62,9 +69,7 @@ LcpSolution LcpSolver::solve(const MatX& M, const VecX& q) const {
   problem.M = nm.get();
   problem.q = qCopy.data();
 
-  const int id = options_.method == LcpMethod::Lemke ? SICONOS_LCP_LEMKE : SICONOS_LCP_PGS;
-  std::unique_ptr<SolverOptions, OptionsDeleter> so(solver_options_create(id));
-  if (!so) throw SolverError("LCP: Siconos could not create the solver options", 0.0, 0.0);
+  SolverOptions* const so = solverOptions_.get();
   so->iparam[SICONOS_IPARAM_MAX_ITER] = options_.maxIterations;
   so->dparam[SICONOS_DPARAM_TOL] = options_.tolerance;
 
@@ -84,7 +89,7 @@ LcpSolution LcpSolver::solve(const MatX& M, const VecX& q) const {
   VecX z = VecX::Zero(n), w = VecX::Zero(n);
   int info = -1;
   if (options_.method == LcpMethod::Lemke) {
-    lcp_lexicolemke(&problem, z.data(), w.data(), &info, so.get());
+    lcp_lexicolemke(&problem, z.data(), w.data(), &info, so);
     out.info = info;
     out.iterations = so->iparam[SICONOS_IPARAM_ITER_DONE];
     check(z);
@@ -99,7 +104,7 @@ LcpSolution LcpSolver::solve(const MatX& M, const VecX& q) const {
     for (int attempt = 0; attempt < 4; ++attempt) {
       so->dparam[SICONOS_DPARAM_TOL] = tol;
       so->iparam[SICONOS_IPARAM_MAX_ITER] = std::max(1, options_.maxIterations - sweeps);
-      lcp_pgs(&problem, z.data(), w.data(), &info, so.get());
+      lcp_pgs(&problem, z.data(), w.data(), &info, so);
       sweeps += so->iparam[SICONOS_IPARAM_ITER_DONE];
       out.info = info;
       out.iterations = sweeps;

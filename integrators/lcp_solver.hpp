@@ -3,9 +3,12 @@
 // small interface, so the time-stepper does not see Siconos.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "core/types.hpp"
+
+struct SolverOptions;  // Siconos numerics (SolverOptions.h), kept out of this header
 
 namespace flexmbd {
 
@@ -34,17 +37,28 @@ struct LcpSolution {
   bool ok = true;      ///< residual <= tolerance (Siconos' info is reported, not used)
 };
 
+/// Holds one Siconos SolverOptions for all its solves (created in the constructor, freed
+/// in the destructor): creating them per solve cost an allocation per step, and Siconos'
+/// solver_options_delete frees only their contents, not the structure itself.
+/// Not copyable; solve() is not reentrant (one solver per thread).
 class LcpSolver {
  public:
   /// @throws InputError if tolerance <= 0 or maxIterations < 1.
   explicit LcpSolver(const LcpOptions& options);
+  ~LcpSolver();
+  LcpSolver(const LcpSolver&) = delete;
+  LcpSolver& operator=(const LcpSolver&) = delete;
   /// @pre M square, q of the same size. Never throws on non-convergence: check ok.
   /// An empty problem returns an empty solution with ok = true.
   LcpSolution solve(const MatX& M, const VecX& q) const;
   const LcpOptions& options() const { return options_; }
 
  private:
+  struct OptionsDeleter {
+    void operator()(SolverOptions* o) const;
+  };
   LcpOptions options_;
+  std::unique_ptr<SolverOptions, OptionsDeleter> solverOptions_;
 };
 
 }  // namespace flexmbd

@@ -37,12 +37,63 @@ inline std::string fmt(double x) {
   return buf;
 }
 
+/// Longest text of a value or name quoted in an error message; longer ones are cut and
+/// end in "...". A message must stay one readable line even for a 100 KB name.
+constexpr std::size_t kMaxQuoted = 60;
+
+/// `s` cut to at most `limit` characters, ending in "..." if it was cut (never inside
+/// a UTF-8 sequence).
+inline std::string shorten(const std::string& s, std::size_t limit = kMaxQuoted) {
+  if (s.size() <= limit) return s;
+  std::size_t n = limit - 3;
+  while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // continuation byte
+  return s.substr(0, n) + "...";
+}
+
+/// Appends at most about `limit` characters of the JSON text of `v`: never serialises
+/// more of a large or deep value than the message can show (the cost and the size of
+/// the message are bounded whatever the value).
+inline void appendBounded(std::string& out, const json& v, std::size_t limit, int depth = 0) {
+  if (out.size() > limit) return;
+  switch (v.type()) {
+    case json::value_t::string: {
+      const std::string part = shorten(v.get_ref<const std::string&>(), limit + 4 - std::min(limit, out.size()));
+      out += json(part).dump(-1, ' ', false, json::error_handler_t::replace);
+      return;
+    }
+    case json::value_t::array:
+    case json::value_t::object: {
+      const bool isObject = v.is_object();
+      out += isObject ? '{' : '[';
+      if (depth >= 8) {
+        out += "...";
+      } else {
+        bool first = true;
+        for (auto it = v.begin(); it != v.end(); ++it) {
+          if (out.size() > limit) break;
+          if (!first) out += ',';
+          first = false;
+          if (isObject) {
+            out += json(shorten(it.key(), limit)).dump(-1, ' ', false, json::error_handler_t::replace);
+            out += ':';
+          }
+          appendBounded(out, *it, limit, depth + 1);
+        }
+      }
+      out += isObject ? '}' : ']';
+      return;
+    }
+    default: out += v.dump(); return;
+  }
+}
+
 /// "string \"abc\"", "number 3", "array [1,2]", "null", ... (long values shortened).
 inline std::string describe(const json& v) {
   if (v.is_null()) return "null";
   if (v.is_number_float() && !std::isfinite(v.get<double>())) return "number " + fmt(v.get<double>());
-  std::string d = v.dump();
-  if (d.size() > 60) d = d.substr(0, 57) + "...";
+  std::string d;
+  appendBounded(d, v, kMaxQuoted);
+  if (d.size() > kMaxQuoted) d = d.substr(0, kMaxQuoted - 3) + "...";
   switch (v.type()) {
     case json::value_t::string: return "string " + d;
     case json::value_t::boolean: return "boolean " + d;
@@ -55,13 +106,50 @@ inline std::string describe(const json& v) {
   }
 }
 
+/// Items of a list in a message: each shortened, at most 20 of them.
 inline std::string join(const std::vector<std::string>& items) {
+  constexpr std::size_t kMaxItems = 20;
   std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  for (std::size_t k = 0; k < items.size() && k < kMaxItems; ++k) out += (out.empty() ? "" : ", ") + shorten(items[k]);
+  if (items.size() > kMaxItems) out += ", ... (" + std::to_string(items.size() - kMaxItems) + " more)";
   return out;
 }
 
-inline std::string inQuotes(const std::string& s) { return "\"" + s + "\""; }
+/// Deepest nesting of arrays and objects a scene file may have. The formats use at most
+/// 5 levels (scene > "bodies" > body > "elastic_coordinates"... or a matrix's rows); 64
+/// leaves room for any future key while keeping every recursive step over the parsed value
+/// (copy, destruction, serialisation) far from the stack's limit.
+constexpr int kMaxJsonDepth = 64;
+
+/// Refuses JSON text nested deeper than kMaxJsonDepth before it is parsed (a file of
+/// 100,000 '[' would otherwise exhaust the stack). Strings are skipped; the text need not
+/// be valid JSON (the parser reports that). @throws InputError "<source>: ...".
+inline void checkJsonNesting(const std::string& text, const std::string& source) {
+  int depth = 0;
+  bool inString = false;
+  for (std::size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    if (inString) {
+      if (c == '\\') ++k;
+      else if (c == '"') inString = false;
+      continue;
+    }
+    if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) {
+        throw InputError(source + ": JSON nested more than " + std::to_string(kMaxJsonDepth) +
+                         " levels deep at byte " + std::to_string(k + 1) +
+                         " (scene files need at most 5 levels of arrays and objects)");
+      }
+    } else if (c == ']' || c == '}') {
+      if (depth > 0) --depth;
+    }
+  }
+}
+
+/// A name or key in quotes, shortened to kMaxQuoted characters.
+inline std::string inQuotes(const std::string& s) { return "\"" + shorten(s) + "\""; }
 
 /// nlohmann's message without its "[json.exception.xxx.nnn] " prefix.
 inline std::string plainMessage(const json::exception& e) {

@@ -159,6 +159,7 @@ KinematicsScene parseKinematicsScene(const json& j) {
 }
 
 KinematicsScene parseKinematicsSceneText(const std::string& text, const std::string& source) {
+  checkJsonNesting(text, source);
   json j;
   try {
     j = json::parse(text, DuplicateKeyCheck{}, /*allow_exceptions=*/true);

@@ -644,6 +644,7 @@ Scene parseScene(const json& j) {
 }
 
 Scene parseSceneText(const std::string& text, const std::string& source) {
+  checkJsonNesting(text, source);
   PathTracker tracker;
   json j;
   try {

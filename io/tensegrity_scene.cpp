@@ -49,23 +49,42 @@ std::pair<int, int> nodePair(const TensegrityStructure& s, const Reader& r) {
 
 }  // namespace
 
+namespace {
+std::string readText(std::ifstream& in) {
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  return buf.str();
+}
+}  // namespace
+
 bool isTensegritySceneFile(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) return false;
-  const json j = json::parse(in, nullptr, /*allow_exceptions=*/false);
+  const std::string text = readText(in);
+  try {
+    checkJsonNesting(text, path);
+  } catch (const InputError&) {
+    return false;  // the scene loader reports it
+  }
+  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (!j.is_object()) return false;
   const auto it = j.find("model");
   return it != j.end() && it->is_string() && it->get<std::string>() == "tensegrity";
 }
 
 TensegrityScene loadTensegrityScene(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open the scene file");
+  const std::string text = readText(in);
+  checkJsonNesting(text, path);
   json j;
   try {
-    j = json::parse(in);
+    j = json::parse(text);
   } catch (const json::parse_error& e) {
     throw InputError(path + ": not valid JSON (" + e.what() + ")");
+  } catch (const json::exception& e) {
+    // 406: a number literal that does not fit a double (1e999)
+    throw InputError(path + ": invalid JSON: " + plainMessage(e) + " (numbers must be finite)");
   }
   try {
     return parseTensegrityScene(j);
