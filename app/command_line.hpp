@@ -48,6 +48,9 @@ inline double parseNumberOption(const std::string& option, const std::string& te
     throw UsageError("option " + option + " expects a number, got '" + text + "'");
   }
   if (!std::isfinite(x)) throw UsageError("option " + option + " expects a finite number, got '" + text + "'");
+  if (std::fabs(x) > 1e100) {  // the bound of scene numbers (io/json_reader.hpp, kMaxInputMagnitude)
+    throw UsageError("option " + option + " must be at most 1e100 in magnitude, got '" + text + "'");
+  }
   return x;
 }
 

@@ -199,7 +199,7 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
   j["mobility"] = scene->linkage.mobility();
   j["coordinates"] = scene->linkage.numCoordinates();
   j["steps"] = st.steps;
-  j["steps_completed"] = summary.stepsCompleted - 1;
+  j["steps_completed"] = std::max(0, summary.stepsCompleted - 1);
   j["alpha_start"] = st.start;
   j["alpha_end"] = st.end;
   j["alpha_reached"] = summary.alphaReached;

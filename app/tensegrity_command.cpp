@@ -56,6 +56,21 @@ class TensegrityResults {
     events_ << "t,step,type,member,other,impulse,elongation_rate,energy_change,x,y,z\n";
   }
   void sample(const TensegritySample& smp) {
+    // A row with a non-finite value is not written: the run stops there (issue 11).
+    const auto check = [&](bool finite, const std::string& what) {
+      if (!finite) throw NonFiniteResult("non-finite " + what + " at t = " + num(smp.t));
+    };
+    check(std::isfinite(smp.t), "time");
+    check(smp.x.allFinite(), "node positions");
+    check(smp.v.allFinite(), "node velocities");
+    for (int c = 0; c < s_.numCables(); ++c) {
+      check(std::isfinite(smp.cableTension[c]) && std::isfinite(smp.cableImpulse[c]) &&
+                std::isfinite(smp.cableLength[c]),
+            "tension, impulse or length of cable \"" + s_.cable(c).name + "\"");
+    }
+    check(std::isfinite(smp.kineticEnergy) && std::isfinite(smp.potentialEnergy) &&
+              std::isfinite(smp.kineticEnergy + smp.potentialEnergy),
+          "energy");
     results_ << num(smp.t);
     for (int k = 0; k < smp.x.size(); ++k) results_ << "," << num(smp.x[k]);
     for (int k = 0; k < smp.v.size(); ++k) results_ << "," << num(smp.v[k]);
@@ -194,6 +209,14 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     }
   } catch (const InputError& e) {
     return reportInputError(outDir, o.scenePath + ": " + e.what());
+  } catch (const NonFiniteResult& e) {
+    if (results->rows() == 0) {  // at the start: the scene's own values overflow (exit 2)
+      return reportInputError(outDir, o.scenePath + ": the initial state has " + e.what() +
+                                          ": values of the scene overflow (check masses, velocities, stiffnesses)");
+    }
+    summary.ok = false;
+    summary.message = std::string(e.what()) + ": the run stops before this output (the rows before it are kept)";
+    summary.tReached = results->lastTime();
   } catch (const std::exception& e) {
     summary.ok = false;
     summary.message = e.what();

@@ -264,6 +264,31 @@ SingularPosition KinematicAnalysis::locate(const KinematicState& regular, double
   return s;
 }
 
+namespace {
+
+/// The first non-finite quantity of a state ("" if all are finite): a run never reports a
+/// position, transfer function, velocity or acceleration that is inf or NaN (issue 11).
+std::string firstNonFinite(const KinematicState& s) {
+  if (!s.x.allFinite()) return "positions";
+  if (!s.xp.allFinite() || !s.xpp.allFinite()) return "transfer functions";
+  if (!s.v.allFinite()) return "velocities (X' times the input speed)";
+  if (!s.a.allFinite()) return "accelerations (X'' times speed^2 plus X' times the input acceleration)";
+  if (!std::isfinite(s.residual)) return "residual";
+  return "";
+}
+
+void stopAtNonFinite(KinematicSummary& summary, const KinematicState& s, const std::string& what,
+                     const KinematicState* prev) {
+  summary.ok = false;
+  summary.message = "non-finite " + what + " at step " + std::to_string(s.step) + ", alpha = " + fmt(s.alpha) +
+                    " (overflow: are the input speed and acceleration within range?); " +
+                    (prev ? "results kept up to alpha = " + fmt(prev->alpha) + " (step " + std::to_string(prev->step) +
+                                ")"
+                          : std::string("no results were written"));
+}
+
+}  // namespace
+
 KinematicSummary KinematicAnalysis::run(const std::function<void(const KinematicState&)>& onStep) const {
   const auto t0 = std::chrono::steady_clock::now();
   KinematicSummary summary;
@@ -276,6 +301,13 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
   c0.residual = maxAbs(linkage_.deformations(x0_));
   KinematicState prev = makeState(0, settings_.start, x0_, c0);
   int prevSign = transferFunctions(x0_).determinantSign;
+  if (const std::string bad = firstNonFinite(prev); !bad.empty()) {
+    stopAtNonFinite(summary, prev, bad, nullptr);
+    summary.stepsCompleted = 0;
+    summary.alphaReached = settings_.start;
+    summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return summary;
+  }
   onStep(prev);
   summary.stepsCompleted = 1;
   summary.alphaReached = prev.alpha;
@@ -306,6 +338,10 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
       break;
     }
     KinematicState state = makeState(k, alpha, X, c);
+    if (const std::string bad = firstNonFinite(state); !bad.empty()) {
+      stopAtNonFinite(summary, state, bad, &prev);
+      break;
+    }
     prevSign = tf.determinantSign;
     onStep(state);
     summary.stepsCompleted = k + 1;

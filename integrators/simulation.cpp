@@ -101,6 +101,13 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
   return os.str();
 }
 
+/// A time in a message: 10 significant digits.
+std::string fmtTime(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", t);
+  return buf;
+}
+
 }  // namespace
 
 void SolverSettings::validate() const {
@@ -184,8 +191,12 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
       summary.maxVelocityViolation = std::max(
           summary.maxVelocityViolation, velocityConstraintResidual(sys, s.q, s.v, t).lpNorm<Eigen::Infinity>());
     }
+    const char* bad = !s.q.allFinite() ? "positions" : !s.v.allFinite() ? "velocities"
+                      : !s.a.allFinite() ? "accelerations" : !s.lambda.allFinite() ? "multipliers" : nullptr;
+    if (bad) throw NonFiniteResult(std::string("non-finite ") + bad + " at t = " + fmtTime(t));
     if (conservative) {
       const double E = kineticEnergy(sys, s.q, s.v) + potentialEnergy(sys, s.q);
+      if (!std::isfinite(E)) throw NonFiniteResult("non-finite energy at t = " + fmtTime(t));
       if (!summary.energyStart) summary.energyStart = E;
       summary.energyEnd = E;
     }
@@ -193,7 +204,13 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     if (onOutput) onOutput(s);
     last = std::move(s);
   };
-  emit(t0, y0, yp0);
+  try {
+    emit(t0, y0, yp0);
+  } catch (const NonFiniteResult& e) {
+    // Nothing was integrated: the scene's own values overflow (masses, speeds, loads).
+    throw InputError(std::string("the initial state has ") + e.what() +
+                     ": values of the scene overflow (check masses, inertias, speeds, loads)");
+  }
 
   IntegratorOptions o;
   o.rtol = settings.rtol;
@@ -228,6 +245,10 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     } catch (const std::exception&) {
       // the diagnosis is optional: IDA's reason stays the message
     }
+  } catch (const NonFiniteResult& e) {
+    summary.ok = false;
+    summary.failureTime = tOutput;
+    summary.message = std::string(e.what()) + ": the run stops before this output (the rows before it are kept)";
   } catch (const std::exception& e) {
     // post-processing of an output state failed (e.g. a singular mass matrix after the
     // solution blew up, or an output exactly at a singular position of the mechanism,

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 #include "core/dae_system.hpp"
@@ -66,6 +67,12 @@ struct SimulationSummary {
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   bool usedKlu = false;
   int initialPositionIterations = 0;
+};
+
+/// A value of the results (state, energy, reaction, output) that is inf or NaN: the run
+/// stops before the row that holds it (issue 11: never `ok` with non-finite results).
+struct NonFiniteResult : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 /// Called at t0 and at every output time (also the last one reached before a failure).

@@ -23,6 +23,12 @@ namespace flexmbd::jsonread {
 
 using nlohmann::json;
 
+/// Largest magnitude of a number in a scene file. The engine forms squares and products
+/// of a few input values (speed^2 in accelerations, mass * speed^2 in energies, E I / L^3
+/// in stiffnesses): 1e100 keeps them finite, and no physical quantity in SI units comes
+/// near it (the mass of the observable universe is 1e53 kg).
+constexpr double kMaxInputMagnitude = 1e100;
+
 // ----- formatting ------------------------------------------------------------------
 
 /// Shortest text that reads back as the same double ("-1", "0.1", "1e-08").
@@ -370,6 +376,10 @@ class ObjectReader {
     if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
     const double x = v.get<double>();
     if (!std::isfinite(x)) fail("key " + inQuotes(label) + " must be a finite number, got " + fmt(x));
+    if (std::fabs(x) > kMaxInputMagnitude) {
+      fail("key " + inQuotes(label) + " must be at most 1e100 in magnitude (larger values overflow to inf in the "
+           "products the engine forms), got " + fmt(x));
+    }
     return x;
   }
   Vec2 toVec2(const json& v, const std::string& label) const {

@@ -97,29 +97,35 @@ void ResultsWriter::write(const OutputSample& s) {
   if (s.q.size() != nq) throw std::runtime_error(sizeMismatch("q", s.q.size(), nq, s.t));
   if (s.v.size() != nq) throw std::runtime_error(sizeMismatch("v", s.v.size(), nq, s.t));
   if (s.lambda.size() != m) throw std::runtime_error(sizeMismatch("lambda", s.lambda.size(), m, s.t));
+  // The whole row first: a row with a non-finite value is not written (the run stops).
+  std::vector<double> values;
+  values.reserve(columns_.size());
+  values.push_back(s.t);
+  for (long k = 0; k < nq; ++k) values.push_back(s.q[k]);
+  for (long k = 0; k < nq; ++k) values.push_back(s.v[k]);
+  const VecX reactions = reactionOutputs(sys, s.q, s.lambda);
+  for (Eigen::Index k = 0; k < reactions.size(); ++k) values.push_back(reactions[k]);
+  for (const auto& o : scene_.outputs) {
+    for (double x : o.evaluate(sys, s.q, s.v)) values.push_back(x);
+  }
+  if (values.size() != columns_.size()) {
+    throw std::runtime_error(sizeMismatch("a row", static_cast<long>(values.size()),
+                                          static_cast<long>(columns_.size()), s.t));
+  }
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) {
+      char tbuf[32];
+      std::snprintf(tbuf, sizeof tbuf, "%.10g", s.t);
+      throw NonFiniteResult("non-finite value " + std::string(std::isnan(values[k]) ? "nan" : "inf") +
+                            " in column \"" + columns_[k] + "\" at t = " + tbuf);
+    }
+  }
   if (!out_.is_open()) open();
-
   std::string line;
   line.reserve(24 * columns_.size());
-  appendNumber(line, s.t);
-  for (long k = 0; k < nq; ++k) {
-    line += ',';
-    appendNumber(line, s.q[k]);
-  }
-  for (long k = 0; k < nq; ++k) {
-    line += ',';
-    appendNumber(line, s.v[k]);
-  }
-  const VecX reactions = reactionOutputs(sys, s.q, s.lambda);
-  for (Eigen::Index k = 0; k < reactions.size(); ++k) {
-    line += ',';
-    appendNumber(line, reactions[k]);
-  }
-  for (const auto& o : scene_.outputs) {
-    for (double x : o.evaluate(sys, s.q, s.v)) {
-      line += ',';
-      appendNumber(line, x);
-    }
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (k) line += ',';
+    appendNumber(line, values[k]);
   }
   line += '\n';
   out_ << line;

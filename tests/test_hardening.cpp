@@ -7,6 +7,10 @@
 #include <string>
 
 #include "cli_fixture.hpp"
+#include "integrators/kinematic_analysis.hpp"
+#include "io/kinematics_scene.hpp"
+#include "io/results_writer.hpp"
+#include "io/scene.hpp"
 
 namespace fs = std::filesystem;
 
@@ -81,6 +85,60 @@ TEST_F(Hardening, HugeNamesAndValuesAreShortenedInErrors) {
   EXPECT_TRUE(IsOneErrorLine(r.err));
   EXPECT_NE(r.err.find("unknown body"), std::string::npos) << r.err.substr(0, 300);
   EXPECT_LT(r.err.size(), kMaxErrorLine);
+}
+
+// ----- item 2: no `ok` with inf or NaN in the results -------------------------------
+
+TEST_F(Hardening, OverflowingInputValuesAreRefused) {
+  nlohmann::json k = exampleScene("kinematics_slider_crank.json");
+  k["analysis"]["speed"] = 1e308;  // accelerations speed^2 X'' overflow: all rows were NaN, status ok
+  CliResult r = runScene("kinematics", writeScene("k.json", k), dir_ / "out_k");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("\"speed\""), std::string::npos) << r.err;
+
+  nlohmann::json t = exampleScene("tensegrity_two_masses.json");
+  t["nodes"][1]["mass"] = 1e308;  // energies were inf, status ok
+  r = runScene("run", writeScene("t.json", t), dir_ / "out_t");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("\"mass\""), std::string::npos) << r.err;
+}
+
+TEST(HardeningLibrary, KinematicsStopsAtTheFirstNonFiniteState) {
+  flexmbd::KinematicsScene scene = flexmbd::loadKinematicsScene(kSourceDir + "/examples/kinematics_slider_crank.json");
+  flexmbd::KinematicSettings settings = scene.settings;
+  settings.speed = 1e200;  // the API does not bound it: speed^2 = inf in the accelerations
+  long rows = 0;
+  const flexmbd::KinematicSummary summary =
+      flexmbd::analyzeKinematics(scene.linkage, settings, [&](const flexmbd::KinematicState&) { ++rows; });
+  EXPECT_FALSE(summary.ok);
+  EXPECT_EQ(rows, 0);
+  EXPECT_NE(summary.message.find("at step 0"), std::string::npos) << summary.message;
+  EXPECT_NE(summary.message.find("non-finite accelerations"), std::string::npos) << summary.message;
+}
+
+TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
+  const fs::path dir = fs::temp_directory_path() / ("flexmbd_test_writer_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const flexmbd::Scene scene = flexmbd::loadScene(kSourceDir + "/examples/slider_crank_rigid.json");
+  {
+    flexmbd::ResultsWriter writer(dir, scene);
+    flexmbd::OutputSample s;
+    s.q = scene.system.initialCoordinates();
+    s.v = flexmbd::VecX::Zero(s.q.size());
+    s.a = s.v;
+    s.lambda = flexmbd::VecX::Zero(scene.system.numConstraintEquations());
+    writer.write(s);
+    s.t = 0.5;
+    s.v[1] = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(writer.write(s), flexmbd::NonFiniteResult);
+    EXPECT_EQ(writer.rowsWritten(), 1);
+  }
+  const std::string csv = readFile(dir / "results.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header and the row at t = 0
+  EXPECT_EQ(csv.find("inf"), std::string::npos);
+  fs::remove_all(dir);
 }
 
 }  // namespace
