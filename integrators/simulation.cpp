@@ -110,6 +110,24 @@ std::string fmtTime(double t) {
 
 }  // namespace
 
+/// Shortest run: the bound of scene numbers (1e100) inverted; below it, squares of the
+/// step underflow.
+constexpr double kMinTimeSpan = 1e-100;
+/// Shortest run relative to |t|: steps of 1e-3 of such a span are still 1e4 round-offs of t.
+constexpr double kMinRelativeSpan = 1e-9;
+/// Most outputs of a run: 1e8 rows of even a one-body model are 6 GB of results.csv.
+constexpr double kMaxOutputs = 1e8;
+/// Default min_step: 1e-12 of the span, at most 1e-12 s. Of the span alone, a long run
+/// (t_end = 2^31 s) got min_step = 2e-3 s and failed at its first step. 1e-12 s is below
+/// every physical time scale of the models (their fastest elastic modes have periods above
+/// 1e-6 s): a step that small has collapsed (lock-up, singularity), it does not resolve.
+constexpr double kDefaultMinStepFraction = 1e-12;
+constexpr double kDefaultMinStepSeconds = 1e-12;
+
+double defaultMinStepSize(const SolverSettings& s) {
+  return std::min(kDefaultMinStepFraction * (s.tEnd - s.tStart), kDefaultMinStepSeconds);
+}
+
 void SolverSettings::validate() const {
   requireSetting(rtol > 0.0 && std::isfinite(rtol), "rtol", "a positive number", rtol);
   requireSetting(atol > 0.0 && std::isfinite(atol), "atol", "a positive number", atol);
@@ -121,11 +139,22 @@ void SolverSettings::validate() const {
   requireSetting(std::isfinite(tEnd) && tEnd > tStart, "t_end", "a number greater than t_start", tEnd);
   requireSetting(outputStep > 0.0 && std::isfinite(outputStep), "output_step", "a positive number",
                  outputStep);
+  // A span the integrator can resolve: IDA refuses a stop time within round-off of t_start
+  // (IDA_ILL_INPUT for t_end = 1e-300) and needs steps well above round-off of t.
+  const double span = tEnd - tStart;
+  requireSetting(span >= kMinTimeSpan && span >= kMinRelativeSpan * std::max(std::fabs(tStart), std::fabs(tEnd)),
+                 "t_end", "t_end - t_start >= 1e-100 and >= 1e-9 max(|t_start|, |t_end|) (a span the integrator "
+                 "can resolve)", tEnd);
+  requireSetting(span / outputStep <= kMaxOutputs, "output_step",
+                 "at most 1e8 outputs over t_end - t_start (results.csv would not fit a disk): a larger step",
+                 outputStep);
   requireSetting(maxStepSize >= 0.0 && std::isfinite(maxStepSize), "max_step",
                  "a non-negative number (0: no limit)", maxStepSize);
   if (minStepSize) {
     requireSetting(*minStepSize >= 0.0 && std::isfinite(*minStepSize), "min_step",
                    "a non-negative number", *minStepSize);
+    requireSetting(*minStepSize < std::min(span, outputStep), "min_step",
+                   "less than t_end - t_start and than output_step", *minStepSize);
   }
   requireSetting(initialStepSize >= 0.0 && std::isfinite(initialStepSize), "initial_step",
                  "a non-negative number (0: IDA's estimate)", initialStepSize);
@@ -219,7 +248,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
   o.initialStepSize = settings.initialStepSize;
-  o.minStepSize = settings.minStepSize.value_or(1e-12 * (tEnd - t0));
+  o.minStepSize = settings.minStepSize.value_or(defaultMinStepSize(settings));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
   const std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(settings.integrator, dae, t0, y0, yp0, o);

@@ -29,7 +29,7 @@ struct SolverSettings {
   double outputStep = 0.01;
   double maxStepSize = 0.0;       ///< 0: no limit
   /// Smallest step IDA may take before it reports failure (a lock-up or a singularity
-  /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start).
+  /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start), at most 1e-12 s.
   std::optional<double> minStepSize;
   long maxSteps = 1000000;        ///< per output interval
   /// Highest BDF order (1..5). Orders 1 and 2 are A-stable: undamped high-frequency

@@ -240,8 +240,9 @@ class ObjectReader {
     return v.get<bool>();
   }
 
-  /// An integer >= minimum (1e6 written as a float is accepted if integral).
-  long integer(const std::string& key, long fallback, long minimum) const {
+  /// An integer in [minimum, maximum] (1e6 written as a float is accepted if integral).
+  long integer(const std::string& key, long fallback, long minimum,
+               long maximum = std::numeric_limits<int>::max()) const {
     if (!has(key)) return fallback;
     const json& v = required(key);
     long value = 0;
@@ -262,6 +263,9 @@ class ObjectReader {
     }
     if (value < minimum) {
       fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + std::to_string(value));
+    }
+    if (value > maximum) {
+      fail("key " + inQuotes(key) + " must be <= " + std::to_string(maximum) + ", got " + std::to_string(value));
     }
     return value;
   }

@@ -141,4 +141,35 @@ TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   fs::remove_all(dir);
 }
 
+// ----- item 7: time spans the integrator cannot use are input errors, long runs run -----
+
+TEST_F(Hardening, UnresolvableTimeSpanIsAnInputError) {
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 1e-300;  // was IDA_ILL_INPUT, exit 1
+  CliResult r = runScene("run", writeScene("tiny.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.t_end"), std::string::npos) << r.err;
+
+  j["solver"]["t_end"] = 2147483648.0;  // 2^31 s at the example's output step: 2e10 rows
+  r = runScene("run", writeScene("rows.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.output_step"), std::string::npos) << r.err;
+}
+
+TEST_F(Hardening, LongRunIsNotStoppedAtItsStartByTheDefaultMinStep) {
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 2147483648.0;  // 2^31 s: the default min_step was 2e-3 s, IDA failed at t = 0
+  j["solver"]["output_step"] = 2147483648.0 / 10;
+  j["solver"]["max_steps"] = 3000;  // the run is cut by this limit, after it got going
+  const CliResult r = runScene("run", writeScene("long.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 1) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  // 3000 steps of the crank at 1 rad/s with rtol 1e-8 cover tens of seconds at least.
+  EXPECT_GT(summary.at("t_failure").get<double>(), 10.0) << summary.dump();
+  EXPECT_NE(r.err.find("IDA_TOO_MUCH_WORK"), std::string::npos) << r.err;
+}
+
 }  // namespace
