@@ -239,6 +239,18 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     // Nothing was integrated: the scene's own values overflow (masses, speeds, loads).
     throw InputError(std::string("the initial state has ") + e.what() +
                      ": values of the scene overflow (check masses, inertias, speeds, loads)");
+  } catch (const RunInterrupted& e) {
+    summary.ok = false;
+    summary.interruptedBySignal = e.signal;
+    summary.failureTime = t0;
+    summary.message = e.what();
+    return summary;
+  } catch (const OutputWriteError& e) {
+    summary.ok = false;
+    summary.outputFailed = true;
+    summary.failureTime = t0;
+    summary.message = e.what();
+    return summary;
   }
 
   IntegratorOptions o;
@@ -274,6 +286,16 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     } catch (const std::exception&) {
       // the diagnosis is optional: IDA's reason stays the message
     }
+  } catch (const RunInterrupted& e) {
+    summary.ok = false;
+    summary.interruptedBySignal = e.signal;
+    summary.failureTime = tOutput;
+    summary.message = e.what();
+  } catch (const OutputWriteError& e) {
+    summary.ok = false;
+    summary.outputFailed = true;
+    summary.failureTime = tOutput;
+    summary.message = e.what();
   } catch (const NonFiniteResult& e) {
     summary.ok = false;
     summary.failureTime = tOutput;

@@ -67,12 +67,27 @@ struct SimulationSummary {
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   bool usedKlu = false;
   int initialPositionIterations = 0;
+  int interruptedBySignal = 0;   ///< the signal that stopped the run (RunInterrupted), or 0
+  bool outputFailed = false;     ///< the run stopped because its results could not be written
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run
 /// stops before the row that holds it (issue 11: never `ok` with non-finite results).
 struct NonFiniteResult : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+/// The results cannot be written (disk full, file size limit): the run stops, the rows
+/// written before stay complete.
+struct OutputWriteError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Thrown by an output callback after it wrote its row when the run must stop (SIGINT,
+/// SIGTERM): the summary says "interrupted" with the time reached.
+struct RunInterrupted : std::runtime_error {
+  RunInterrupted(const std::string& message, int signal) : std::runtime_error(message), signal(signal) {}
+  int signal;
 };
 
 /// Called at t0 and at every output time (also the last one reached before a failure).

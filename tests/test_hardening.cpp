@@ -3,7 +3,9 @@
 // here failed before its fix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <csignal>
+#include <sstream>
 #include <string>
 
 #include "cli_fixture.hpp"
@@ -29,6 +31,18 @@ class Hardening : public Cli {
     return run(command + " " + shellQuote(scene.string()) + " --out " + shellQuote(out.string()) +
                (command == "run" ? " --quiet" : "") +
                (extra.empty() ? "" : " " + extra));
+  }
+  /// Runs `shell` (a command line where $F is the flexmbd binary) through bash -c.
+  CliResult runShell(const std::string& shell) const {
+    const fs::path out = dir_ / "cli_stdout.txt", err = dir_ / "cli_stderr.txt";
+    const std::string cmd = "F=" + shellQuote(FLEXMBD_CLI) + "; { " + shell + "; } >" + shellQuote(out.string()) +
+                            " 2>" + shellQuote(err.string());
+    const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
+    CliResult r;
+    r.status = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : -1;
+    r.out = readFile(out);
+    r.err = readFile(err);
+    return r;
   }
   fs::path writeText(const std::string& name, const std::string& text) const {
     const fs::path p = dir_ / name;
@@ -139,6 +153,79 @@ TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header and the row at t = 0
   EXPECT_EQ(csv.find("inf"), std::string::npos);
   fs::remove_all(dir);
+}
+
+// ----- item 6: output failures, signals, stale frames ---------------------------------
+
+/// Every line of a CSV file is complete: ends in a newline, as many fields as the header.
+::testing::AssertionResult WholeRows(const std::string& csv) {
+  if (csv.empty() || csv.back() != '\n') return ::testing::AssertionFailure() << "does not end in a newline";
+  std::istringstream in(csv);
+  std::string line;
+  long fields = -1, rows = 0;
+  while (std::getline(in, line)) {
+    const long n = std::count(line.begin(), line.end(), ',');
+    if (fields < 0) fields = n;
+    if (n != fields) return ::testing::AssertionFailure() << "row " << rows << " has " << n << " commas, header " << fields;
+    ++rows;
+  }
+  return ::testing::AssertionSuccess() << rows << " lines";
+}
+
+TEST_F(Hardening, FullDiskKeepsWholeRowsAndTheSummarySaysWhy) {
+  // A file size limit of 20 KB (ulimit -f, SIGXFSZ ignored) fails the writes of results.csv
+  // with EFBIG in the middle of the run, as a full disk fails them with ENOSPC.
+  const fs::path out = dir_ / "out";
+  const CliResult r = runShell("trap '' XFSZ; ulimit -f 20; exec \"$F\" run " + shellQuote(kExample) + " --out " +
+                               shellQuote(out.string()) + " --quiet");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("cannot write '" + (out / "results.csv").string() + "' at t = "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("summary.json.tmp"), std::string::npos) << r.err;
+  const std::string csv = readFile(out / "results.csv");
+  EXPECT_TRUE(WholeRows(csv));
+  EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 10);  // the rows before the failure are kept
+  EXPECT_FALSE(fs::exists(out / "summary.json.tmp"));
+  ASSERT_TRUE(fs::exists(out / "summary.json"));
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  EXPECT_NE(summary.at("message").get<std::string>().find("results.csv"), std::string::npos) << summary.dump();
+}
+
+TEST_F(Hardening, SignalsEndTheRunWithAnInterruptedSummary) {
+  for (const auto& [signal, status] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
+    const fs::path out = dir_ / ("out_" + signal);
+    // 1e4 s of the driven crank: about 10 s of computing; the signal comes after 1 s.
+    const CliResult r = runShell("\"$F\" run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) +
+                                 " --quiet --t-end 10000 & pid=$!; sleep 1; kill -" + signal + " $pid; wait $pid");
+    EXPECT_EQ(r.status, status) << signal << ": " << r.err;
+    EXPECT_TRUE(IsOneErrorLine(r.err));
+    EXPECT_NE(r.err.find("interrupted by SIG" + signal), std::string::npos) << r.err;
+    EXPECT_TRUE(WholeRows(readFile(out / "results.csv")));
+    ASSERT_TRUE(fs::exists(out / "summary.json"));
+    const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+    EXPECT_EQ(summary.at("status"), "interrupted");
+    EXPECT_GT(summary.at("t_reached").get<double>(), 0.0);
+  }
+}
+
+TEST_F(Hardening, RerunIntoAnOldOutputFolderLeavesNoFramesOfTheOldModel) {
+  const fs::path out = dir_ / "out";
+  CliResult r = runScene("run", kExample, out, "--vtk");  // 61 frames
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ofstream(out / "vtk" / "notes.txt") << "the user's own file\n";
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 0.5;  // 6 frames of another run
+  r = runScene("run", writeScene("short.json", j), out, "--vtk");
+  ASSERT_EQ(r.status, 0) << r.err;
+  long frames = 0;
+  for (const auto& e : fs::directory_iterator(out / "vtk")) frames += e.path().extension() == ".vtu";
+  EXPECT_EQ(frames, 6);
+  EXPECT_TRUE(fs::exists(out / "vtk" / "notes.txt"));
+  r = runScene("run", writeScene("short.json", j), out);  // no --vtk: no frames at all
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(out / "vtk" / "bodies_000000.vtu"));
+  EXPECT_FALSE(fs::exists(out / "vtk" / "bodies.pvd"));
 }
 
 // ----- item 7: time spans the integrator cannot use are input errors, long runs run -----
