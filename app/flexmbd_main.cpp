@@ -225,6 +225,7 @@ int runCommand(const Options& o) {
     summary.cpuSeconds = cpuSecondsSince(start);
   }
 
+  for (const std::string& w : summary.warnings) std::cerr << "flexmbd: warning: " << oneLine(w) << std::endl;
   const std::string kept = writer->rowsWritten() > 0
                                ? "results up to t = " + fmt(writer->lastTime()) + " kept in " +
                                      writer->resultsPath().string()

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
@@ -55,6 +56,18 @@ struct OutputSample {
   VecX q, v, a, lambda;
 };
 
+/// The largest change the consistent initialisation made to one body's given initial
+/// coordinates (positions and elastic coordinates in length units, angles in rad).
+struct InitialCorrection {
+  std::string body;
+  double position = 0.0;   ///< max over its position and elastic coordinates of |q - q_given|
+  double angle = 0.0;      ///< max over its angle coordinates of |q - q_given|
+  std::string coordinate;  ///< the coordinate changed most (relative to its threshold)
+  double given = 0.0, corrected = 0.0;  ///< that coordinate before and after
+  std::string constraint;  ///< the joint or driver most violated by the given values on this body
+  double residual = 0.0;   ///< its largest |g| at the given values
+};
+
 struct SimulationSummary {
   bool ok = true;
   std::string message;
@@ -67,6 +80,11 @@ struct SimulationSummary {
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   bool usedKlu = false;
   int initialPositionIterations = 0;
+  double modelSize = 1.0;        ///< System::characteristicLength(): the scale of the warnings
+  std::vector<InitialCorrection> initialCorrections;  ///< bodies the initialisation moved
+  /// Results that may not mean what they seem: large initial corrections, constraint
+  /// violations beyond a fraction of the model size (one line each).
+  std::vector<std::string> warnings;
   int interruptedBySignal = 0;   ///< the signal that stopped the run (RunInterrupted), or 0
   bool outputFailed = false;     ///< the run stopped because its results could not be written
 };

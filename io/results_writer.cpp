@@ -279,6 +279,22 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["cpu_seconds"] = numberOrNull(summary.cpuSeconds);
   j["max_position_violation"] = numberOrNull(summary.maxPositionViolation);
   j["max_velocity_violation"] = numberOrNull(summary.maxVelocityViolation);
+  j["model_size"] = summary.modelSize;
+  nlohmann::ordered_json corrections = nlohmann::ordered_json::array();
+  for (const InitialCorrection& c : summary.initialCorrections) {
+    nlohmann::ordered_json e;
+    e["body"] = c.body;
+    e["position"] = c.position;
+    e["angle"] = c.angle;
+    e["coordinate"] = c.coordinate;
+    e["given"] = c.given;
+    e["corrected"] = c.corrected;
+    e["constraint"] = c.constraint.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(c.constraint);
+    e["residual"] = c.residual;
+    corrections.push_back(e);
+  }
+  j["initial_corrections"] = corrections;
+  j["warnings"] = summary.warnings;
   j["energy_start"] = summary.energyStart ? numberOrNull(*summary.energyStart) : nlohmann::ordered_json(nullptr);
   j["energy_end"] = summary.energyEnd ? numberOrNull(*summary.energyEnd) : nlohmann::ordered_json(nullptr);
   j["formulation"] = toString(s.formulation);

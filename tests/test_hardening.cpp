@@ -155,6 +155,66 @@ TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   fs::remove_all(dir);
 }
 
+// ----- item 3: tolerances that cannot give a result; constraint violation warnings ------
+
+TEST_F(Hardening, MeaninglessTolerancesAreRefused) {
+  nlohmann::json j = exampleScene("slider_crank_elastic.json");
+  j["solver"]["atol"] = 1e6;  // was: ok after 18 steps, deflection 31x wrong, violation 1.87 m
+  CliResult r = runScene("run", writeScene("atol.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.atol"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("model size"), std::string::npos) << r.err;
+
+  j = example();
+  j["solver"]["rtol"] = 0.5;
+  r = runScene("run", writeScene("rtol.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("solver.rtol"), std::string::npos) << r.err;
+}
+
+TEST_F(Hardening, LargeConstraintViolationIsWarned) {
+  const fs::path out = dir_ / "out";
+  CliResult r = runScene("run", kExample, out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;  // the example at its tolerances: no warning
+  EXPECT_TRUE(nlohmann::json::parse(readFile(out / "summary.json")).at("warnings").empty());
+
+  nlohmann::json j = example();
+  j["solver"]["atol"] = 1e-2;  // accepted (1/300 of the 3 m model) but coarse:
+  j["solver"]["rtol"] = 1e-2;  // violations of 0.025 m and 0.03 m/s were measured
+  r = runScene("run", writeScene("coarse.json", j), out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: position constraints violated by up to"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "ok");
+  EXPECT_GT(summary.at("max_position_violation").get<double>(), 1e-3 * summary.at("model_size").get<double>());
+  ASSERT_FALSE(summary.at("warnings").empty());
+  EXPECT_NE(summary.at("warnings")[0].get<std::string>().find("model size"), std::string::npos);
+}
+
+// ----- item 4: large moves of the consistent initialisation ----------------------------
+
+TEST_F(Hardening, LargeInitialCorrectionIsRecordedAndWarned) {
+  const fs::path out = dir_ / "out";
+  nlohmann::json j = example();
+  j["bodies"][0]["angle"] = 0.4;  // the crank's driver law starts at 0: moved 0.4 rad silently
+  const CliResult r = runScene("run", writeScene("moved.json", j), out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: initial position of body 'crank' corrected: crank.theta given 0.4, now"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("driver 'motor'"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  const auto& corrections = summary.at("initial_corrections");
+  ASSERT_FALSE(corrections.empty());
+  EXPECT_EQ(corrections[0].at("body"), "crank");
+  // The driver fixes the angle at 0: the correction is the 0.4 given, to round-off.
+  EXPECT_NEAR(corrections[0].at("angle").get<double>(), 0.4, 1e-12);
+  EXPECT_EQ(corrections[0].at("constraint"), "driver 'motor'");
+  EXPECT_EQ(summary.at("warnings").size(), 1u) << summary.at("warnings").dump();
+}
+
 // ----- item 6: output failures, signals, stale frames ---------------------------------
 
 /// Every line of a CSV file is complete: ends in a newline, as many fields as the header.
