@@ -117,6 +117,11 @@ std::string fmtTime(double t) {
 /// large as the mechanism (atol 1e6 on a 0.45 m slider-crank: 18 steps, a constraint
 /// violation of 1.87 m, status ok).
 constexpr double kMaxRelativeTolerance = 1e-2;
+/// Finest tolerances accepted: rtol 1e-14 (about 50 round-offs, IDA cannot meet less);
+/// absolute ones 1e-15 of the model size (positions of the size carry round-off of 1e-16
+/// of it): finer ones cannot be met and only make IDA shrink its step until max_steps.
+constexpr double kMinRelativeTolerance = 1e-14;
+constexpr double kMinToleranceFractionOfSize = 1e-15;
 constexpr double kMaxToleranceFractionOfSize = 1e-2;
 constexpr double kMaxAngleTolerance = 1e-2;
 /// Warning thresholds: position constraint violation above 1e-3 of the model size,
@@ -138,6 +143,16 @@ void checkTolerancesForModel(const SolverSettings& s, double L) {
     if (!ok) throw InputError("solver." + key + ": expected " + expected + ", got " + num(got));
   };
   check(s.rtol <= kMaxRelativeTolerance, "rtol", "at most 1e-2 (coarser gives no meaningful result)", s.rtol);
+  check(s.rtol >= kMinRelativeTolerance, "rtol", "at least 1e-14 (finer is below round-off)", s.rtol);
+  const double minAbs = kMinToleranceFractionOfSize * L;
+  const std::string fineBound = "at least 1e-15 of the model size " + num(L) + " (finer is below round-off)";
+  for (const auto& [key, value] : {std::pair<const char*, std::optional<double>>{"atol", s.atol},
+                                   {"atol_elastic", s.atolElastic}, {"atol_angle", s.atolAngle},
+                                   {"atol_velocity", s.atolVelocity}}) {
+    if (value) check(*value >= (std::string(key) == "atol_angle" ? kMinToleranceFractionOfSize : minAbs), key,
+                     std::string(key) == "atol_angle" ? "at least 1e-15 rad (finer is below round-off)" : fineBound,
+                     *value);
+  }
   const double maxLength = kMaxToleranceFractionOfSize * L;
   const std::string lengthBound = "at most 1e-2 of the model size " + num(L) + ": " + num(maxLength) +
                                   " (coarser cannot resolve the motion)";
