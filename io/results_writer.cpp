@@ -131,10 +131,11 @@ void RowFile::open(const std::filesystem::path& path, const std::string& header)
   bytes_ = static_cast<long long>(header.size());
 }
 
-void RowFile::append(const std::string& row, double t) {
+void RowFile::append(const std::string& row, double t, const char* variable) {
   if (const int err = writeAll(fd_, row.data(), row.size())) {
     if (::ftruncate(fd_, static_cast<off_t>(bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(bytes_), SEEK_SET);
-    throw OutputWriteError("cannot write '" + path_.string() + "' at t = " + timeText(t) + ": " + std::strerror(err) +
+    throw OutputWriteError("cannot write '" + path_.string() + "' at " + variable + " = " + timeText(t) + ": " +
+                           std::strerror(err) +
                            " (" + std::to_string(rows_) + " complete rows kept)");
   }
   bytes_ += static_cast<long long>(row.size());

@@ -65,8 +65,8 @@ class RowFile {
   /// Creates (truncates) `path` and writes `header` (one line, with its newline).
   void open(const std::filesystem::path& path, const std::string& header);
   bool isOpen() const { return fd_ >= 0; }
-  /// Appends `row` (with its newline); `t` is the time named in an error.
-  void append(const std::string& row, double t);
+  /// Appends `row` (with its newline); `t` is the time (or the `variable`) named in an error.
+  void append(const std::string& row, double t, const char* variable = "t");
   long rows() const { return rows_; }
 
  private:
