@@ -252,6 +252,20 @@ TEST_F(Hardening, FullDiskKeepsWholeRowsAndTheSummarySaysWhy) {
   EXPECT_NE(summary.at("message").get<std::string>().find("results.csv"), std::string::npos) << summary.dump();
 }
 
+TEST_F(Hardening, FullDiskInKinematicsKeepsWholeRows) {
+  const fs::path out = dir_ / "out";
+  const CliResult r = runShell("trap '' XFSZ; ulimit -f 8; exec \"$F\" kinematics " +
+                               shellQuote(kSourceDir + "/examples/kinematics_slider_crank.json") + " --out " +
+                               shellQuote(out.string()));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("kinematics.csv' at alpha = "), std::string::npos) << r.err;
+  EXPECT_TRUE(WholeRows(readFile(out / "kinematics.csv")));
+  EXPECT_FALSE(fs::exists(out / "summary.json.tmp"));
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+}
+
 TEST_F(Hardening, SignalsEndTheRunWithAnInterruptedSummary) {
   for (const auto& [signal, status] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
     const fs::path out = dir_ / ("out_" + signal);
