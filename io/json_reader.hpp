@@ -50,6 +50,7 @@ constexpr std::size_t kMaxQuoted = 60;
 /// `s` cut to at most `limit` characters, ending in "..." if it was cut (never inside
 /// a UTF-8 sequence).
 inline std::string shorten(const std::string& s, std::size_t limit = kMaxQuoted) {
+  limit = std::max<std::size_t>(limit, 8);
   if (s.size() <= limit) return s;
   std::size_t n = limit - 3;
   while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // continuation byte
