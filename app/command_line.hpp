@@ -2,7 +2,10 @@
 // one-line errors, option splitting and number parsing. Exit status 2 on UsageError.
 #pragma once
 
+#include <signal.h>
+
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -11,7 +14,41 @@
 #include <string>
 #include <vector>
 
+#include "integrators/simulation.hpp"
+
 namespace flexmbd::cli {
+
+// ----- SIGINT / SIGTERM during a run -----------------------------------------------------
+// The first signal sets a flag; the run finishes the row it is writing, writes its summary
+// (status "interrupted", the time reached) and exits 128 + signal (130, 143). The handler
+// resets itself: a second signal ends the process at once.
+
+inline volatile std::sig_atomic_t gStopSignal = 0;
+
+inline void onStopSignal(int sig) { gStopSignal = sig; }
+
+inline void installStopHandlers() {
+  struct sigaction sa {};
+  sa.sa_handler = onStopSignal;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESETHAND;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
+inline std::string signalName(int sig) {
+  return sig == SIGINT ? "SIGINT" : sig == SIGTERM ? "SIGTERM" : "signal " + std::to_string(sig);
+}
+
+/// Called after each output row: stops the run if a signal came.
+inline void stopIfSignalled(double t) {
+  if (const int sig = gStopSignal) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", t);
+    throw RunInterrupted("interrupted by " + signalName(sig) + " at t = " + buf + " (the run stopped after this output)",
+                         sig);
+  }
+}
 
 /// A bad command line (exit status 2).
 struct UsageError : std::runtime_error {

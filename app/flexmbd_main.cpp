@@ -196,6 +196,7 @@ int runCommand(const Options& o) {
   }
 
   // ----- the run -----
+  installStopHandlers();
   const std::clock_t start = std::clock();
   SimulationSummary summary;
   try {
@@ -203,6 +204,7 @@ int runCommand(const Options& o) {
                        [&](const OutputSample& sample) {
                          writer->write(sample);
                          if (vtk) vtk->write(sample);
+                         stopIfSignalled(sample.t);
                        });
   } catch (const InputError& e) {
     // Includes ModelError: the model cannot be set up (assembly, redundant or
@@ -223,20 +225,25 @@ int runCommand(const Options& o) {
     summary.cpuSeconds = cpuSecondsSince(start);
   }
 
+  for (const std::string& w : summary.warnings) std::cerr << "flexmbd: warning: " << oneLine(w) << std::endl;
+  const std::string kept = writer->rowsWritten() > 0
+                               ? "results up to t = " + fmt(writer->lastTime()) + " kept in " +
+                                     writer->resultsPath().string()
+                               : "no results were written";
+  const int failureStatus = summary.interruptedBySignal ? 128 + summary.interruptedBySignal : kExitSolverFailure;
+  // The first error is reported first: a failed results file, then the summary's own.
+  const std::string what = summary.interruptedBySignal || summary.outputFailed ? summary.message
+                                                                               : "solver failure: " + summary.message;
   try {
     writeSummary(outDir, summary, *scene);
   } catch (const std::exception& e) {
-    printError(std::string("cannot write the summary: ") + e.what());
-    return kExitSolverFailure;
+    printError((summary.ok ? std::string() : what + " (" + kept + "); ") + "cannot write the summary: " + e.what());
+    return summary.ok ? kExitSolverFailure : failureStatus;
   }
 
   if (!summary.ok) {
-    const std::string kept = writer->rowsWritten() > 0
-                                 ? "results up to t = " + fmt(writer->lastTime()) + " kept in " +
-                                       writer->resultsPath().string()
-                                 : "no results were written";
-    printError("solver failure: " + summary.message + " (" + kept + ")");
-    return kExitSolverFailure;
+    printError(what + " (" + kept + ")");
+    return failureStatus;
   }
   std::cout << "flexmbd: ok: t = " << fmt(summary.tReached) << " reached, " << summary.stats.steps << " steps, "
             << fmt(summary.cpuSeconds) << " s CPU; results in " << writer->resultsPath().string() << std::endl;

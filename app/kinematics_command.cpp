@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "integrators/kinematic_analysis.hpp"
 #include "io/kinematics_scene.hpp"
+#include "io/results_writer.hpp"
 
 namespace flexmbd {
 
@@ -74,9 +75,8 @@ Options parseOptions(const std::vector<std::string>& args) {
 /// DIR/kinematics.csv, one row per input step, flushed row by row (kept on a stop).
 class KinematicsWriter {
  public:
-  KinematicsWriter(const fs::path& path, const Linkage2d& linkage) : linkage_(linkage), out_(path) {
-    if (!out_) throw std::runtime_error("cannot write '" + path.string() + "'");
-    out_.precision(17);
+  KinematicsWriter(const fs::path& path, const Linkage2d& linkage) : linkage_(linkage) {
+    std::ostringstream out_;
     out_ << "step,alpha,iterations,residual,rcond";
     for (int i = 0; i < linkage.numInputs(); ++i) out_ << ',' << linkage.input(InputIndex(i)).name;
     for (int i = 0; i < linkage.numNodes(); ++i) {
@@ -90,9 +90,13 @@ class KinematicsWriter {
       for (const char* c : {".angle", ".dangle_da", ".d2angle_da2", ".omega", ".omega_dot"}) out_ << ',' << n << c;
     }
     out_ << '\n';
+    file_.open(path, out_.str());
   }
 
+  /// One row, written whole or not at all (RowFile).
   void write(const KinematicState& s) {
+    std::ostringstream out_;
+    out_.precision(17);
     out_ << s.step << ',' << s.alpha << ',' << s.iterations << ',' << s.residual << ',' << s.rcond;
     for (int i = 0; i < linkage_.numInputs(); ++i) out_ << ',' << s.x[linkage_.input(InputIndex(i)).coordinate];
     for (int i = 0; i < linkage_.numNodes(); ++i) {
@@ -107,23 +111,16 @@ class KinematicsWriter {
       out_ << ',' << s.x[c] << ',' << s.xp[c] << ',' << s.xpp[c] << ',' << s.v[c] << ',' << s.a[c];
     }
     out_ << '\n';
-    out_.flush();
-    if (!out_) throw std::runtime_error("cannot write the kinematics results");
+    file_.append(out_.str(), s.alpha, "alpha");
   }
 
  private:
   const Linkage2d& linkage_;
-  std::ofstream out_;
+  RowFile file_;
 };
 
 void writeJson(const fs::path& dir, const nlohmann::json& j) {
-  const fs::path tmp = dir / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    out << j.dump(2) << '\n';
-    if (!out) throw std::runtime_error("cannot write '" + tmp.string() + "'");
-  }
-  fs::rename(tmp, dir / "summary.json");
+  writeSummaryText(dir, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + '\n');
 }
 
 void removeStale(const fs::path& dir) {
@@ -179,6 +176,7 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
   try {
     fs::create_directories(outDir);
     removeStale(outDir);
+    reserveSummary(outDir);
     writer.emplace(outDir / "kinematics.csv", scene->linkage);
   } catch (const std::exception& e) {
     printError(e.what());
@@ -187,7 +185,12 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
 
   KinematicSummary summary;
   int minIt = 0, maxIt = 0;
-  summary = analysis->run([&](const KinematicState& s) { writer->write(s); });
+  try {
+    summary = analysis->run([&](const KinematicState& s) { writer->write(s); });
+  } catch (const OutputWriteError& e) {  // disk full: the rows written are whole
+    summary.ok = false;
+    summary.message = e.what();
+  }
   minIt = summary.minIterations;
   maxIt = summary.maxIterations;
 

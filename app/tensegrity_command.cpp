@@ -37,23 +37,22 @@ std::string num(double x) {
 class TensegrityResults {
  public:
   TensegrityResults(const std::filesystem::path& dir, const TensegrityStructure& s) : s_(s) {
-    results_.open(dir / "results.csv");
-    events_.open(dir / "events.csv");
-    if (!results_ || !events_) throw std::runtime_error("cannot write in " + dir.string());
     const char* axes[3] = {"x", "y", "z"};
-    results_ << "t";
+    std::ostringstream h;
+    h << "t";
     for (int i = 0; i < s.numNodes(); ++i) {
-      for (int a = 0; a < s.dimension(); ++a) results_ << "," << s.node(i).name << "." << axes[a];
+      for (int a = 0; a < s.dimension(); ++a) h << "," << s.node(i).name << "." << axes[a];
     }
     for (int i = 0; i < s.numNodes(); ++i) {
-      for (int a = 0; a < s.dimension(); ++a) results_ << "," << s.node(i).name << ".v" << axes[a];
+      for (int a = 0; a < s.dimension(); ++a) h << "," << s.node(i).name << ".v" << axes[a];
     }
     for (int c = 0; c < s.numCables(); ++c) {
       const std::string& n = s.cable(c).name;
-      results_ << "," << n << ".tension," << n << ".slack," << n << ".impulse," << n << ".length";
+      h << "," << n << ".tension," << n << ".slack," << n << ".impulse," << n << ".length";
     }
-    results_ << ",energy.kinetic,energy.potential,energy.total\n";
-    events_ << "t,step,type,member,other,impulse,elongation_rate,energy_change,x,y,z\n";
+    h << ",energy.kinetic,energy.potential,energy.total\n";
+    results_.open(dir / "results.csv", h.str());
+    events_.open(dir / "events.csv", "t,step,type,member,other,impulse,elongation_rate,energy_change,x,y,z\n");
   }
   void sample(const TensegritySample& smp) {
     // A row with a non-finite value is not written: the run stops there (issue 11).
@@ -71,39 +70,41 @@ class TensegrityResults {
     check(std::isfinite(smp.kineticEnergy) && std::isfinite(smp.potentialEnergy) &&
               std::isfinite(smp.kineticEnergy + smp.potentialEnergy),
           "energy");
-    results_ << num(smp.t);
-    for (int k = 0; k < smp.x.size(); ++k) results_ << "," << num(smp.x[k]);
-    for (int k = 0; k < smp.v.size(); ++k) results_ << "," << num(smp.v[k]);
+    std::ostringstream row;
+    row << num(smp.t);
+    for (int k = 0; k < smp.x.size(); ++k) row << "," << num(smp.x[k]);
+    for (int k = 0; k < smp.v.size(); ++k) row << "," << num(smp.v[k]);
     for (int c = 0; c < s_.numCables(); ++c) {
-      results_ << "," << num(smp.cableTension[c]) << "," << (smp.slack[c] ? 1 : 0) << "," << num(smp.cableImpulse[c])
-               << "," << num(smp.cableLength[c]);
+      row << "," << num(smp.cableTension[c]) << "," << (smp.slack[c] ? 1 : 0) << "," << num(smp.cableImpulse[c])
+          << "," << num(smp.cableLength[c]);
     }
-    results_ << "," << num(smp.kineticEnergy) << "," << num(smp.potentialEnergy) << ","
-             << num(smp.kineticEnergy + smp.potentialEnergy) << "\n";
-    results_.flush();
+    row << "," << num(smp.kineticEnergy) << "," << num(smp.potentialEnergy) << ","
+        << num(smp.kineticEnergy + smp.potentialEnergy) << "\n";
+    results_.append(row.str(), smp.t);
     ++rows_;
     lastTime_ = smp.t;
   }
   void event(const TensegrityEvent& e) {
-    events_ << num(e.t) << "," << e.step << "," << toString(e.type) << "," << e.member << "," << e.other << ","
-            << num(e.impulse) << "," << num(e.elongationRate) << "," << num(e.energyChange) << "," << num(e.point[0])
-            << "," << num(e.point[1]) << "," << num(e.point[2]) << "\n";
-    events_.flush();
+    std::ostringstream row;
+    row << num(e.t) << "," << e.step << "," << toString(e.type) << "," << e.member << "," << e.other << ","
+        << num(e.impulse) << "," << num(e.elongationRate) << "," << num(e.energyChange) << "," << num(e.point[0])
+        << "," << num(e.point[1]) << "," << num(e.point[2]) << "\n";
+    events_.append(row.str(), e.t);
   }
   long rows() const { return rows_; }
   double lastTime() const { return lastTime_; }
 
  private:
   const TensegrityStructure& s_;
-  std::ofstream results_, events_;
+  RowFile results_, events_;
   long rows_ = 0;
   double lastTime_ = NAN;
 };
 
 void writeTensegritySummary(const std::filesystem::path& dir, const TensegrityRunSummary& s,
-                            const TensegrityScene& scene) {
+                            const TensegrityScene& scene, int interruptedBy) {
   nlohmann::json j;
-  j["status"] = s.ok ? "ok" : "failed";
+  j["status"] = s.ok ? "ok" : interruptedBy ? "interrupted" : "failed";
   j["message"] = s.message;
   j["model"] = "tensegrity";
   j["scene"] = scene.name;
@@ -137,13 +138,7 @@ void writeTensegritySummary(const std::filesystem::path& dir, const TensegrityRu
     j["rtol"] = scene.massless.cvode.rtol;
     j["atol"] = scene.massless.cvode.atol;
   }
-  const std::filesystem::path tmp = dir / "summary.json.tmp";
-  {
-    std::ofstream out(tmp);
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-    out << j.dump(2) << "\n";
-  }
-  std::filesystem::rename(tmp, dir / "summary.json");
+  writeSummaryText(dir, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 int reportInputError(const std::filesystem::path& outDir, const std::string& message) {
@@ -193,14 +188,21 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
   try {
     std::filesystem::create_directories(outDir);
     removeStaleResults(outDir);
+    reserveSummary(outDir);
     results.emplace(outDir, *scene.structure);
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;
   }
-  const TensegrityObserver observer{[&](const TensegritySample& s) { results->sample(s); },
+  const TensegrityObserver observer{[&](const TensegritySample& s) {
+                                      results->sample(s);
+                                      cli::stopIfSignalled(s.t);
+                                    },
                                     [&](const TensegrityEvent& e) { results->event(e); }};
   TensegrityRunSummary summary;
+  int interruptedBy = 0;
+  bool outputFailed = false;
+  cli::installStopHandlers();
   try {
     if (scene.method == TensegrityScene::Method::TimeStepping) {
       summary = TensegrityTimeStepper(*scene.structure, scene.timeStepping).run(observer);
@@ -209,6 +211,16 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     }
   } catch (const InputError& e) {
     return reportInputError(outDir, o.scenePath + ": " + e.what());
+  } catch (const RunInterrupted& e) {
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = results->lastTime();
+    interruptedBy = e.signal;
+  } catch (const OutputWriteError& e) {
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = results->lastTime();
+    outputFailed = true;
   } catch (const NonFiniteResult& e) {
     if (results->rows() == 0) {  // at the start: the scene's own values overflow (exit 2)
       return reportInputError(outDir, o.scenePath + ": the initial state has " + e.what() +
@@ -223,9 +235,20 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     summary.tReached = results->lastTime();
   }
   try {
-    writeTensegritySummary(outDir, summary, scene);
+    writeTensegritySummary(outDir, summary, scene, interruptedBy);
   } catch (const std::exception& e) {
-    printError(std::string("cannot write the summary: ") + e.what());
+    printError((summary.ok ? std::string() : summary.message + "; ") + "cannot write the summary: " + e.what());
+    return interruptedBy ? 128 + interruptedBy : kExitSolverFailure;
+  }
+  const std::string kept = results->rows() > 0 ? "results up to t = " + num(results->lastTime()) + " kept in " +
+                                                     (outDir / "results.csv").string()
+                                               : std::string("no results were written");
+  if (interruptedBy) {
+    printError(summary.message + " (" + kept + ")");
+    return 128 + interruptedBy;
+  }
+  if (outputFailed) {
+    printError(summary.message + " (" + kept + ")");
     return kExitSolverFailure;
   }
   if (!summary.ok) {

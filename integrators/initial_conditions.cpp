@@ -68,12 +68,36 @@ void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2
   y = sol.tail(m);
 }
 
+namespace {
+
+/// What was measured of the mass matrix when the augmented system is singular: the
+/// smallest and largest diagonal entries and their coordinates (a mass or inertia tiny
+/// beside the others makes [M G^T; G 0] numerically singular).
+std::string massDiagonalReport(const System& sys, const MatX& M) {
+  if (M.rows() == 0) return "";
+  const std::vector<std::string> names = sys.coordinateNames();
+  Eigen::Index lo = 0, hi = 0;
+  const VecX d = M.diagonal().cwiseAbs();
+  d.minCoeff(&lo);
+  d.maxCoeff(&hi);
+  std::ostringstream os;
+  os.precision(3);
+  os << "; mass matrix diagonal from " << d[lo] << " (" << names[lo] << ") to " << d[hi] << " (" << names[hi] << ")";
+  return os.str();
+}
+
+}  // namespace
+
 void computeAccelerations(const System& sys, double t, const VecX& q, const VecX& v, VecX& a,
                           VecX& lambda) {
   MatX G;
   evaluateConstraints(sys, q, t, nullptr, &G);
-  solveAugmented(massMatrix(sys, q), G, generalizedForces(sys, t, q, v),
-                 accelerationConstraintRhs(sys, q, v, t), a, lambda);
+  const MatX M = massMatrix(sys, q);
+  try {
+    solveAugmented(M, G, generalizedForces(sys, t, q, v), accelerationConstraintRhs(sys, q, v, t), a, lambda);
+  } catch (const ModelError& e) {
+    throw ModelError(e.what() + massDiagonalReport(sys, M));
+  }
 }
 
 ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0, const VecX& v0) {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <sstream>
@@ -110,6 +111,125 @@ std::string fmtTime(double t) {
 
 }  // namespace
 
+/// Coarsest tolerances accepted. rtol: IDA's error control at 1 % relative error already
+/// gives qualitative results only. atol of positions and elastic coordinates: 1 % of the
+/// model size, of angles 0.01 rad: above, the error test passes steps whose errors are as
+/// large as the mechanism (atol 1e6 on a 0.45 m slider-crank: 18 steps, a constraint
+/// violation of 1.87 m, status ok).
+constexpr double kMaxRelativeTolerance = 1e-2;
+/// Finest tolerances accepted: rtol 1e-14 (about 50 round-offs, IDA cannot meet less);
+/// absolute ones 1e-15 of the model size (positions of the size carry round-off of 1e-16
+/// of it): finer ones cannot be met and only make IDA shrink its step until max_steps.
+/// Velocity tolerances have no floor: their scale is the model's time scale, not known
+/// here (slow modes of stiff chains use atol_velocity 1e-16, tests/test_stability.cpp).
+constexpr double kMinRelativeTolerance = 1e-14;
+constexpr double kMinToleranceFractionOfSize = 1e-15;
+constexpr double kMaxToleranceFractionOfSize = 1e-2;
+constexpr double kMaxAngleTolerance = 1e-2;
+/// Warning thresholds: position constraint violation above 1e-3 of the model size,
+/// velocity violation above 1e-3 of the model's velocity scale (largest speed seen, at
+/// least size / span), an initial correction above 1e-3 of the size or 1e-3 rad. Ten
+/// times below the coarsest tolerance accepted; regular runs stay 1e5 times below them.
+constexpr double kWarnFraction = 1e-3;
+constexpr double kWarnAngle = 1e-3;
+
+std::string num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
+
+/// Refuses tolerances that cannot give a meaningful result for this model.
+void checkTolerancesForModel(const SolverSettings& s, double L) {
+  const auto check = [&](bool ok, const std::string& key, const std::string& expected, double got) {
+    if (!ok) throw InputError("solver." + key + ": expected " + expected + ", got " + num(got));
+  };
+  check(s.rtol <= kMaxRelativeTolerance, "rtol", "at most 1e-2 (coarser gives no meaningful result)", s.rtol);
+  check(s.rtol >= kMinRelativeTolerance, "rtol", "at least 1e-14 (finer is below round-off)", s.rtol);
+  const double minAbs = kMinToleranceFractionOfSize * L;
+  const std::string fineBound = "at least 1e-15 of the model size " + num(L) + " (finer is below round-off)";
+  for (const auto& [key, value] : {std::pair<const char*, std::optional<double>>{"atol", s.atol},
+                                   {"atol_elastic", s.atolElastic}, {"atol_angle", s.atolAngle}}) {
+    if (value) check(*value >= (std::string(key) == "atol_angle" ? kMinToleranceFractionOfSize : minAbs), key,
+                     std::string(key) == "atol_angle" ? "at least 1e-15 rad (finer is below round-off)" : fineBound,
+                     *value);
+  }
+  const double maxLength = kMaxToleranceFractionOfSize * L;
+  const std::string lengthBound = "at most 1e-2 of the model size " + num(L) + ": " + num(maxLength) +
+                                  " (coarser cannot resolve the motion)";
+  check(s.atol <= maxLength, "atol", lengthBound, s.atol);
+  if (s.atolElastic) check(*s.atolElastic <= maxLength, "atol_elastic", lengthBound, *s.atolElastic);
+  if (s.atolAngle) {
+    check(*s.atolAngle <= kMaxAngleTolerance, "atol_angle", "at most 1e-2 rad (coarser cannot resolve the motion)",
+          *s.atolAngle);
+  } else {
+    check(s.atol <= kMaxAngleTolerance, "atol", "at most 1e-2 (it is also the tolerance of angles, in rad)", s.atol);
+  }
+}
+
+/// The largest correction per body of the consistent initialisation, with the joint or
+/// driver most violated on that body by the given values.
+std::vector<InitialCorrection> initialCorrections(const System& sys, double t0, const VecX& given,
+                                                  const VecX& corrected, double L) {
+  std::vector<InitialCorrection> out;
+  VecX g;
+  if (sys.numConstraintEquations() > 0) evaluateConstraints(sys, given, t0, &g, nullptr);
+  const std::vector<std::string> names = sys.coordinateNames();
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  for (int b = 1; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int off = sys.coordinateOffset(BodyIndex(b));
+    InitialCorrection c;
+    c.body = body.name();
+    double worst = 0.0;  // change relative to its warning threshold
+    for (int k = off; k < off + body.numCoordinates(); ++k) {
+      const double d = std::fabs(corrected[k] - given[k]);
+      const bool angle = kinds[k] == CoordinateKind::Angle;
+      (angle ? c.angle : c.position) = std::max(angle ? c.angle : c.position, d);
+      const double rel = d / (angle ? kWarnAngle : kWarnFraction * L);
+      if (rel > worst) {
+        worst = rel;
+        c.coordinate = names[k];
+        c.given = given[k];
+        c.corrected = corrected[k];
+      }
+    }
+    if (c.position == 0.0 && c.angle == 0.0) continue;
+    for (int ci = 0; ci < sys.numConstraints(); ++ci) {
+      const Constraint& con = sys.constraint(ConstraintIndex(ci));
+      const auto& bodies = con.bodies();
+      if (std::find(bodies.begin(), bodies.end(), BodyIndex(b)) == bodies.end()) continue;
+      const int row0 = sys.constraintOffset(ConstraintIndex(ci));
+      for (int r = row0; r < row0 + con.numEquations(); ++r) {
+        if (std::fabs(g[r]) > c.residual) {
+          c.residual = std::fabs(g[r]);
+          c.constraint = std::string(con.isDriver() ? "driver '" : "joint '") + con.name() + "'";
+        }
+      }
+    }
+    out.push_back(c);
+  }
+  return out;
+}
+
+/// Shortest run: the bound of scene numbers (1e100) inverted; below it, squares of the
+/// step underflow.
+constexpr double kMinTimeSpan = 1e-100;
+/// Shortest run relative to |t|: steps of 1e-3 of such a span are still 1e4 round-offs of t.
+constexpr double kMinRelativeSpan = 1e-9;
+/// Most outputs of a run: 1e8 rows of even a one-body model are 6 GB of results.csv.
+constexpr double kMaxOutputs = 1e8;
+/// Default min_step: 1e-12 of the span, at most 1e-12 s. Of the span alone, a long run
+/// (t_end = 2^31 s) got min_step = 2e-3 s and failed at its first step. 1e-12 s is below
+/// every physical time scale of the models (their fastest elastic modes have periods above
+/// 1e-6 s): a step that small has collapsed (lock-up, singularity), it does not resolve.
+constexpr double kDefaultMinStepFraction = 1e-12;
+constexpr double kDefaultMinStepSeconds = 1e-12;
+
+double defaultMinStepSize(const SolverSettings& s) {
+  return std::min(kDefaultMinStepFraction * (s.tEnd - s.tStart), kDefaultMinStepSeconds);
+}
+
 void SolverSettings::validate() const {
   requireSetting(rtol > 0.0 && std::isfinite(rtol), "rtol", "a positive number", rtol);
   requireSetting(atol > 0.0 && std::isfinite(atol), "atol", "a positive number", atol);
@@ -121,11 +241,22 @@ void SolverSettings::validate() const {
   requireSetting(std::isfinite(tEnd) && tEnd > tStart, "t_end", "a number greater than t_start", tEnd);
   requireSetting(outputStep > 0.0 && std::isfinite(outputStep), "output_step", "a positive number",
                  outputStep);
+  // A span the integrator can resolve: IDA refuses a stop time within round-off of t_start
+  // (IDA_ILL_INPUT for t_end = 1e-300) and needs steps well above round-off of t.
+  const double span = tEnd - tStart;
+  requireSetting(span >= kMinTimeSpan && span >= kMinRelativeSpan * std::max(std::fabs(tStart), std::fabs(tEnd)),
+                 "t_end", "t_end - t_start >= 1e-100 and >= 1e-9 max(|t_start|, |t_end|) (a span the integrator "
+                 "can resolve)", tEnd);
+  requireSetting(span / outputStep <= kMaxOutputs, "output_step",
+                 "at most 1e8 outputs over t_end - t_start (results.csv would not fit a disk): a larger step",
+                 outputStep);
   requireSetting(maxStepSize >= 0.0 && std::isfinite(maxStepSize), "max_step",
                  "a non-negative number (0: no limit)", maxStepSize);
   if (minStepSize) {
     requireSetting(*minStepSize >= 0.0 && std::isfinite(*minStepSize), "min_step",
                    "a non-negative number", *minStepSize);
+    requireSetting(*minStepSize < std::min(span, outputStep), "min_step",
+                   "less than t_end - t_start and than output_step", *minStepSize);
   }
   requireSetting(initialStepSize >= 0.0 && std::isfinite(initialStepSize), "initial_step",
                  "a non-negative number (0: IDA's estimate)", initialStepSize);
@@ -159,6 +290,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
                            const OutputCallback& onOutput) {
   settings.validate();
   if (!sys.isFinalized()) throw InputError("simulate: the system must be finalized first");
+  checkTolerancesForModel(settings, sys.characteristicLength());
   const std::clock_t cpuStart = std::clock();
   const double t0 = settings.tStart, tEnd = settings.tEnd;
 
@@ -171,7 +303,22 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
 
   SimulationSummary summary;
   summary.initialPositionIterations = init.positionIterations;
+  const double modelSize = sys.characteristicLength();
+  summary.modelSize = modelSize;
+  summary.initialCorrections = initialCorrections(sys, t0, sys.initialCoordinates(), init.q, modelSize);
+  for (const InitialCorrection& c : summary.initialCorrections) {
+    if (c.position > kWarnFraction * modelSize || c.angle > kWarnAngle) {
+      summary.warnings.push_back("initial position of body '" + c.body + "' corrected: " + c.coordinate + " given " +
+                                 num(c.given) + ", now " + num(c.corrected) + " (largest change " +
+                                 num(c.position) + " in position, " + num(c.angle) + " rad in angle) to satisfy " +
+                                 (c.constraint.empty() ? std::string("the joints of other bodies")
+                                                       : c.constraint + " (residual " + num(c.residual) +
+                                                             " at the given values)"));
+    }
+  }
   const bool conservative = isConservative(sys);
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  double maxSpeed = 0.0;  // velocity scale of the warnings: translational, angular rates times size
   OutputSample last;  // the last output, for the diagnosis of a failure
   double tOutput = t0;  // the output being evaluated
   auto emit = [&](double t, const VecX& y, const VecX& yp) {
@@ -184,6 +331,9 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     // state itself, unlike the interpolated y' (docs/formulations.md).
     (void)yp;
     computeAccelerations(sys, t, s.q, s.v, s.a, s.lambda);
+    for (int k = 0; k < L.nq; ++k) {
+      maxSpeed = std::max(maxSpeed, std::fabs(s.v[k]) * (kinds[k] == CoordinateKind::Angle ? modelSize : 1.0));
+    }
     if (L.m > 0) {
       VecX g;
       evaluateConstraints(sys, s.q, t, &g, nullptr);
@@ -210,6 +360,18 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     // Nothing was integrated: the scene's own values overflow (masses, speeds, loads).
     throw InputError(std::string("the initial state has ") + e.what() +
                      ": values of the scene overflow (check masses, inertias, speeds, loads)");
+  } catch (const RunInterrupted& e) {
+    summary.ok = false;
+    summary.interruptedBySignal = e.signal;
+    summary.failureTime = t0;
+    summary.message = e.what();
+    return summary;
+  } catch (const OutputWriteError& e) {
+    summary.ok = false;
+    summary.outputFailed = true;
+    summary.failureTime = t0;
+    summary.message = e.what();
+    return summary;
   }
 
   IntegratorOptions o;
@@ -219,7 +381,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
   o.initialStepSize = settings.initialStepSize;
-  o.minStepSize = settings.minStepSize.value_or(1e-12 * (tEnd - t0));
+  o.minStepSize = settings.minStepSize.value_or(defaultMinStepSize(settings));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
   const std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(settings.integrator, dae, t0, y0, yp0, o);
@@ -245,6 +407,16 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     } catch (const std::exception&) {
       // the diagnosis is optional: IDA's reason stays the message
     }
+  } catch (const RunInterrupted& e) {
+    summary.ok = false;
+    summary.interruptedBySignal = e.signal;
+    summary.failureTime = tOutput;
+    summary.message = e.what();
+  } catch (const OutputWriteError& e) {
+    summary.ok = false;
+    summary.outputFailed = true;
+    summary.failureTime = tOutput;
+    summary.message = e.what();
   } catch (const NonFiniteResult& e) {
     summary.ok = false;
     summary.failureTime = tOutput;
@@ -263,6 +435,17 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     }
   }
   summary.stats = ida.stats();
+  const double velocityScale = std::max(maxSpeed, modelSize / (tEnd - t0));
+  if (summary.maxPositionViolation > kWarnFraction * modelSize) {
+    summary.warnings.push_back("position constraints violated by up to " + num(summary.maxPositionViolation) +
+                               ", more than 1e-3 of the model size " + num(modelSize) +
+                               ": the results are not accurate (tighten atol and rtol)");
+  }
+  if (summary.maxVelocityViolation > kWarnFraction * velocityScale) {
+    summary.warnings.push_back("velocity constraints violated by up to " + num(summary.maxVelocityViolation) +
+                               ", more than 1e-3 of the velocity scale " + num(velocityScale) +
+                               ": the results are not accurate (tighten atol and rtol)");
+  }
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
   if (summary.ok) summary.message = "reached t_end";
   return summary;

@@ -6,6 +6,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
@@ -29,7 +30,7 @@ struct SolverSettings {
   double outputStep = 0.01;
   double maxStepSize = 0.0;       ///< 0: no limit
   /// Smallest step IDA may take before it reports failure (a lock-up or a singularity
-  /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start).
+  /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start), at most 1e-12 s.
   std::optional<double> minStepSize;
   long maxSteps = 1000000;        ///< per output interval
   /// Highest BDF order (1..5). Orders 1 and 2 are A-stable: undamped high-frequency
@@ -55,6 +56,18 @@ struct OutputSample {
   VecX q, v, a, lambda;
 };
 
+/// The largest change the consistent initialisation made to one body's given initial
+/// coordinates (positions and elastic coordinates in length units, angles in rad).
+struct InitialCorrection {
+  std::string body;
+  double position = 0.0;   ///< max over its position and elastic coordinates of |q - q_given|
+  double angle = 0.0;      ///< max over its angle coordinates of |q - q_given|
+  std::string coordinate;  ///< the coordinate changed most (relative to its threshold)
+  double given = 0.0, corrected = 0.0;  ///< that coordinate before and after
+  std::string constraint;  ///< the joint or driver most violated by the given values on this body
+  double residual = 0.0;   ///< its largest |g| at the given values
+};
+
 struct SimulationSummary {
   bool ok = true;
   std::string message;
@@ -67,12 +80,32 @@ struct SimulationSummary {
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   bool usedKlu = false;
   int initialPositionIterations = 0;
+  double modelSize = 1.0;        ///< System::characteristicLength(): the scale of the warnings
+  std::vector<InitialCorrection> initialCorrections;  ///< bodies the initialisation moved
+  /// Results that may not mean what they seem: large initial corrections, constraint
+  /// violations beyond a fraction of the model size (one line each).
+  std::vector<std::string> warnings;
+  int interruptedBySignal = 0;   ///< the signal that stopped the run (RunInterrupted), or 0
+  bool outputFailed = false;     ///< the run stopped because its results could not be written
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run
 /// stops before the row that holds it (issue 11: never `ok` with non-finite results).
 struct NonFiniteResult : std::runtime_error {
   using std::runtime_error::runtime_error;
+};
+
+/// The results cannot be written (disk full, file size limit): the run stops, the rows
+/// written before stay complete.
+struct OutputWriteError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Thrown by an output callback after it wrote its row when the run must stop (SIGINT,
+/// SIGTERM): the summary says "interrupted" with the time reached.
+struct RunInterrupted : std::runtime_error {
+  RunInterrupted(const std::string& message, int signal) : std::runtime_error(message), signal(signal) {}
+  int signal;
 };
 
 /// Called at t0 and at every output time (also the last one reached before a failure).

@@ -126,6 +126,15 @@ TensegrityTimeStepper::TensegrityTimeStepper(const TensegrityStructure& structur
   }
   if (!(o.tEnd > o.tStart)) throw InputError("solver.t_end must be > t_start, got " + num(o.tEnd));
   if (!(o.outputStep >= 0.0)) throw InputError("solver.output_step must be >= 0, got " + num(o.outputStep));
+  // Bounded work (a run never hangs): t_end 1e100 with time_step 1e-3 is 1e103 steps.
+  constexpr double kMaxSteps = 1e9;
+  if (!((o.tEnd - o.tStart) / o.timeStep <= kMaxSteps)) {
+    throw InputError("solver.t_end: at most 1e9 time steps of " + num(o.timeStep) + " s expected, got (t_end - t_start) / "
+                     "time_step = " + num((o.tEnd - o.tStart) / o.timeStep));
+  }
+  if (!(o.outputStep / o.timeStep <= kMaxSteps)) {
+    throw InputError("solver.output_step: at most 1e9 time steps per output expected, got " + num(o.outputStep));
+  }
   if (!(o.projectionTolerance > 0.0)) throw InputError("solver.projection_tolerance must be > 0");
   if (!(o.slackTolerance >= 0.0)) throw InputError("solver.slack_tolerance must be >= 0");
   if (o.maxProjectionIterations < 1) throw InputError("solver.max_projection_iterations must be >= 1");

@@ -50,6 +50,7 @@ constexpr std::size_t kMaxQuoted = 60;
 /// `s` cut to at most `limit` characters, ending in "..." if it was cut (never inside
 /// a UTF-8 sequence).
 inline std::string shorten(const std::string& s, std::size_t limit = kMaxQuoted) {
+  limit = std::max<std::size_t>(limit, 8);
   if (s.size() <= limit) return s;
   std::size_t n = limit - 3;
   while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // continuation byte
@@ -240,8 +241,9 @@ class ObjectReader {
     return v.get<bool>();
   }
 
-  /// An integer >= minimum (1e6 written as a float is accepted if integral).
-  long integer(const std::string& key, long fallback, long minimum) const {
+  /// An integer in [minimum, maximum] (1e6 written as a float is accepted if integral).
+  long integer(const std::string& key, long fallback, long minimum,
+               long maximum = std::numeric_limits<int>::max()) const {
     if (!has(key)) return fallback;
     const json& v = required(key);
     long value = 0;
@@ -262,6 +264,9 @@ class ObjectReader {
     }
     if (value < minimum) {
       fail("key " + inQuotes(key) + " must be >= " + std::to_string(minimum) + ", got " + std::to_string(value));
+    }
+    if (value > maximum) {
+      fail("key " + inQuotes(key) + " must be <= " + std::to_string(maximum) + ", got " + std::to_string(value));
     }
     return value;
   }

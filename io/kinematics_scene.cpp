@@ -22,6 +22,9 @@
 namespace flexmbd {
 namespace {
 
+/// Most input steps: the bound of the --steps option (a 1e8-row kinematics.csv is GBs).
+constexpr long kMaxKinematicSteps = 100000000;
+
 using nlohmann::json;
 
 using namespace jsonread;
@@ -101,11 +104,11 @@ KinematicSettings parseAnalysis(const json& j) {
   KinematicSettings s;
   s.start = r.number("start", s.start);
   s.end = r.number("end", s.end);
-  s.steps = static_cast<int>(r.integer("steps", s.steps, 1));
+  s.steps = static_cast<int>(r.integer("steps", s.steps, 1, kMaxKinematicSteps));
   s.speed = r.number("speed", s.speed);
   s.acceleration = r.number("acceleration", s.acceleration);
   s.tolerance = r.positive("tolerance", s.tolerance);
-  s.maxIterations = static_cast<int>(r.integer("max_iterations", s.maxIterations, 1));
+  s.maxIterations = static_cast<int>(r.integer("max_iterations", s.maxIterations, 1, 1000000));
   const std::string corrector = r.string("corrector", "newton");
   if (corrector == "newton") {
     s.corrector = CorrectorKind::Newton;

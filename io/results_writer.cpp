@@ -1,7 +1,12 @@
 #include "io/results_writer.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <system_error>
@@ -38,22 +43,50 @@ std::string sizeMismatch(const char* what, long got, long expected, double t) {
          std::to_string(got) + ", expected " + std::to_string(expected);
 }
 
-/// Writes `j` to DIR/summary.json via a temporary file and a rename.
-void writeJsonFile(const std::filesystem::path& dir, const nlohmann::ordered_json& j) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create output directory '" + dir.string() + "': " + ec.message());
-  const auto target = dir / "summary.json";
-  const auto tmp = dir / "summary.json.tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write '" + tmp.string() + "'");
-    out << j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << '\n';
-    out.flush();
-    if (!out) throw std::runtime_error("cannot write '" + tmp.string() + "'");
+/// Writes all of `data` to `fd` at its current offset: 0, or the errno of the failure
+/// (ENOSPC: disk full, EFBIG: file size limit).
+int writeAll(int fd, const char* data, std::size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (n == 0) return EIO;
+    data += n;
+    size -= static_cast<std::size_t>(n);
   }
-  std::filesystem::rename(tmp, target, ec);
-  if (ec) throw std::runtime_error("cannot write '" + target.string() + "': " + ec.message());
+  return 0;
+}
+
+/// Writes `text` as the whole content of `path` (created or truncated): 0 or an errno.
+int writeWholeFile(const std::filesystem::path& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return errno;
+  int err = writeAll(fd, text.data(), text.size());
+  if (::close(fd) != 0 && err == 0) err = errno;
+  return err;
+}
+
+/// Overwrites the existing `path` in place with `text` (no new blocks needed when the file
+/// was at least as long) and cuts it to the length of `text`: 0 or an errno.
+int overwriteInPlace(const std::filesystem::path& path, const std::string& text) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd < 0) return errno;
+  int err = writeAll(fd, text.data(), text.size());
+  if (err == 0 && ::ftruncate(fd, static_cast<off_t>(text.size())) != 0) err = errno;
+  if (::close(fd) != 0 && err == 0) err = errno;
+  return err;
+}
+
+std::string timeText(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", t);
+  return buf;
+}
+
+void writeJsonFile(const std::filesystem::path& dir, const nlohmann::ordered_json& j) {
+  writeSummaryText(dir, j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + '\n');
 }
 
 nlohmann::ordered_json numberOrNull(double x) {
@@ -68,6 +101,7 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
   std::filesystem::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create output directory '" + dir.string() + "': " + ec.message());
   removeStaleResults(dir);
+  reserveSummary(dir);
 
   const System& sys = scene.system;
   columns_.push_back("t");
@@ -82,12 +116,47 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
   }
 }
 
+RowFile::~RowFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void RowFile::open(const std::filesystem::path& path, const std::string& header) {
+  path_ = path;
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw OutputWriteError("cannot create '" + path.string() + "': " + std::strerror(errno));
+  if (const int err = writeAll(fd_, header.data(), header.size())) {
+    if (::ftruncate(fd_, 0) == 0) ::lseek(fd_, 0, SEEK_SET);
+    throw OutputWriteError("cannot write the header of '" + path.string() + "': " + std::strerror(err));
+  }
+  bytes_ = static_cast<long long>(header.size());
+}
+
+void RowFile::append(const std::string& row, double t, const char* variable) {
+  if (const int err = writeAll(fd_, row.data(), row.size())) {
+    if (::ftruncate(fd_, static_cast<off_t>(bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(bytes_), SEEK_SET);
+    throw OutputWriteError("cannot write '" + path_.string() + "' at " + variable + " = " + timeText(t) + ": " +
+                           std::strerror(err) +
+                           " (" + std::to_string(rows_) + " complete rows kept)");
+  }
+  bytes_ += static_cast<long long>(row.size());
+  ++rows_;
+}
+
+ResultsWriter::~ResultsWriter() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
 void ResultsWriter::open() {
-  out_.open(path_, std::ios::trunc);
-  if (!out_) throw std::runtime_error("cannot create '" + path_.string() + "'");
+  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw OutputWriteError("cannot create '" + path_.string() + "': " + std::strerror(errno));
   std::string header;
   for (std::size_t k = 0; k < columns_.size(); ++k) header += (k ? "," : "") + csvField(columns_[k]);
-  out_ << header << '\n';
+  header += '\n';
+  if (const int err = writeAll(fd_, header.data(), header.size())) {
+    if (::ftruncate(fd_, 0) == 0) ::lseek(fd_, 0, SEEK_SET);
+    throw OutputWriteError("cannot write the header of '" + path_.string() + "': " + std::strerror(err));
+  }
+  bytes_ = static_cast<long long>(header.size());
 }
 
 void ResultsWriter::write(const OutputSample& s) {
@@ -120,7 +189,7 @@ void ResultsWriter::write(const OutputSample& s) {
                             " in column \"" + columns_[k] + "\" at t = " + tbuf);
     }
   }
-  if (!out_.is_open()) open();
+  if (fd_ < 0) open();
   std::string line;
   line.reserve(24 * columns_.size());
   for (std::size_t k = 0; k < values.size(); ++k) {
@@ -128,28 +197,73 @@ void ResultsWriter::write(const OutputSample& s) {
     appendNumber(line, values[k]);
   }
   line += '\n';
-  out_ << line;
-  out_.flush();
-  if (!out_) throw std::runtime_error("cannot write '" + path_.string() + "' (disk full?)");
+  if (const int err = writeAll(fd_, line.data(), line.size())) {
+    // Cut a partly written row (never a half row in the file), ready for no more rows.
+    if (::ftruncate(fd_, static_cast<off_t>(bytes_)) == 0) ::lseek(fd_, static_cast<off_t>(bytes_), SEEK_SET);
+    throw OutputWriteError("cannot write '" + path_.string() + "' at t = " + timeText(s.t) + ": " +
+                           std::strerror(err) + " (" + std::to_string(rows_) + " complete rows kept)");
+  }
+  bytes_ += static_cast<long long>(line.size());
   ++rows_;
   lastTime_ = s.t;
 }
 
 void removeStaleResults(const std::filesystem::path& dir) {
   std::error_code ec;
-  for (const char* name : {"results.csv", "summary.json", "summary.json.tmp"}) {
-    std::filesystem::remove(dir / name, ec);
-    if (ec) {
-      throw std::runtime_error("cannot delete stale '" + (dir / name).string() + "': " + ec.message());
+  std::vector<std::filesystem::path> stale;
+  for (const char* name : {"results.csv", "summary.json", "summary.json.tmp"}) stale.push_back(dir / name);
+  // Frames of an earlier run with --vtk (VtkWriter: bodies_NNNNNN.vtu, bodies.pvd): left
+  // there, they would be read as frames of this run's model.
+  const std::filesystem::path vtk = dir / "vtk";
+  if (std::filesystem::is_directory(vtk, ec)) {
+    for (const auto& entry : std::filesystem::directory_iterator(vtk, ec)) {
+      const std::string name = entry.path().filename().string();
+      const bool frame = name.rfind("bodies_", 0) == 0 && name.size() > 11 &&
+                         name.compare(name.size() - 4, 4, ".vtu") == 0;
+      if (frame || name == "bodies.pvd") stale.push_back(entry.path());
     }
   }
+  for (const auto& path : stale) {
+    std::filesystem::remove(path, ec);
+    if (ec) throw std::runtime_error("cannot delete stale '" + path.string() + "': " + ec.message());
+  }
+}
+
+void reserveSummary(const std::filesystem::path& dir) {
+  nlohmann::ordered_json j;
+  j["status"] = "running";
+  j["message"] = "the run has not finished, or was killed before it could write its summary";
+  std::string text = j.dump(2) + '\n';
+  text.append(kSummaryReserve > text.size() ? kSummaryReserve - text.size() : 0, ' ');
+  const std::filesystem::path target = dir / "summary.json";
+  if (const int err = writeWholeFile(target, text)) {
+    throw OutputWriteError("cannot write '" + target.string() + "': " + std::strerror(err));
+  }
+}
+
+void writeSummaryText(const std::filesystem::path& dir, const std::string& text) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw OutputWriteError("cannot create output directory '" + dir.string() + "': " + ec.message());
+  const auto target = dir / "summary.json";
+  const auto tmp = dir / "summary.json.tmp";
+  int err = writeWholeFile(tmp, text);
+  if (err == 0) {
+    std::filesystem::rename(tmp, target, ec);
+    if (!ec) return;
+    err = ec.value();
+  }
+  std::filesystem::remove(tmp, ec);
+  // Disk full: the summary reserved at the start of the run (reserveSummary) holds the space.
+  if (text.size() <= kSummaryReserve && overwriteInPlace(target, text) == 0) return;
+  throw OutputWriteError("cannot write '" + target.string() + "': " + std::strerror(err));
 }
 
 void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene) {
   const SolverSettings& s = scene.solver;
   const IntegratorStats& st = summary.stats;
   nlohmann::ordered_json j;  // keys in this order in the file
-  j["status"] = summary.ok ? "ok" : "failed";
+  j["status"] = summary.ok ? "ok" : summary.interruptedBySignal ? "interrupted" : "failed";
   j["message"] = summary.message;
   j["scene"] = scene.name;
   j["t_reached"] = numberOrNull(summary.tReached);
@@ -166,6 +280,22 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["cpu_seconds"] = numberOrNull(summary.cpuSeconds);
   j["max_position_violation"] = numberOrNull(summary.maxPositionViolation);
   j["max_velocity_violation"] = numberOrNull(summary.maxVelocityViolation);
+  j["model_size"] = summary.modelSize;
+  nlohmann::ordered_json corrections = nlohmann::ordered_json::array();
+  for (const InitialCorrection& c : summary.initialCorrections) {
+    nlohmann::ordered_json e;
+    e["body"] = c.body;
+    e["position"] = c.position;
+    e["angle"] = c.angle;
+    e["coordinate"] = c.coordinate;
+    e["given"] = c.given;
+    e["corrected"] = c.corrected;
+    e["constraint"] = c.constraint.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(c.constraint);
+    e["residual"] = c.residual;
+    corrections.push_back(e);
+  }
+  j["initial_corrections"] = corrections;
+  j["warnings"] = summary.warnings;
   j["energy_start"] = summary.energyStart ? numberOrNull(*summary.energyStart) : nlohmann::ordered_json(nullptr);
   j["energy_end"] = summary.energyEnd ? numberOrNull(*summary.energyEnd) : nlohmann::ordered_json(nullptr);
   j["formulation"] = toString(s.formulation);

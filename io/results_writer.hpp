@@ -25,11 +25,14 @@ class ResultsWriter {
   /// Creates `dir` (and parents) and deletes a stale results.csv and summary.json.
   /// `scene` must outlive the writer. @throws std::runtime_error if dir cannot be made.
   ResultsWriter(const std::filesystem::path& dir, const Scene& scene);
+  ~ResultsWriter();
   ResultsWriter(const ResultsWriter&) = delete;
   ResultsWriter& operator=(const ResultsWriter&) = delete;
 
-  /// Appends one row. @throws std::runtime_error if the sample has the wrong sizes or
-  /// the file cannot be written.
+  /// Appends one row, whole or not at all: a failed write (disk full) is cut back to the
+  /// end of the last complete row. @throws NonFiniteResult for a row with inf or NaN,
+  /// OutputWriteError (naming the file, the time and the system's reason) if the file
+  /// cannot be written, std::runtime_error if the sample has the wrong sizes.
   void write(const OutputSample& sample);
 
   const std::vector<std::string>& columns() const { return columns_; }
@@ -44,14 +47,50 @@ class ResultsWriter {
   const Scene& scene_;
   std::filesystem::path path_;
   std::vector<std::string> columns_;
-  std::ofstream out_;
+  int fd_ = -1;                ///< results.csv, opened at the first row
+  long long bytes_ = 0;        ///< size of results.csv up to its last complete row
   long rows_ = 0;
   double lastTime_;
 };
 
-/// Deletes DIR/results.csv and DIR/summary.json if they exist (stale from an earlier
-/// run); the directory itself is kept.
+/// A CSV file written row by row, each row whole or not at all: a failed write (disk
+/// full, file size limit) is cut back to the end of the last complete row and throws
+/// OutputWriteError naming the file, the time and the reason.
+class RowFile {
+ public:
+  RowFile() = default;
+  ~RowFile();
+  RowFile(const RowFile&) = delete;
+  RowFile& operator=(const RowFile&) = delete;
+  /// Creates (truncates) `path` and writes `header` (one line, with its newline).
+  void open(const std::filesystem::path& path, const std::string& header);
+  bool isOpen() const { return fd_ >= 0; }
+  /// Appends `row` (with its newline); `t` is the time (or the `variable`) named in an error.
+  void append(const std::string& row, double t, const char* variable = "t");
+  long rows() const { return rows_; }
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+  long long bytes_ = 0;
+  long rows_ = 0;
+};
+
+/// Deletes DIR/results.csv, DIR/summary.json (and its temporary file) and the frames of
+/// DIR/vtk (bodies_NNNNNN.vtu, bodies.pvd) if they exist, stale from an earlier run (which
+/// may have been of another model); the directories and any other file are kept.
 void removeStaleResults(const std::filesystem::path& dir);
+
+/// Writes DIR/summary.json with status "running", padded to kSummaryReserve bytes: the
+/// final summary then overwrites space already held, and is written even if the disk fills
+/// during the run. A run killed outright leaves this summary (status "running").
+void reserveSummary(const std::filesystem::path& dir);
+constexpr std::size_t kSummaryReserve = 4096;  // a summary is about 1 KB
+
+/// Writes `text` as DIR/summary.json: to a temporary file renamed over it (atomic); if that
+/// fails (disk full), over the reserved summary in place. Never leaves the temporary file.
+/// @throws OutputWriteError naming the file and the reason.
+void writeSummaryText(const std::filesystem::path& dir, const std::string& text);
 
 /// Writes DIR/summary.json: status ("ok"/"failed"), message, t_reached, steps,
 /// residual_evals, jacobian_evals, nonlinear_iterations, nonlinear_conv_failures,

@@ -32,6 +32,12 @@
 namespace flexmbd {
 namespace {
 
+/// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
+/// matrices, 72 MB and some 10 s per factorisation at 1,000 elements.
+constexpr long kMaxElements = 1000;
+/// Most elastic modes of a modal body (the same bound on its coordinates).
+constexpr long kMaxModes = 3000;
+
 using nlohmann::json;
 using namespace jsonread;
 
@@ -153,7 +159,7 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
       for (std::size_t k = 0; k < m.size(); ++k) o.modeSet.push_back(r.index(m[k], "modes[" + std::to_string(k) + "]"));
       if (o.modeSet.empty()) r.fail("key \"modes\" must list at least one mode");
     } else {
-      o.modes = static_cast<int>(r.integer("modes", 0, 1));
+      o.modes = static_cast<int>(r.integer("modes", 0, 1, kMaxModes));
     }
   }
   o.geometricStiffening = r.boolean("geometric_stiffening", false);
@@ -171,7 +177,7 @@ void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& s
     const ObjectReader b(r.object("beam"), r.where() + ": beam");
     b.allowOnly({"length", "elements", "origin"});
     const double length = b.positive("length");
-    const int n = static_cast<int>(b.integer("elements", 1, 1));
+    const int n = static_cast<int>(b.integer("elements", 1, 1, kMaxElements));
     mesh = located(b.where(), [&] { return BeamMesh2d::straight(length, n, section, b.vec2("origin", Vec2::Zero())); });
   } else {
     const MatX nodes = r.matrix("nodes");

@@ -77,7 +77,7 @@ void VtkWriter::write(const OutputSample& s) {
   std::snprintf(name, sizeof(name), "_%06ld.vtu", static_cast<long>(times_.size()));
   const std::filesystem::path path = dir_ / (prefix_ + name);
   std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  if (!out) throw OutputWriteError("cannot write '" + path.string() + "' at t = " + std::to_string(s.t));
   out.precision(12);
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << points.size() << "\" NumberOfCells=\"" << lines.size()
@@ -102,7 +102,12 @@ void VtkWriter::write(const OutputSample& s) {
          "format=\"ascii\">\n";
   for (const Vec2& d : displacement) out << d.x() << " " << d.y() << " 0\n";
   out << "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  out.close();
+  if (!out) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);  // no partial frame
+    throw OutputWriteError("cannot write '" + path.string() + "' at t = " + std::to_string(s.t) + " (disk full?)");
+  }
   times_.push_back(s.t);
   writeCollection();
 }

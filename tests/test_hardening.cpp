@@ -3,7 +3,9 @@
 // here failed before its fix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <csignal>
+#include <sstream>
 #include <string>
 
 #include "cli_fixture.hpp"
@@ -29,6 +31,18 @@ class Hardening : public Cli {
     return run(command + " " + shellQuote(scene.string()) + " --out " + shellQuote(out.string()) +
                (command == "run" ? " --quiet" : "") +
                (extra.empty() ? "" : " " + extra));
+  }
+  /// Runs `shell` (a command line where $F is the flexmbd binary) through bash -c.
+  CliResult runShell(const std::string& shell) const {
+    const fs::path out = dir_ / "cli_stdout.txt", err = dir_ / "cli_stderr.txt";
+    const std::string cmd = "F=" + shellQuote(FLEXMBD_CLI) + "; { " + shell + "; } >" + shellQuote(out.string()) +
+                            " 2>" + shellQuote(err.string());
+    const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
+    CliResult r;
+    r.status = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : -1;
+    r.out = readFile(out);
+    r.err = readFile(err);
+    return r;
   }
   fs::path writeText(const std::string& name, const std::string& text) const {
     const fs::path p = dir_ / name;
@@ -139,6 +153,184 @@ TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 2) << csv;  // header and the row at t = 0
   EXPECT_EQ(csv.find("inf"), std::string::npos);
   fs::remove_all(dir);
+}
+
+// ----- item 3: tolerances that cannot give a result; constraint violation warnings ------
+
+TEST_F(Hardening, MeaninglessTolerancesAreRefused) {
+  nlohmann::json j = exampleScene("slider_crank_elastic.json");
+  j["solver"]["atol"] = 1e6;  // was: ok after 18 steps, deflection 31x wrong, violation 1.87 m
+  CliResult r = runScene("run", writeScene("atol.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.atol"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("model size"), std::string::npos) << r.err;
+
+  j = example();
+  j["solver"]["rtol"] = 0.5;
+  r = runScene("run", writeScene("rtol.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("solver.rtol"), std::string::npos) << r.err;
+}
+
+TEST_F(Hardening, LargeConstraintViolationIsWarned) {
+  const fs::path out = dir_ / "out";
+  CliResult r = runScene("run", kExample, out);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;  // the example at its tolerances: no warning
+  EXPECT_TRUE(nlohmann::json::parse(readFile(out / "summary.json")).at("warnings").empty());
+
+  nlohmann::json j = example();
+  j["solver"]["atol"] = 1e-2;  // accepted (1/300 of the 3 m model) but coarse:
+  j["solver"]["rtol"] = 1e-2;  // violations of 0.025 m and 0.03 m/s were measured
+  r = runScene("run", writeScene("coarse.json", j), out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: position constraints violated by up to"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "ok");
+  EXPECT_GT(summary.at("max_position_violation").get<double>(), 1e-3 * summary.at("model_size").get<double>());
+  ASSERT_FALSE(summary.at("warnings").empty());
+  EXPECT_NE(summary.at("warnings")[0].get<std::string>().find("model size"), std::string::npos);
+}
+
+// ----- item 4: large moves of the consistent initialisation ----------------------------
+
+TEST_F(Hardening, LargeInitialCorrectionIsRecordedAndWarned) {
+  const fs::path out = dir_ / "out";
+  nlohmann::json j = example();
+  j["bodies"][0]["angle"] = 0.4;  // the crank's driver law starts at 0: moved 0.4 rad silently
+  const CliResult r = runScene("run", writeScene("moved.json", j), out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: initial position of body 'crank' corrected: crank.theta given 0.4, now"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("driver 'motor'"), std::string::npos) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  const auto& corrections = summary.at("initial_corrections");
+  ASSERT_FALSE(corrections.empty());
+  EXPECT_EQ(corrections[0].at("body"), "crank");
+  // The driver fixes the angle at 0: the correction is the 0.4 given, to round-off.
+  EXPECT_NEAR(corrections[0].at("angle").get<double>(), 0.4, 1e-12);
+  EXPECT_EQ(corrections[0].at("constraint"), "driver 'motor'");
+  EXPECT_EQ(summary.at("warnings").size(), 1u) << summary.at("warnings").dump();
+}
+
+// ----- item 6: output failures, signals, stale frames ---------------------------------
+
+/// Every line of a CSV file is complete: ends in a newline, as many fields as the header.
+::testing::AssertionResult WholeRows(const std::string& csv) {
+  if (csv.empty() || csv.back() != '\n') return ::testing::AssertionFailure() << "does not end in a newline";
+  std::istringstream in(csv);
+  std::string line;
+  long fields = -1, rows = 0;
+  while (std::getline(in, line)) {
+    const long n = std::count(line.begin(), line.end(), ',');
+    if (fields < 0) fields = n;
+    if (n != fields) return ::testing::AssertionFailure() << "row " << rows << " has " << n << " commas, header " << fields;
+    ++rows;
+  }
+  return ::testing::AssertionSuccess() << rows << " lines";
+}
+
+TEST_F(Hardening, FullDiskKeepsWholeRowsAndTheSummarySaysWhy) {
+  // A file size limit of 20 KB (ulimit -f, SIGXFSZ ignored) fails the writes of results.csv
+  // with EFBIG in the middle of the run, as a full disk fails them with ENOSPC.
+  const fs::path out = dir_ / "out";
+  const CliResult r = runShell("trap '' XFSZ; ulimit -f 20; exec \"$F\" run " + shellQuote(kExample) + " --out " +
+                               shellQuote(out.string()) + " --quiet");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("cannot write '" + (out / "results.csv").string() + "' at t = "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("summary.json.tmp"), std::string::npos) << r.err;
+  const std::string csv = readFile(out / "results.csv");
+  EXPECT_TRUE(WholeRows(csv));
+  EXPECT_GT(std::count(csv.begin(), csv.end(), '\n'), 10);  // the rows before the failure are kept
+  EXPECT_FALSE(fs::exists(out / "summary.json.tmp"));
+  ASSERT_TRUE(fs::exists(out / "summary.json"));
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  EXPECT_NE(summary.at("message").get<std::string>().find("results.csv"), std::string::npos) << summary.dump();
+}
+
+TEST_F(Hardening, FullDiskInKinematicsKeepsWholeRows) {
+  const fs::path out = dir_ / "out";
+  const CliResult r = runShell("trap '' XFSZ; ulimit -f 8; exec \"$F\" kinematics " +
+                               shellQuote(kSourceDir + "/examples/kinematics_slider_crank.json") + " --out " +
+                               shellQuote(out.string()));
+  EXPECT_EQ(r.status, 1);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("kinematics.csv' at alpha = "), std::string::npos) << r.err;
+  EXPECT_TRUE(WholeRows(readFile(out / "kinematics.csv")));
+  EXPECT_FALSE(fs::exists(out / "summary.json.tmp"));
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+}
+
+TEST_F(Hardening, SignalsEndTheRunWithAnInterruptedSummary) {
+  for (const auto& [signal, status] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
+    const fs::path out = dir_ / ("out_" + signal);
+    // 1e4 s of the driven crank: about 10 s of computing; the signal comes after 1 s.
+    const CliResult r = runShell("\"$F\" run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) +
+                                 " --quiet --t-end 10000 & pid=$!; sleep 1; kill -" + signal + " $pid; wait $pid");
+    EXPECT_EQ(r.status, status) << signal << ": " << r.err;
+    EXPECT_TRUE(IsOneErrorLine(r.err));
+    EXPECT_NE(r.err.find("interrupted by SIG" + signal), std::string::npos) << r.err;
+    EXPECT_TRUE(WholeRows(readFile(out / "results.csv")));
+    ASSERT_TRUE(fs::exists(out / "summary.json"));
+    const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+    EXPECT_EQ(summary.at("status"), "interrupted");
+    EXPECT_GT(summary.at("t_reached").get<double>(), 0.0);
+  }
+}
+
+TEST_F(Hardening, RerunIntoAnOldOutputFolderLeavesNoFramesOfTheOldModel) {
+  const fs::path out = dir_ / "out";
+  CliResult r = runScene("run", kExample, out, "--vtk");  // 61 frames
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ofstream(out / "vtk" / "notes.txt") << "the user's own file\n";
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 0.5;  // 6 frames of another run
+  r = runScene("run", writeScene("short.json", j), out, "--vtk");
+  ASSERT_EQ(r.status, 0) << r.err;
+  long frames = 0;
+  for (const auto& e : fs::directory_iterator(out / "vtk")) frames += e.path().extension() == ".vtu";
+  EXPECT_EQ(frames, 6);
+  EXPECT_TRUE(fs::exists(out / "vtk" / "notes.txt"));
+  r = runScene("run", writeScene("short.json", j), out);  // no --vtk: no frames at all
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(fs::exists(out / "vtk" / "bodies_000000.vtu"));
+  EXPECT_FALSE(fs::exists(out / "vtk" / "bodies.pvd"));
+}
+
+// ----- item 7: time spans the integrator cannot use are input errors, long runs run -----
+
+TEST_F(Hardening, UnresolvableTimeSpanIsAnInputError) {
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 1e-300;  // was IDA_ILL_INPUT, exit 1
+  CliResult r = runScene("run", writeScene("tiny.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.t_end"), std::string::npos) << r.err;
+
+  j["solver"]["t_end"] = 2147483648.0;  // 2^31 s at the example's output step: 2e10 rows
+  r = runScene("run", writeScene("rows.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("solver.output_step"), std::string::npos) << r.err;
+}
+
+TEST_F(Hardening, LongRunIsNotStoppedAtItsStartByTheDefaultMinStep) {
+  nlohmann::json j = example();
+  j["solver"]["t_end"] = 2147483648.0;  // 2^31 s: the default min_step was 2e-3 s, IDA failed at t = 0
+  j["solver"]["output_step"] = 2147483648.0 / 10;
+  j["solver"]["max_steps"] = 3000;  // the run is cut by this limit, after it got going
+  const CliResult r = runScene("run", writeScene("long.json", j), dir_ / "out");
+  EXPECT_EQ(r.status, 1) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(dir_ / "out" / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  // 3000 steps of the crank at 1 rad/s with rtol 1e-8 cover tens of seconds at least.
+  EXPECT_GT(summary.at("t_failure").get<double>(), 10.0) << summary.dump();
+  EXPECT_NE(r.err.find("IDA_TOO_MUCH_WORK"), std::string::npos) << r.err;
 }
 
 }  // namespace
