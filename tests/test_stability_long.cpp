@@ -25,8 +25,10 @@ constexpr int kRevolutions = 1000;
 struct LongRun {
   SimulationSummary summary;
   double seconds = 0;
-  /// max |g| and |G v - f'| over the first and the last 10 % of the revolutions
+  /// root mean square of |g| and |G v - f'| over the first and the last 10 % of the
+  /// revolutions (sums of squares and counts while running)
   double earlyG = 0, lateG = 0, earlyGv = 0, lateGv = 0;
+  long earlyN = 0, lateN = 0;
   double sliderError = 0;       ///< max |x - x_rigid| / l2 (rigid run only)
   double imbalance = 0;         ///< max_t |W(t) - (E(t) - E(0))| (Simpson, all outputs)
   double imbalanceHalf = 0;     ///< the same from every other output (Simpson error estimate)
@@ -76,17 +78,21 @@ LongRun runLong(Scene& s, double speed, int perRev, bool rigidReference) {
     const double gv = velocityConstraintResidual(sys, o.q, o.v, o.t).lpNorm<Eigen::Infinity>();
     const double rev = o.t / T;
     if (rev <= 0.1 * kRevolutions) {
-      r.earlyG = std::max(r.earlyG, gi);
-      r.earlyGv = std::max(r.earlyGv, gv);
+      r.earlyG += gi * gi;
+      r.earlyGv += gv * gv;
+      ++r.earlyN;
     } else if (rev >= 0.9 * kRevolutions) {
-      r.lateG = std::max(r.lateG, gi);
-      r.lateGv = std::max(r.lateGv, gv);
+      r.lateG += gi * gi;
+      r.lateGv += gv * gv;
+      ++r.lateN;
     }
     if (rigidReference) {
       const double exact = reference::sliderCrank(1.0, 2.0, speed * o.t, speed).x;
       r.sliderError = std::max(r.sliderError, std::abs(o.q[xs] - exact) / 2.0);
     }
   });
+  for (double* x : {&r.earlyG, &r.earlyGv}) *x = std::sqrt(*x / std::max(r.earlyN, 1L));
+  for (double* x : {&r.lateG, &r.lateGv}) *x = std::sqrt(*x / std::max(r.lateN, 1L));
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   simpsonBalance(t, P, E, 1, r.imbalance, r.throughput);
   double dummy = 0;
@@ -96,7 +102,7 @@ LongRun runLong(Scene& s, double speed, int perRev, bool rigidReference) {
 }
 
 void print(const char* what, const LongRun& r) {
-  std::printf("[ measured ] %s, %d revolutions: %ld steps (%.1f per revolution), %.1f s; |g| max %.2e (first 10 %% "
+  std::printf("[ measured ] %s, %d revolutions: %ld steps (%.1f per revolution), %.1f s; |g| max %.2e (rms first 10 %% "
               "%.2e, last 10 %% %.2e), |G v - f'| max %.2e (%.2e, %.2e); energy imbalance %.3e J = %.2e of the "
               "throughput %.4e J (%.2e per revolution; Simpson at half the outputs: %.2e); slider error %.2e\n",
               what, kRevolutions, r.summary.stats.steps, double(r.summary.stats.steps) / kRevolutions, r.seconds,
@@ -109,9 +115,14 @@ void print(const char* what, const LongRun& r) {
 /// g = 0 and G v = f' to IDA's Newton tolerance, a fraction of the local error tolerance
 /// (20 revolutions of the rigid slider-crank: 1.5 rtol, docs/formulations.md).
 constexpr double kOnManifoldPerRtol = 5.0;
-/// Drift must not grow: the residuals over the last 10 % of the revolutions may differ
-/// from those of the first 10 % only by the scatter of the Newton residual (factor 2).
-constexpr double kNoGrowth = 2.0;
+/// Drift must not grow. A drift growing linearly in time would make the root mean
+/// square residual of the last 10 % of the revolutions 19 times that of the first 10 %
+/// (ratio of the windows' mid-times, 950 / 50); the Newton-limited level of GGL only
+/// scatters with the state (measured: 1.0 rigid, 2.1 for |g| of the modal run, whose
+/// elastic amplitude settles over the first revolutions). Bound 4: well below growth,
+/// above the scatter. Root mean squares, not maxima: a single Newton iterate stopped near
+/// its tolerance sets a window's maximum.
+constexpr double kNoGrowth = 4.0;
 
 void expectBoundedDrift(const LongRun& r, double rtol, double lengthScale, double speedScale) {
   EXPECT_LT(r.summary.maxPositionViolation, kOnManifoldPerRtol * rtol * lengthScale);
