@@ -34,8 +34,8 @@ void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2
   const int n = static_cast<int>(M.rows()), m = static_cast<int>(G.rows());
   VecX rhs(n + m), sol;
   rhs << r1, r2;
-  const char* singular =
-      "the augmented system [M G^T; G 0] is singular: constraints are redundant or a body has no mass";
+  // The cause is named by the callers, from what they measured (computeAccelerations).
+  const char* singular = "the augmented system [M G^T; G 0] is singular";
   if (n + m <= kDenseAugmentedLimit) {
     MatX A = MatX::Zero(n + m, n + m);
     A.topLeftCorner(n, n) = M;
@@ -96,7 +96,12 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
   try {
     solveAugmented(M, G, generalizedForces(sys, t, q, v), accelerationConstraintRhs(sys, q, v, t), a, lambda);
   } catch (const ModelError& e) {
-    throw ModelError(e.what() + massDiagonalReport(sys, M));
+    const std::vector<int> rows = dependentRows(G);
+    std::string rank;
+    for (size_t k = 0; k < rows.size(); ++k) rank += (k ? "; " : "") + sys.describeEquation(rows[k]);
+    throw ModelError(e.what() + massDiagonalReport(sys, M) +
+                     (rows.empty() ? std::string("; the constraint Jacobian has full rank")
+                                   : "; dependent constraint rows: " + rank));
   }
 }
 
