@@ -128,22 +128,6 @@ VecX DaeSystem::differentialIds() const {
   VecX id = VecX::Zero(layout_.size);
   id.segment(layout_.q, layout_.nq).setOnes();
   if (formulation_ != Formulation::Index3) id.segment(layout_.v, layout_.nq).setOnes();
-  if (formulation_ == Formulation::Ggl) {
-    // Elastic velocities of damped bodies: out of the error test (docs/formulations.md,
-    // "BDF order and damped elastic modes"). Their damping makes them follow the forces
-    // algebraically, the joint reactions (index-2 multipliers) included, whose first-order
-    // error at a step-size change they then carry without the factor h; their positions
-    // stay error-controlled.
-    for (int b = 0; b < sys_.numBodies(); ++b) {
-      const Body& body = sys_.body(BodyIndex(b));
-      if (!body.isDissipative()) continue;
-      const std::vector<CoordinateKind> kinds = body.coordinateKinds();
-      const int offset = sys_.coordinateOffset(BodyIndex(b));
-      for (size_t k = 0; k < kinds.size(); ++k) {
-        if (kinds[k] == CoordinateKind::Elastic) id[layout_.v + offset + static_cast<int>(k)] = 0.0;
-      }
-    }
-  }
   return id;
 }
 
