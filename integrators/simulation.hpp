@@ -79,6 +79,8 @@ struct SimulationSummary {
   double maxVelocityViolation = 0.0;  ///< max over outputs of max |G v + g_t|
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   bool usedKlu = false;
+  int maxOrder = 5;              ///< highest BDF order IDA was allowed (settings, stability limit)
+  std::string orderLimit;        ///< why it is below the settings' max_order ("" if it is not)
   int initialPositionIterations = 0;
   double modelSize = 1.0;        ///< System::characteristicLength(): the scale of the warnings
   std::vector<InitialCorrection> initialCorrections;  ///< bodies the initialisation moved

@@ -7,21 +7,32 @@ namespace flexmbd {
 
 struct StaticEquilibriumOptions {
   double tolerance = 1e-10;   ///< on max |correction of q| relative to (1 + max |q|)
-  int maxIterations = 50;
+  int maxIterations = 50;     ///< Newton iterations per load increment
+  /// Load increments (tried ones, failed ones included) before giving up.
+  int maxIncrements = 64;
+  /// Smallest load increment, as a fraction of the whole load, before giving up.
+  double minIncrement = 1.0 / 4096;
 };
 
 struct StaticEquilibrium {
   VecX q, lambda;
-  int iterations = 0;
+  int iterations = 0;               ///< Newton iterations, all increments
+  int increments = 0;               ///< converged load increments (1: the load in one solve)
   double forceResidual = 0.0;       ///< max |Q - G^T lambda| at the solution
   double constraintResidual = 0.0;  ///< max |g|
 };
 
-/// Newton iterations on [ -Q(t, q, 0) + G^T lambda ; g(q, t) ] = 0 from q0, with the
-/// tangent [ -dQ/dq + sum lambda_a H_a , G^T ; G , 0 ] assembled by the same code as the
-/// integrator's Jacobian (DaeSystem, at v = v' = 0), and a backtracking line search.
-/// @throws ModelError if it does not converge (reports the residuals) or the tangent
-/// is singular (an unstable or unconstrained configuration).
+/// Newton iterations on r(x) = [ -Q(t, q, 0) + G^T lambda ; g(q, t) ] = 0 from x0 =
+/// [q0, 0], with the tangent [ -dQ/dq + sum lambda_a H_a , G^T ; G , 0 ] assembled by
+/// the same code as the integrator's Jacobian (DaeSystem, at v = v' = 0), and a
+/// backtracking line search. Load stepping: the whole load is tried first; if Newton
+/// fails, the residual r(x0) (the unbalanced load at the start) is applied in
+/// increments: r(x) - (1 - s) r(x0) = 0 for s rising to 1 (Newton homotopy; for an
+/// unstressed start, f_int(q) - s f_ext), the increment halved after a failure and
+/// doubled after a convergence in few iterations.
+/// @throws ModelError if it does not converge (names the load fraction reached, the
+/// increment and the residuals) or the tangent is singular (an unstable or unconstrained
+/// configuration).
 StaticEquilibrium solveStaticEquilibrium(const System& sys, double t, const VecX& q0,
                                          const StaticEquilibriumOptions& options = {});
 

@@ -300,6 +300,8 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["energy_end"] = summary.energyEnd ? numberOrNull(*summary.energyEnd) : nlohmann::ordered_json(nullptr);
   j["formulation"] = toString(s.formulation);
   j["linear_solver"] = summary.usedKlu ? "klu" : "dense";
+  j["max_order"] = summary.maxOrder;
+  j["order_limit"] = summary.orderLimit.empty() ? nlohmann::json() : nlohmann::json(summary.orderLimit);
   j["rtol"] = s.rtol;
   j["atol"] = s.atol;
   j["atol_velocity"] = s.atolVelocity ? *s.atolVelocity : s.atol;
