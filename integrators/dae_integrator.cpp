@@ -1,6 +1,8 @@
 #include "integrators/dae_integrator.hpp"
 
 #include "core/errors.hpp"
+#include "core/dae_system.hpp"
+#include "integrators/augmented_lagrangian_integrator.hpp"
 #include "integrators/ida_solver.hpp"
 #include "integrators/radau5_solver.hpp"
 
@@ -27,6 +29,7 @@ std::string toString(IntegratorKind k) {
   switch (k) {
     case IntegratorKind::Ida: return "ida";
     case IntegratorKind::Radau5: return "radau5";
+    case IntegratorKind::AugmentedLagrangian: return "ali3p";
   }
   return "?";
 }
@@ -34,7 +37,8 @@ std::string toString(IntegratorKind k) {
 IntegratorKind parseIntegrator(const std::string& name) {
   if (name == "ida") return IntegratorKind::Ida;
   if (name == "radau5") return IntegratorKind::Radau5;
-  throw InputError("solver.integrator: unknown integrator '" + name + "' (expected one of: ida, radau5)");
+  if (name == "ali3p") return IntegratorKind::AugmentedLagrangian;
+  throw InputError("solver.integrator: unknown integrator '" + name + "' (expected one of: ida, radau5, ali3p)");
 }
 
 std::unique_ptr<DaeIntegrator> makeIntegrator(IntegratorKind kind, const DaeProblem& dae, double t0,
@@ -42,6 +46,11 @@ std::unique_ptr<DaeIntegrator> makeIntegrator(IntegratorKind kind, const DaeProb
   switch (kind) {
     case IntegratorKind::Ida: return std::make_unique<IdaSolver>(dae, t0, y0, yp0, options);
     case IntegratorKind::Radau5: return std::make_unique<Radau5Solver>(dae, t0, y0, yp0, options);
+    case IntegratorKind::AugmentedLagrangian: {
+      const auto* model = dynamic_cast<const DaeSystem*>(&dae);
+      if (!model) throw InputError("solver.integrator: ali3p integrates the engine's own models only");
+      return std::make_unique<AugmentedLagrangianSolver>(*model, t0, y0, yp0, options);
+    }
   }
   throw InputError("solver.integrator: unknown integrator kind");
 }

@@ -49,9 +49,12 @@ struct IntegratorStats {
 enum class IntegratorKind {
   Ida,     ///< SUNDIALS IDA: variable-order BDF (orders 1..5)
   Radau5,  ///< Radau IIA of order 5, three stages (integrators/radau5_solver.hpp)
+  /// Index-3 augmented Lagrangian with projections, trapezoidal rule (order 2), stays
+  /// regular at singular positions (integrators/augmented_lagrangian_integrator.hpp)
+  AugmentedLagrangian,
 };
 std::string toString(IntegratorKind k);
-/// "ida", "radau5". @throws InputError otherwise.
+/// "ida", "radau5", "ali3p". @throws InputError otherwise.
 IntegratorKind parseIntegrator(const std::string& name);
 
 /// A DAE integrator started from consistent y0, y0' at t0.
@@ -66,6 +69,12 @@ class DaeIntegrator {
   virtual const VecX& yp() const = 0;
   virtual IntegratorStats stats() const = 0;
   virtual bool usesKlu() const = 0;
+  /// After advance() threw SolverError: the solution y at the error's time (the last step
+  /// completed), if the integrator keeps it; false if not. A restart can begin there.
+  virtual bool solutionAtFailure(VecX& y) const {
+    (void)y;
+    return false;
+  }
 };
 
 /// The integrator of the given kind. @throws InputError on bad options, SolverError if

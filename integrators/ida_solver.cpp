@@ -198,6 +198,8 @@ double IdaSolver::advance(double tout, double tStop) {
     } else if (!d.lastIdaMessage.empty()) {
       os << " (" << d.lastIdaMessage << ")";
     }
+    // IDASolve returns the solution at its last successful step (tret = tn) on failures
+    failureState_ = Eigen::Map<const VecX>(N_VGetArrayPointer(d.yy), n);
     throw SolverError(os.str(), tcur, h);
   }
   y_ = Eigen::Map<const VecX>(N_VGetArrayPointer(d.yy), n);

@@ -28,11 +28,16 @@ class IdaSolver final : public DaeIntegrator {
   const VecX& yp() const override { return yp_; }
   IntegratorStats stats() const override;
   bool usesKlu() const override { return usesKlu_; }
+  bool solutionAtFailure(VecX& y) const override {
+    if (failureState_.size() == 0) return false;
+    y = failureState_;
+    return true;
+  }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  VecX y_, yp_;
+  VecX y_, yp_, failureState_;
   bool usesKlu_ = false;
 };
 

@@ -14,6 +14,7 @@
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
+#include "integrators/augmented_lagrangian_integrator.hpp"
 #include "integrators/bdf_stability.hpp"
 #include "integrators/initial_conditions.hpp"
 
@@ -87,9 +88,38 @@ double constraintConditioning(const MatX& G) {
 /// slider-crank made to fail at a regular position stays at 0.3-1x its start.
 constexpr double kApproachingSingular = 0.1;
 
-std::string singularityDiagnosis(const System& sys, const OutputSample& last, double tFail, double startRatio) {
+/// Where the DAE integrator stops with the constraint Jacobian G worse conditioned than
+/// kCrossingTrigger times at the start, the failure is taken for the approach of a singular
+/// position and crossed. Measured on the undriven parallelogram: IDA stops at a singular
+/// value ratio of 2e-3 (rtol 1e-8) to 0.33 (rtol 1e-12) of its value at the start.
+constexpr double kCrossingTrigger = 0.5;
+/// A crossing ends past the failure, where the ratio has grown back to kCrossingEndFactor
+/// times its value where it began (at most kCrossingEndConditioning of the start's): IDA
+/// fails where the ratio is so small for its tolerance, so it restarts well above that.
+constexpr double kCrossingEndFactor = 4.0, kCrossingEndConditioning = 0.9;
+/// Tolerances of a crossing relative to the run's: ALI3-P is of order 2 against IDA's 5, so
+/// its local errors are held smaller for global errors of the same size.
+constexpr double kCrossingToleranceFactor = 1e-2;
+/// ... but not below rtol 1e-12: at 1e-14 the error estimate h^2/12 (a_{n+1} - a_n) is
+/// round-off near the singular position (accelerations along the nearly dependent
+/// direction are determined to 1/sigma_min) and the steps collapse (measured).
+constexpr double kMinCrossingRtol = 1e-12;
+/// An integrator that fails within this many steps of its restart after a crossing has not
+/// left the singular position's neighbourhood: the crossing goes on, to twice the ratio.
+constexpr long kRestartSteps = 50;
+
+/// What singularityDiagnosis measured: the message, and whether it found the mechanism at
+/// or approaching a singular position (the cases the augmented-Lagrangian bridge crosses).
+struct SingularityDiagnosis {
+  std::string text;
+  bool singular = false;
+  double ratio = 1.0;  ///< smallest/largest singular value of G at the failure
+};
+
+SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample& last, double tFail,
+                                          double startRatio) {
   const int m = sys.numConstraintEquations();
-  if (m == 0 || last.q.size() == 0 || m > sys.numCoordinates()) return "";
+  if (m == 0 || last.q.size() == 0 || m > sys.numCoordinates()) return {};
   const double dt = tFail - last.t;
   VecX q = last.q + dt * last.v + 0.5 * dt * dt * last.a;
   VecX g;
@@ -106,7 +136,7 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
     g = gn;
     G = Gn;
   }
-  if (!G.allFinite()) return "";
+  if (!G.allFinite()) return {};
   const VecX sv = Eigen::JacobiSVD<MatX>(G).singularValues();
   const double ratio = sv.size() > 0 && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
   const std::vector<int> rows = dependentRows(G, kNearlyDependent);
@@ -120,10 +150,10 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
     if (ratio < kApproachingSingular * startRatio) {
       os << ", full rank but " << startRatio / ratio
          << " times worse conditioned than at the start: the mechanism is approaching a singular position";
-    } else {
-      os << ", full rank and conditioned as at the start: not a singular position";
+      return {os.str(), true, ratio};
     }
-    return os.str();
+    os << ", full rank and conditioned as at the start: not a singular position";
+    return {os.str(), false, ratio};
   }
   os << ", nearly rank-deficient: ";
   for (size_t k = 0; k < rows.size(); ++k) os << (k ? "; " : "") << sys.describeEquation(rows[k]);
@@ -133,7 +163,26 @@ std::string singularityDiagnosis(const System& sys, const OutputSample& last, do
                   "the motion"
                 : "a singular position of the undriven mechanism (change point or dead centre), where the "
                   "constraints lose rank");
-  return os.str();
+  return {os.str(), true, ratio};
+}
+
+/// A crossing of a singular position that failed: the integrator's reason, the diagnosis
+/// and why the augmented-Lagrangian bridge could not cross either.
+struct CrossingFailure : SolverError {
+  using SolverError::SolverError;
+};
+
+/// Counts of `more` added to `total`; the last step size and time are those of `more`.
+void addStats(IntegratorStats& total, const IntegratorStats& more) {
+  total.steps += more.steps;
+  total.residualEvals += more.residualEvals;
+  total.jacobianEvals += more.jacobianEvals;
+  total.nonlinearIterations += more.nonlinearIterations;
+  total.nonlinearConvFailures += more.nonlinearConvFailures;
+  total.errorTestFailures += more.errorTestFailures;
+  total.linearSetups += more.linearSetups;
+  total.lastStepSize = more.lastStepSize;
+  total.currentTime = more.currentTime;
 }
 
 /// A state whose position coordinates exceed this multiple of the model size has
@@ -370,18 +419,17 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     startRatio = constraintConditioning(G0);
   }
   double tOutput = t0;  // the output being evaluated
-  auto emit = [&](double t, const VecX& y, const VecX& yp) {
+  auto emit = [&](double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v) {
     tOutput = t;
     OutputSample s;
     s.t = t;
-    s.q = y.segment(L.q, L.nq);
-    s.v = y.segment(L.v, L.nq);
+    s.q = q;
+    s.v = v;
     for (int k = 0; k < L.nq; ++k) {
       if (kinds[k] != CoordinateKind::Angle) largestCoordinate = std::max(largestCoordinate, std::fabs(s.q[k]));
     }
     // Accelerations and multipliers recomputed from the state (q, v): as accurate as the
     // state itself, unlike the interpolated y' (docs/formulations.md).
-    (void)yp;
     computeAccelerations(sys, t, s.q, s.v, s.a, s.lambda);
     for (int k = 0; k < L.nq; ++k) {
       maxSpeed = std::max(maxSpeed, std::fabs(s.v[k]) * (kinds[k] == CoordinateKind::Angle ? modelSize : 1.0));
@@ -407,7 +455,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     last = std::move(s);
   };
   try {
-    emit(t0, y0, yp0);
+    emit(t0, y0.segment(L.q, L.nq), y0.segment(L.v, L.nq));
   } catch (const NonFiniteResult& e) {
     // Nothing was integrated: the scene's own values overflow (masses, speeds, loads).
     throw InputError(std::string("the initial state has ") + e.what() +
@@ -444,20 +492,118 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.minStepSize = settings.minStepSize.value_or(defaultMinStepSize(settings));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
-  const std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(settings.integrator, dae, t0, y0, yp0, o);
-  DaeIntegrator& ida = *integrator;
-  summary.usedKlu = ida.usesKlu();
+  std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(settings.integrator, dae, t0, y0, yp0, o);
+  summary.usedKlu = integrator->usesKlu();
+  IntegratorStats finished;  // statistics of the integrators a crossing replaced, and of the crossings
 
   ProgressReporter progress(settings.progress, t0, tEnd);
   // Output times t0 + k dt; the last one is exactly t_end (IDASetStopTime).
   const long nOut = std::max(1L, static_cast<long>(std::ceil((tEnd - t0) / settings.outputStep - 1e-9)));
-  try {
-    for (long k = 1; k <= nOut; ++k) {
-      const double tout = (k == nOut) ? tEnd : std::min(tEnd, t0 + k * settings.outputStep);
-      const double t = ida.advance(tout, tEnd);
-      emit(t, ida.y(), ida.yp());
-      progress.update(t, ida.stats().steps);
+  const auto outputTime = [&](long k) { return k == nOut ? tEnd : std::min(tEnd, t0 + k * settings.outputStep); };
+  long k = 1;  // the next output
+  const auto totalSteps = [&] { return finished.steps + (integrator ? integrator->stats().steps : 0); };
+
+  // Across a singular position where the integrator stopped: ALI3-P from the last output
+  // (whose constraint Jacobian is still regular) past the failure, until G is conditioned
+  // again as at kApproachingSingular of the start; then the integrator restarts from a
+  // consistent state there. Returns the time reached. @throws CrossingFailure.
+  const auto crossSingularPosition = [&](const SolverError& failure, const std::string& diagnosis,
+                                         const OutputSample& start, double endFactor) {
+    SingularCrossing crossing;
+    crossing.tFailure = failure.time();
+    crossing.tStart = start.t;
+    AugmentedLagrangianOptions bo;
+    const double factor = std::max(kCrossingToleranceFactor, kMinCrossingRtol / settings.rtol);
+    bo.rtol = settings.rtol * factor;
+    bo.atolPosition = factor * o.atol.segment(L.q, L.nq);
+    bo.maxStepSize = settings.maxStepSize;
+    bo.minStepSize = o.minStepSize;
+    bo.lengthScale = modelSize;
+    AugmentedLagrangianIntegrator ali(sys, start.t, start.q, start.v, start.a, start.lambda, bo);
+    const double endRatio =
+        std::min(endFactor * ali.constraintConditioning(), kCrossingEndConditioning * startRatio);
+    VecX qi, vi;
+    try {
+      for (long steps = 0;; ++steps) {
+        if (steps >= settings.maxSteps) {
+          throw SolverError("more than max_steps = " + std::to_string(settings.maxSteps) + " steps", ali.time(),
+                            ali.stats().lastStepSize);
+        }
+        const double t = ali.step(tEnd);
+        for (; k <= nOut && outputTime(k) <= t; ++k) {
+          ali.interpolate(outputTime(k), qi, vi);
+          emit(outputTime(k), qi, vi);
+          progress.update(outputTime(k), totalSteps() + ali.stats().steps);
+        }
+        if (t >= tEnd) break;
+        if (t > failure.time() && ali.constraintConditioning() >= endRatio) break;
+      }
+    } catch (const SolverError& e) {
+      addStats(finished, ali.stats());
+      throw CrossingFailure(std::string(failure.what()) + diagnosis +
+                                "; crossing it with the augmented Lagrangian integrator (ali3p) from t = " +
+                                fmtTime(start.t) + " failed too: " + e.what(),
+                            std::max(failure.time(), e.time()), e.stepSize());
     }
+    crossing.tEnd = ali.time();
+    crossing.steps = ali.stats().steps;
+    summary.singularCrossings.push_back(crossing);
+    addStats(finished, ali.stats());
+    if (ali.time() < tEnd) {
+      const ConsistentState cs = computeConsistentState(sys, ali.time(), ali.q(), ali.v());
+      VecX y, yp;
+      dae.packState(cs.q, cs.v, cs.a, cs.lambda, y, yp);
+      integrator = makeIntegrator(settings.integrator, dae, ali.time(), y, yp, o);
+    }
+  };
+  // The state a crossing starts from: the integrator's last step before its failure if it
+  // keeps it (and the accelerations can be computed there), else the last output.
+  const auto crossingStart = [&](const SolverError& failure) {
+    VecX yf;
+    if (integrator->solutionAtFailure(yf) && failure.time() > last.t) {
+      OutputSample s;
+      s.t = failure.time();
+      s.q = yf.segment(L.q, L.nq);
+      s.v = yf.segment(L.v, L.nq);
+      try {
+        computeAccelerations(sys, s.t, s.q, s.v, s.a, s.lambda);
+        if (s.q.allFinite() && s.v.allFinite() && s.a.allFinite() && s.lambda.allFinite()) return s;
+      } catch (const std::exception&) {
+      }
+    }
+    return last;
+  };
+  const bool mayCross = settings.crossSingular && settings.integrator != IntegratorKind::AugmentedLagrangian && L.m > 0;
+  int restarts = 0;  // consecutive failures just after a crossing
+  try {
+    while (k <= nOut) {
+      try {
+        for (; k <= nOut; ++k) {
+          const double t = integrator->advance(outputTime(k), tEnd);
+          emit(t, integrator->y().segment(L.q, L.nq), integrator->y().segment(L.v, L.nq));
+          progress.update(t, totalSteps());
+        }
+      } catch (const SolverError& e) {
+        if (!mayCross || largestCoordinate > kDivergedSize * modelSize) throw;
+        SingularityDiagnosis d;
+        try {
+          d = singularityDiagnosis(sys, last, e.time(), startRatio);
+        } catch (const std::exception&) {
+        }
+        // a failure just after a crossing is part of it (the restart was too close to the singular position)
+        const bool justRestarted = !summary.singularCrossings.empty() && integrator->stats().steps < kRestartSteps;
+        if (!d.singular && d.ratio >= kCrossingTrigger * startRatio && !justRestarted) throw;
+        restarts = justRestarted ? restarts + 1 : 0;
+        const OutputSample start = crossingStart(e);
+        addStats(finished, integrator->stats());
+        integrator.reset();
+        crossSingularPosition(e, d.text, start, kCrossingEndFactor * std::pow(2.0, restarts));
+      }
+    }
+  } catch (const CrossingFailure& e) {
+    summary.ok = false;
+    summary.message = e.what();
+    summary.failureTime = e.time();
   } catch (const SolverError& e) {
     summary.ok = false;
     summary.message = e.what();
@@ -465,7 +611,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     try {
       summary.message += divergenceReport(largestCoordinate, modelSize, tOutput);
       if (!(largestCoordinate > kDivergedSize * modelSize)) {
-        summary.message += singularityDiagnosis(sys, last, summary.failureTime, startRatio);
+        summary.message += singularityDiagnosis(sys, last, summary.failureTime, startRatio).text;
       }
     } catch (const std::exception&) {
       // the diagnosis is optional: IDA's reason stays the message
@@ -490,17 +636,18 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     // where the augmented matrix for the accelerations is singular): a failure of the
     // run, reported like a solver failure
     summary.ok = false;
-    summary.failureTime = ida.stats().currentTime;
+    summary.failureTime = integrator ? integrator->stats().currentTime : tOutput;
     summary.message = "evaluating the outputs at t = " + std::to_string(tOutput) + " failed: " + e.what();
     try {
       summary.message += divergenceReport(largestCoordinate, modelSize, tOutput);
       if (!(largestCoordinate > kDivergedSize * modelSize)) {
-        summary.message += singularityDiagnosis(sys, last, tOutput, startRatio);
+        summary.message += singularityDiagnosis(sys, last, tOutput, startRatio).text;
       }
     } catch (const std::exception&) {
     }
   }
-  summary.stats = ida.stats();
+  summary.stats = finished;
+  if (integrator) addStats(summary.stats, integrator->stats());
   const double velocityScale = std::max(maxSpeed, modelSize / (tEnd - t0));
   if (summary.maxPositionViolation > kWarnFraction * modelSize) {
     summary.warnings.push_back("position constraints violated by up to " + num(summary.maxPositionViolation) +

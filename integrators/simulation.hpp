@@ -41,6 +41,10 @@ struct SolverSettings {
   LinearSolverKind linearSolver = LinearSolverKind::Automatic;
   bool finiteDifferenceJacobian = false;
   bool progress = true;           ///< progress on stderr for long runs (if a terminal)
+  /// Where IDA or Radau stop at a singular position of the mechanism (the constraint
+  /// Jacobian loses rank: change points, dead centres), cross it with the augmented
+  /// Lagrangian integrator (ALI3-P) and restart after it. Off: such a run stops there.
+  bool crossSingular = true;
   /// @throws InputError naming the solver key that is out of range.
   void validate() const;
 };
@@ -68,6 +72,14 @@ struct InitialCorrection {
   double residual = 0.0;   ///< its largest |g| at the given values
 };
 
+/// A singular position crossed by the augmented Lagrangian integrator.
+struct SingularCrossing {
+  double tFailure = 0.0;  ///< where the DAE integrator stopped
+  double tStart = 0.0;    ///< the output the crossing started from
+  double tEnd = 0.0;      ///< where the DAE integrator restarted (conditioning regained)
+  long steps = 0;         ///< ALI3-P steps of the crossing
+};
+
 struct SimulationSummary {
   bool ok = true;
   std::string message;
@@ -89,6 +101,8 @@ struct SimulationSummary {
   std::vector<std::string> warnings;
   int interruptedBySignal = 0;   ///< the signal that stopped the run (RunInterrupted), or 0
   bool outputFailed = false;     ///< the run stopped because its results could not be written
+  /// Singular positions crossed (crossSingular); their steps are counted in `stats` too.
+  std::vector<SingularCrossing> singularCrossings;
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run

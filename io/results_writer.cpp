@@ -298,7 +298,13 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["warnings"] = summary.warnings;
   j["energy_start"] = summary.energyStart ? numberOrNull(*summary.energyStart) : nlohmann::ordered_json(nullptr);
   j["energy_end"] = summary.energyEnd ? numberOrNull(*summary.energyEnd) : nlohmann::ordered_json(nullptr);
+  nlohmann::ordered_json crossings = nlohmann::ordered_json::array();
+  for (const SingularCrossing& c : summary.singularCrossings) {
+    crossings.push_back({{"t_failure", c.tFailure}, {"t_start", c.tStart}, {"t_end", c.tEnd}, {"steps", c.steps}});
+  }
+  j["singular_crossings"] = crossings;
   j["formulation"] = toString(s.formulation);
+  j["integrator"] = toString(s.integrator);
   j["linear_solver"] = summary.usedKlu ? "klu" : "dense";
   j["max_order"] = summary.maxOrder;
   j["order_limit"] = summary.orderLimit.empty() ? nlohmann::json() : nlohmann::json(summary.orderLimit);

@@ -446,14 +446,14 @@ SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
   r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
                "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian", "integrator", "atol_angle",
-               "atol_elastic"});
+               "atol_elastic", "cross_singular"});
   SolverSettings s;
   if (r.has("integrator")) {
     const std::string name = r.string("integrator");
     try {
       s.integrator = parseIntegrator(name);
     } catch (const InputError&) {
-      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: ida, radau5)");
+      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: ida, radau5, ali3p)");
     }
   }
   if (r.has("formulation")) {
@@ -486,6 +486,7 @@ SolverSettings parseSolver(const json& j) {
   s.maxOrder = static_cast<int>(r.integer("max_order", s.maxOrder, 1));
   s.initialStepSize = r.number("initial_step", s.initialStepSize);
   s.finiteDifferenceJacobian = r.boolean("fd_jacobian", s.finiteDifferenceJacobian);
+  s.crossSingular = r.boolean("cross_singular", s.crossSingular);
   checkSolverSettings(s);
   return s;
 }

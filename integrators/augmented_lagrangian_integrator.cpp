@@ -1,0 +1,368 @@
+#include "integrators/augmented_lagrangian_integrator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <limits>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
+#include "core/errors.hpp"
+#include "core/system_evaluation.hpp"
+
+namespace flexmbd {
+namespace {
+
+/// Penalty factor alpha relative to the inertia of a step: alpha G^T G ~ kPenalty (4/h^2) M.
+/// The multiplier iteration lambda* += alpha g reduces a violation in a well-conditioned
+/// constraint direction by ~1/kPenalty per Newton iteration, while the Newton matrix loses
+/// ~log10(kPenalty) = 6 of its 16 digits: enough for rtol down to 1e-10.
+constexpr double kPenalty = 1e6;
+/// Newton on the positions has converged when the correction is below this fraction of
+/// the error weights (the step's local error is 1 in these units).
+constexpr double kNewtonTolerance = 1e-3;
+constexpr int kMaxNewtonIterations = 10;
+/// Convergence where the multiplier iteration stalls on a nearly dependent constraint: the
+/// violation below kConstraintTolerance of the smallest error weight, the last correction
+/// below kSingularNewtonTolerance of the weights (the step's local error is 1 in them).
+constexpr double kConstraintTolerance = 1e-2, kSingularNewtonTolerance = 0.5;
+/// Round-off levels, in units of epsilon (|q| + model size): a constraint violation below
+/// kRoundOffViolation is not fed into the multipliers, a Newton correction below
+/// kRoundOffCorrection ends the iteration (tight atol can ask for less than round-off).
+constexpr double kRoundOffViolation = 100.0, kRoundOffCorrection = 1000.0;
+/// Velocity and acceleration projections: at most this many passes (one reaches ~1/kPenalty).
+constexpr int kProjectionPasses = 2;
+/// Step size controller for the local error est ~ h^3 (order 2 method): safety factor,
+/// largest growth and shrink factors per step (Hairer, Norsett & Wanner I, II.4).
+constexpr double kSafety = 0.9, kMaxGrowth = 2.0, kMinShrink = 0.2, kMinShrinkRejected = 0.1;
+/// An error estimate above 1 that stays above kArtifactPersistence of its value after the
+/// step shrank kArtifactShrink times does not scale as h^3: it is accepted if below
+/// kMaxArtifactError (measured at the rank-2 change point of a multi-parallelogram: 4.4
+/// for every step from 1e-5 down to 1e-12 s).
+constexpr double kArtifactShrink = 4.0, kArtifactPersistence = 0.5, kMaxArtifactError = 100.0;
+/// A step whose Newton iteration fails is retried with this fraction of its size.
+constexpr double kNewtonFailureShrink = 0.25;
+
+double wrms(const VecX& x, const VecX& w) {
+  return std::sqrt((x.array() / w.array()).square().mean());
+}
+
+}  // namespace
+
+struct AugmentedLagrangianIntegrator::Impl {
+  const System& sys;
+  AugmentedLagrangianOptions opt;
+  DaeSystem ggl, index1;  // residual blocks: F_v, g, G v + g_t; and G a + (G v)_q v + g_tt
+  std::unique_ptr<DaeScratch> scratch, scratch1;
+  int nq, m;
+  DaeLayout L, L1;
+  // work arrays (sized once)
+  VecX y, yp, F, y1, yp1, F1;
+  MatX J, P, G;
+  Eigen::PartialPivLU<MatX> lu;
+  VecX r, dq, w, qN, vN, aN, lamN, err;
+  // state at the end of the last step and at its start
+  double t = 0.0, tPrev = 0.0, h = 0.0, massScale = 1.0, constraintScale = 1.0;
+  VecX q, v, a, lam, qPrev, vPrev, aPrev;
+  IntegratorStats stats;
+  long forcedSteps = 0;  ///< steps accepted with an error estimate that is not truncation error
+
+  Impl(const System& s, const AugmentedLagrangianOptions& o)
+      : sys(s), opt(o), ggl(s, Formulation::Ggl), index1(s, Formulation::Index1),
+        scratch(ggl.makeScratch()), scratch1(index1.makeScratch()),
+        nq(s.numCoordinates()), m(s.numConstraintEquations()), L(ggl.layout()), L1(index1.layout()) {
+    y = yp = F = VecX::Zero(L.size);
+    y1 = yp1 = F1 = VecX::Zero(L1.size);
+    J = MatX::Zero(L.size, L.size);
+    P = MatX::Zero(nq, nq);
+    G = MatX::Zero(m, nq);
+    lu = Eigen::PartialPivLU<MatX>(nq);
+    r = dq = w = qN = vN = aN = err = VecX::Zero(nq);
+    lamN = VecX::Zero(m);
+  }
+
+  /// F (GGL, mu = 0) at (q, v, a) with multipliers lam; with the Jacobian dF/dy + cj dF/dy' if asked.
+  void evaluate(double tt, const VecX& qq, const VecX& vv, const VecX& aa, const VecX& ll, bool jacobian, double cj) {
+    y.setZero();
+    yp.setZero();
+    y.segment(L.q, nq) = qq;
+    y.segment(L.v, nq) = vv;
+    y.segment(L.lambda, m) = ll;
+    yp.segment(L.q, nq) = vv;
+    yp.segment(L.v, nq) = aa;
+    ggl.residual(tt, y.data(), yp.data(), F.data(), *scratch);
+    ++stats.residualEvals;
+    if (jacobian) {
+      J.setZero();
+      JacobianSink sink = JacobianSink::dense(J.data(), L.size);
+      ggl.jacobian(tt, y.data(), yp.data(), cj, sink, *scratch);
+      G = J.block(L.lambda, L.q, m, nq);
+      ++stats.jacobianEvals;
+    }
+  }
+
+  /// Acceleration-level constraint residual G a + (G v)_q v + g_tt (into F1 at L1.lambda).
+  void evaluateAccelerationConstraints(double tt, const VecX& qq, const VecX& vv, const VecX& aa) {
+    y1.setZero();
+    yp1.setZero();
+    y1.segment(L1.q, nq) = qq;
+    y1.segment(L1.v, nq) = vv;
+    yp1.segment(L1.q, nq) = vv;
+    yp1.segment(L1.v, nq) = aa;
+    index1.residual(tt, y1.data(), yp1.data(), F1.data(), *scratch1);
+    ++stats.residualEvals;
+  }
+
+  void weights(const VecX& qq) { w = opt.rtol * qq.cwiseAbs() + opt.atolPosition; }
+
+  /// One attempt with step size hh from (t, q, v, a, lam). True if Newton converged;
+  /// then qN, vN, aN, lamN hold the projected end state.
+  bool attempt(double hh) {
+    const double tn = t + hh;
+    const double alpha = m > 0 ? kPenalty * 4.0 / (hh * hh) * massScale / constraintScale : 0.0;
+    qN = q + hh * v + 0.5 * hh * hh * a;  // trapezoidal predictor with a_{n+1} = a_n
+    lamN = lam;
+    weights(q);
+    const double roundOffScale = std::numeric_limits<double>::epsilon() * (opt.lengthScale + q.cwiseAbs().maxCoeff());
+    double lastNorm = 0.0;
+    bool converged = false;
+    for (int it = 0; it < kMaxNewtonIterations; ++it) {
+      // trapezoidal rule: v_{n+1} = 2/h (q_{n+1} - q_n) - v_n, a_{n+1} = 4/h^2 (q_{n+1} - q_n) - 4/h v_n - a_n
+      vN = (2.0 / hh) * (qN - q) - v;
+      aN = (4.0 / (hh * hh)) * (qN - q) - (4.0 / hh) * v - a;
+      evaluate(tn, qN, vN, aN, lamN, true, 2.0 / hh);
+      ++stats.nonlinearIterations;
+      const auto g = F.segment(L.lambda, m);
+      r = F.segment(L.v, nq);
+      if (m > 0) {
+        // multiplier update lambda* += alpha g(q_{k+1}) (Bayo & Ledesma 1996, eq. 20), not on a
+        // violation at round-off: alpha times round-off moves near-singular directions
+        if (it > 0 && g.cwiseAbs().maxCoeff() > kRoundOffViolation * roundOffScale) {
+          lamN += alpha * g;
+          r.noalias() += G.transpose() * (alpha * g);
+        }
+        r.noalias() += G.transpose() * (alpha * g);  // M a + G^T (lambda* + alpha g) - Q (ibid., eq. 19)
+      }
+      // Newton matrix / (h^2/4): dF_v/dq + 2/h dF_v/dv (cj = 2/h) + alpha G^T G (Cuadrado et al. 1997, eq. 11)
+      P = J.block(L.v, L.q, nq, nq) + (2.0 / hh) * J.block(L.v, L.v, nq, nq);
+      if (m > 0) P.noalias() += alpha * G.transpose() * G;
+      lu.compute(P);
+      ++stats.linearSetups;
+      dq = -lu.solve(r);
+      if (!dq.allFinite()) return false;
+      qN += dq;
+      const double norm = wrms(dq, w);
+      const bool atRoundOff = dq.cwiseAbs().maxCoeff() <= kRoundOffCorrection * roundOffScale;
+      // Near a singular position the multiplier iteration barely moves a violation along the
+      // nearly dependent constraint direction (contraction 1 - alpha sigma_min^2 / ...): a
+      // violation far below atol with corrections inside the error weights is converged.
+      const bool satisfied = it > 0 && m > 0 && norm <= kSingularNewtonTolerance &&
+                             g.cwiseAbs().maxCoeff() <= kConstraintTolerance * w.minCoeff();
+      if ((norm <= kNewtonTolerance && it > 0) || atRoundOff || satisfied) {
+        converged = true;
+        break;
+      }
+      if (it > 1 && norm > 2.0 * lastNorm) return false;  // diverging
+      lastNorm = norm;
+    }
+    if (!converged) return false;
+    vN = (2.0 / hh) * (qN - q) - v;
+    aN = (4.0 / (hh * hh)) * (qN - q) - (4.0 / hh) * v - a;
+    if (m > 0) {
+      // mass-orthogonal projections with the last Newton matrix (Bayo & Ledesma 1996, eqs. 27, 31):
+      // P (v - v*) = -alpha G^T (G v* + g_t),  P (a - a*) = -alpha G^T (G a* + (G v)_q v + g_tt)
+      for (int pass = 0; pass < kProjectionPasses; ++pass) {
+        evaluate(tn, qN, vN, aN, lamN, false, 0.0);
+        vN -= lu.solve(G.transpose() * (alpha * F.segment(L.mu, m)));
+      }
+      for (int pass = 0; pass < kProjectionPasses; ++pass) {
+        evaluateAccelerationConstraints(tn, qN, vN, aN);
+        aN -= lu.solve(G.transpose() * (alpha * F1.segment(L1.lambda, m)));
+      }
+    }
+    return qN.allFinite() && vN.allFinite() && aN.allFinite();
+  }
+};
+
+AugmentedLagrangianIntegrator::AugmentedLagrangianIntegrator(const System& sys, double t0, const VecX& q0,
+                                                             const VecX& v0, const VecX& a0, const VecX& lambda0,
+                                                             const AugmentedLagrangianOptions& options)
+    : impl_(std::make_unique<Impl>(sys, options)) {
+  Impl& s = *impl_;
+  const int nq = s.nq;
+  if (q0.size() != nq || v0.size() != nq || a0.size() != nq || lambda0.size() != s.m) {
+    throw InputError("ali3p: initial state of the wrong size");
+  }
+  if (s.opt.atolPosition.size() != nq) {
+    throw InputError("ali3p: absolute tolerances must be given per coordinate");
+  }
+  if (!(s.opt.rtol > 0.0) || !(s.opt.atolPosition.array() > 0.0).all()) {
+    throw InputError("ali3p: tolerances must be positive");
+  }
+  s.t = s.tPrev = t0;
+  s.q = s.qPrev = q0;
+  s.v = s.vPrev = v0;
+  s.a = s.aPrev = a0;
+  s.lam = lambda0;
+  // scales of the penalty: the largest diagonal entries of M and of G^T G at the start
+  const MatX M = massMatrix(sys, q0);
+  s.massScale = std::max(M.diagonal().cwiseAbs().maxCoeff(), 1e-300);
+  if (s.m > 0) {
+    MatX G0;
+    evaluateConstraints(sys, q0, t0, nullptr, &G0);
+    s.constraintScale = std::max(G0.colwise().squaredNorm().maxCoeff(), 1e-300);
+    s.G = G0;
+  }
+  s.weights(q0);
+  const double an = wrms(a0, s.w);
+  // first step: the Taylor term h^2/2 |a| at a tenth of the error weights
+  s.h = s.opt.initialStepSize > 0.0 ? s.opt.initialStepSize : (an > 0.0 ? std::sqrt(0.2 / an) : 1e-3);
+  if (s.opt.maxStepSize > 0.0) s.h = std::min(s.h, s.opt.maxStepSize);
+}
+
+AugmentedLagrangianIntegrator::~AugmentedLagrangianIntegrator() = default;
+
+double AugmentedLagrangianIntegrator::step(double tStop) {
+  Impl& s = *impl_;
+  if (!(tStop > s.t)) return s.t;
+  double rejectedError = 0.0, rejectedStep = 0.0;  // the first rejection of this step
+  for (;;) {
+    double hh = s.h;
+    bool last = false;
+    if (s.t + hh >= tStop || s.t + 1.01 * hh >= tStop) {  // land on tStop exactly, no sliver step
+      hh = tStop - s.t;
+      last = true;
+    }
+    if (hh < s.opt.minStepSize && !last) {
+      std::ostringstream os;
+      os << "ali3p: the step size fell to " << hh << " at t = " << s.t << " (below min_step "
+         << s.opt.minStepSize << ") after " << s.stats.nonlinearConvFailures << " Newton failures and "
+         << s.stats.errorTestFailures << " error test failures in " << s.stats.steps << " steps";
+      throw SolverError(os.str(), s.t, hh);
+    }
+    if (!s.attempt(hh)) {
+      ++s.stats.nonlinearConvFailures;
+      s.h = kNewtonFailureShrink * hh;
+      continue;
+    }
+    // local error of the trapezoidal rule: h^2/12 (a_{n+1} - a_n) (Zienkiewicz & Xie 1991, beta = 1/4)
+    s.err = (hh * hh / 12.0) * (s.aN - s.a);
+    s.weights(s.qN.cwiseAbs().cwiseMax(s.q.cwiseAbs()));
+    const double e = wrms(s.err, s.w);
+    const double factor = e > 0.0 ? kSafety * std::pow(e, -1.0 / 3.0) : kMaxGrowth;
+    // An error that does not fall as the step shrinks is not the truncation error (h^3): near
+    // a singular position it is the correction of the last step's violation along a nearly
+    // dependent constraint, (4/h^2) delta q in the accelerations. Bounded, it is accepted.
+    const bool notTruncation = rejectedStep >= kArtifactShrink * hh && e >= kArtifactPersistence * rejectedError &&
+                               e <= kMaxArtifactError;
+    if (notTruncation) ++s.forcedSteps;
+    if (!(e <= 1.0) && !notTruncation) {
+      if (rejectedStep == 0.0) {
+        rejectedError = e;
+        rejectedStep = hh;
+      }
+      ++s.stats.errorTestFailures;
+      s.h = hh * std::clamp(factor, kMinShrinkRejected, 1.0);
+      continue;
+    }
+    s.tPrev = s.t;
+    s.qPrev = s.q;
+    s.vPrev = s.v;
+    s.aPrev = s.a;
+    s.t = last ? tStop : s.t + hh;
+    s.q = s.qN;
+    s.v = s.vN;
+    s.a = s.aN;
+    s.lam = s.lamN;
+    ++s.stats.steps;
+    s.stats.lastStepSize = hh;
+    s.stats.currentTime = s.t;
+    // a step shortened to land on tStop does not shrink the next one
+    s.h = last ? std::max(s.h, hh * std::clamp(factor, kMinShrink, kMaxGrowth))
+               : hh * std::clamp(factor, kMinShrink, kMaxGrowth);
+    if (s.opt.maxStepSize > 0.0) s.h = std::min(s.h, s.opt.maxStepSize);
+    return s.t;
+  }
+}
+
+double AugmentedLagrangianIntegrator::time() const { return impl_->t; }
+const VecX& AugmentedLagrangianIntegrator::q() const { return impl_->q; }
+const VecX& AugmentedLagrangianIntegrator::v() const { return impl_->v; }
+const VecX& AugmentedLagrangianIntegrator::a() const { return impl_->a; }
+const VecX& AugmentedLagrangianIntegrator::lambda() const { return impl_->lam; }
+IntegratorStats AugmentedLagrangianIntegrator::stats() const { return impl_->stats; }
+long AugmentedLagrangianIntegrator::forcedSteps() const { return impl_->forcedSteps; }
+
+void AugmentedLagrangianIntegrator::interpolate(double tt, VecX& qq, VecX& vv) const {
+  const Impl& s = *impl_;
+  const double hh = s.t - s.tPrev;
+  if (!(hh > 0.0)) {
+    qq = s.q;
+    vv = s.v;
+    return;
+  }
+  // cubic Hermite basis on [t_{n-1}, t_n]
+  const double x = std::clamp((tt - s.tPrev) / hh, 0.0, 1.0);
+  const double h00 = 2 * x * x * x - 3 * x * x + 1, h10 = x * x * x - 2 * x * x + x;
+  const double h01 = -2 * x * x * x + 3 * x * x, h11 = x * x * x - x * x;
+  qq = h00 * s.qPrev + (h10 * hh) * s.vPrev + h01 * s.q + (h11 * hh) * s.v;
+  vv = h00 * s.vPrev + (h10 * hh) * s.aPrev + h01 * s.v + (h11 * hh) * s.a;
+}
+
+double AugmentedLagrangianIntegrator::constraintConditioning() const {
+  const Impl& s = *impl_;
+  if (s.m == 0) return 1.0;
+  MatX G;
+  evaluateConstraints(s.sys, s.q, s.t, nullptr, &G);
+  const VecX sv = Eigen::JacobiSVD<MatX>(G).singularValues();
+  return sv.size() > 0 && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
+}
+
+namespace {
+
+AugmentedLagrangianOptions solverOptions(const DaeSystem& dae, const IntegratorOptions& o) {
+  const DaeLayout& L = dae.layout();
+  AugmentedLagrangianOptions a;
+  a.rtol = o.rtol;
+  if (o.atol.size() != L.size) throw InputError("ali3p: absolute tolerances of the wrong size");
+  a.atolPosition = o.atol.segment(L.q, L.nq);
+  a.initialStepSize = o.initialStepSize;
+  a.maxStepSize = o.maxStepSize;
+  a.minStepSize = o.minStepSize > 0.0 ? o.minStepSize : 1e-14;
+  return a;
+}
+
+}  // namespace
+
+AugmentedLagrangianSolver::AugmentedLagrangianSolver(const DaeSystem& dae, double t0, const VecX& y0,
+                                                     const VecX& yp0, const IntegratorOptions& options)
+    : dae_(dae),
+      integrator_(dae.system(), t0, y0.segment(dae.layout().q, dae.layout().nq),
+                  y0.segment(dae.layout().v, dae.layout().nq), yp0.segment(dae.layout().v, dae.layout().nq),
+                  y0.segment(dae.layout().lambda, dae.layout().m), solverOptions(dae, options)),
+      y_(y0), yp_(yp0), maxSteps_(options.maxSteps) {}
+
+double AugmentedLagrangianSolver::advance(double tout, double tStop) {
+  const DaeLayout& L = dae_.layout();
+  const long steps0 = integrator_.stats().steps;
+  while (integrator_.time() < tout) {
+    integrator_.step(tStop);
+    if (integrator_.stats().steps - steps0 > maxSteps_) {
+      throw SolverError("ali3p: more than max_steps = " + std::to_string(maxSteps_) + " steps before t = " +
+                            std::to_string(tout), integrator_.time(),
+                        integrator_.stats().lastStepSize);
+    }
+  }
+  integrator_.interpolate(tout, q_, v_);
+  y_.setZero();
+  yp_.setZero();
+  y_.segment(L.q, L.nq) = q_;
+  y_.segment(L.v, L.nq) = v_;
+  y_.segment(L.lambda, L.m) = integrator_.lambda();
+  yp_.segment(L.q, L.nq) = v_;
+  yp_.segment(L.v, L.nq) = integrator_.a();
+  return tout;
+}
+
+}  // namespace flexmbd

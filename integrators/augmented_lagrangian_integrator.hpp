@@ -1,0 +1,92 @@
+// Index-3 augmented Lagrangian formulation with mass-orthogonal projections (ALI3-P) and
+// the trapezoidal rule: E. Bayo, R. Ledesma, "Augmented Lagrangian and mass-orthogonal
+// projection methods for constrained multibody dynamics", Nonlinear Dynamics 9 (1996)
+// 113-130; J. Cuadrado, J. Cardenal, E. Bayo, "Modeling and solution methods for
+// efficient real-time simulation of multibody dynamics", Multibody System Dynamics 1
+// (1997) 259-280. Written from the formulas of these papers.
+//
+// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) stays regular where the
+// constraint Jacobian G loses rank, so it carries a mechanism through the isolated
+// singular positions (change points, dead centres) where the index-2 and index-3 DAE
+// integrators stop: the engine uses it as a bridge across them (integrators/simulation.cpp)
+// and as an integrator of its own ("ali3p").
+#pragma once
+
+#include <memory>
+
+#include "core/dae_system.hpp"
+#include "integrators/dae_integrator.hpp"
+
+namespace flexmbd {
+
+/// Tolerances and limits of the ALI3-P integrator.
+struct AugmentedLagrangianOptions {
+  double rtol = 1e-8;
+  VecX atolPosition;   ///< per coordinate (nq): local error test of positions
+  double initialStepSize = 0.0;  ///< 0: from the accelerations (h^2/2 |a| = 1 in the error weights)
+  double maxStepSize = 0.0;      ///< 0: no limit
+  double minStepSize = 1e-14;    ///< failure below this
+  double lengthScale = 1.0;      ///< model size: the scale of round-off in positions and constraints
+};
+
+/// The ALI3-P integrator on a finalized System. State: positions q, velocities v,
+/// accelerations a (all consistent after the projections) and the multiplier estimate
+/// lambda* of the augmented Lagrangian. Dense linear algebra (nq x nq): meant for
+/// mechanisms and for short bridges of larger models.
+class AugmentedLagrangianIntegrator {
+ public:
+  /// q0, v0 must satisfy the position and velocity constraints (e.g. from
+  /// computeConsistentState); a0 and lambda0 are the consistent accelerations and
+  /// multipliers there. @throws InputError on bad options.
+  AugmentedLagrangianIntegrator(const System& sys, double t0, const VecX& q0, const VecX& v0, const VecX& a0,
+                                const VecX& lambda0, const AugmentedLagrangianOptions& options);
+  ~AugmentedLagrangianIntegrator();
+  AugmentedLagrangianIntegrator(const AugmentedLagrangianIntegrator&) = delete;
+  AugmentedLagrangianIntegrator& operator=(const AugmentedLagrangianIntegrator&) = delete;
+
+  /// One accepted step, never past tStop (error test, Newton failures and step size
+  /// changes inside). Returns the time reached. @throws SolverError with the reason, the
+  /// time reached and the step size tried when the step size falls below the minimum.
+  double step(double tStop);
+  double time() const;
+  const VecX& q() const;
+  const VecX& v() const;
+  const VecX& a() const;
+  const VecX& lambda() const;
+  /// Positions and velocities at t in the last step [t_{n-1}, t_n] (cubic Hermite
+  /// interpolation of q from (q, v) and of v from (v, a) at both ends).
+  void interpolate(double t, VecX& q, VecX& v) const;
+  /// Smallest/largest singular value of G at the current positions (1 without constraints).
+  double constraintConditioning() const;
+  IntegratorStats stats() const;
+  /// Steps accepted although their error estimate exceeded 1, because it did not fall as
+  /// the step shrank (not a truncation error: the correction of a constraint violation
+  /// along a nearly dependent direction at a singular position).
+  long forcedSteps() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// ALI3-P behind the DaeIntegrator interface: y() and yp() in the layout of `dae` (the
+/// DaeSystem whose unknowns the run outputs; its formulation is not used for stepping).
+class AugmentedLagrangianSolver final : public DaeIntegrator {
+ public:
+  /// y0, yp0 must be consistent. @throws InputError on bad options.
+  AugmentedLagrangianSolver(const DaeSystem& dae, double t0, const VecX& y0, const VecX& yp0,
+                            const IntegratorOptions& options);
+  double advance(double tout, double tStop) override;
+  const VecX& y() const override { return y_; }
+  const VecX& yp() const override { return yp_; }
+  IntegratorStats stats() const override { return integrator_.stats(); }
+  bool usesKlu() const override { return false; }
+
+ private:
+  const DaeSystem& dae_;
+  AugmentedLagrangianIntegrator integrator_;
+  VecX y_, yp_, q_, v_;
+  long maxSteps_;
+};
+
+}  // namespace flexmbd
