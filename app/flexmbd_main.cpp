@@ -194,7 +194,15 @@ int runCommand(const Options& o) {
   std::optional<VtkWriter> vtk;
   try {
     writer.emplace(outDir, *scene);
-    if (o.vtk) vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
+    if (o.vtk) {
+      vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
+      for (const std::string& b : vtk->bodiesNotDrawn()) {
+        std::cerr << "flexmbd: warning: --vtk: body \"" << oneLine(b)
+                  << "\" has no points to draw (a flexible_invariants body without \"points\"); it is not in "
+                     "the VTK frames"
+                  << std::endl;
+      }
+    }
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;

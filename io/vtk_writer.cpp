@@ -57,7 +57,7 @@ void writeVtu(const std::filesystem::path& path, const Grid& g, double t) {
       out << "<DataArray type=\"String\" Name=\"" << name << "\" NumberOfTuples=\"" << values.size()
           << "\" format=\"ascii\">\n";
       for (const std::string& v : values) {
-        for (unsigned char c : v) out << static_cast<int>(c) << ' ';
+        for (char c : v) out << static_cast<int>(static_cast<signed char>(c)) << ' ';  // as VTK: short(char)
         out << "0\n";
       }
       out << "</DataArray>\n";
@@ -176,6 +176,10 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p);
+  }
+  for (int b = 1; b < sys.numBodies(); ++b) {
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex(b)));
+    if (rigidPoints_[b].empty() && !(fb && fb->beamModel())) notDrawn_.push_back(sys.body(BodyIndex(b)).name());
   }
 }
 

@@ -50,10 +50,14 @@ class VtkWriter {
   /// Writes `<prefix>_<k>.vtu` for the sample and rewrites the .pvd collection.
   void write(const OutputSample& sample);
   long filesWritten() const { return collection_.frames(); }
+  /// Bodies with nothing to draw (a flexible_invariants body without attachment
+  /// points): they are missing from every frame, and the command says so on stderr.
+  const std::vector<std::string>& bodiesNotDrawn() const { return notDrawn_; }
 
  private:
   VtkCollection collection_;
   const System& sys_;
+  std::vector<std::string> notDrawn_;
   int subdivisions_;
   std::vector<std::vector<Vec2>> rigidPoints_;  // per body: body-frame points of its line
 };

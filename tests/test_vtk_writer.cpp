@@ -30,8 +30,11 @@ std::string read(const fs::path& p) {
 
 /// The numbers of the first DataArray named `name` (or of the Points array if empty).
 std::vector<double> dataArray(const std::string& xml, const std::string& name) {
-  const std::string key = name.empty() ? "<Points>" : "Name=\"" + name + "\"";
-  const size_t start = xml.find('>', xml.find("<DataArray", xml.find(key))) + 1;
+  // The array's own tag: the first after <Points>, or the one holding Name="name".
+  const size_t tag = name.empty() ? xml.find("<DataArray", xml.find("<Points>"))
+                                  : xml.rfind("<DataArray", xml.find("Name=\"" + name + "\""));
+  if (tag == std::string::npos || (!name.empty() && xml.find("Name=\"" + name + "\"") == std::string::npos)) return {};
+  const size_t start = xml.find('>', tag) + 1;
   const size_t end = xml.find("</DataArray>", start);
   std::istringstream in(xml.substr(start, end - start));
   std::vector<double> v;
