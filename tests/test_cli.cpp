@@ -384,3 +384,26 @@ TEST_F(Cli, VtkFramesOfATensegritySceneHoldItsNodesMembersAndName) {
   std::snprintf(last, sizeof last, "bodies_%06ld.vtu", rows - 1);
   EXPECT_TRUE(fs::exists(out / "vtk" / last)) << last;
 }
+
+TEST_F(Cli, VtkSaysOnStderrWhichBodyItCannotDraw) {
+  // A flexible_invariants body without attachment points has nothing to draw.
+  nlohmann::json j = nlohmann::json::parse(readFile(kSourceDir + "/examples/bari_slider_crank.json"));
+  nlohmann::json loose;
+  for (const auto& b : j["bodies"]) {
+    if (b["type"] == "flexible_invariants") loose = b;
+  }
+  ASSERT_FALSE(loose.is_null());
+  loose["name"] = "loose";
+  loose["invariants"].erase("points");
+  loose["position"] = {5.0, 5.0};
+  j["bodies"].push_back(loose);
+  j["solver"]["t_end"] = 0.001;
+  j["solver"]["output_step"] = 0.001;
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(writeScene("loose.json", j).string()) + " --out " +
+                          shellQuote(out.string()) + " --vtk --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: --vtk: body \"loose\" has no points to draw"), std::string::npos) << r.err;
+  const std::string vtu = readFile(out / "vtk" / "bodies_000000.vtu");
+  EXPECT_NE(vtu.find("<!-- body_names: crank, rod, slider -->"), std::string::npos) << vtu.substr(0, 200);
+}
