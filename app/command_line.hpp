@@ -97,6 +97,18 @@ inline double parsePositiveOption(const std::string& option, const std::string& 
   return x;
 }
 
+/// The options every command takes (run, kinematics; tensegrity scenes go through run):
+/// --out DIR (required), --quiet / -q (no progress display), --help / -h.
+inline const std::set<std::string> kCommonValueOptions = {"--out"};
+inline const std::map<std::string, std::string> kCommonFlags = {{"--quiet", "--quiet"}, {"-q", "--quiet"}};
+
+/// `common` plus the options of one command.
+template <class C>
+C withCommon(C common, const C& own) {
+  common.insert(own.begin(), own.end());
+  return common;
+}
+
 struct SplitArguments {
   std::vector<std::string> positional;
   std::map<std::string, std::string> values;  ///< "--name" -> value (last one wins)

@@ -42,7 +42,7 @@ constexpr int kExitInputError = 2;
 const char* const kUsage =
     "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--vtk] [--quiet]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
-    "                          [--corrector newton|modified_newton]\n"
+    "                          [--corrector newton|modified_newton] [--quiet]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -55,7 +55,8 @@ const char* const kUsage =
     "  --rtol R     relative tolerance, overrides solver.rtol\n"
     "  --atol A     absolute tolerance of positions, overrides solver.atol (and of\n"
     "               velocities too unless the scene sets solver.atol_velocity)\n"
-    "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView)\n"
+    "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView;\n"
+    "               bodies, or the nodes and members of a tensegrity scene)\n"
     "  --quiet, -q  no progress display\n"
     "  --help, -h   this text\n"
     "\n"
@@ -63,7 +64,10 @@ const char* const kUsage =
     "its input and writes DIR/kinematics.csv (positions, transfer functions, velocities,\n"
     "accelerations, corrector iterations and residual per step) and DIR/summary.json.\n"
     "options of kinematics: --out DIR (required); --steps N, --tolerance T, --corrector C\n"
-    "override analysis.steps, .tolerance, .corrector of the scene.\n"
+    "override analysis.steps, .tolerance, .corrector of the scene; --quiet, -q as for run\n"
+    "(kinematics has no progress display).\n"
+    "\n"
+    "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
     "singular position (results up to there are kept); 2 invalid command line, scene or\n"
@@ -111,8 +115,9 @@ Options parseCommandLine(int argc, char** argv) {
     throw UsageError("unknown command '" + args[0] + "' (expected 'run', 'kinematics', '--help' or '--version')");
   }
   const cli::SplitArguments split =
-      cli::splitArguments({args.begin() + 1, args.end()}, {"--out", "--t-end", "--rtol", "--atol"},
-                          {{"--quiet", "--quiet"}, {"-q", "--quiet"}, {"--vtk", "--vtk"}}, "");
+      cli::splitArguments({args.begin() + 1, args.end()},
+                          cli::withCommon(cli::kCommonValueOptions, {"--t-end", "--rtol", "--atol"}),
+                          cli::withCommon(cli::kCommonFlags, {{"--vtk", "--vtk"}}), "run: ");
   o.quiet = split.flags.count("--quiet") > 0;
   o.vtk = split.flags.count("--vtk") > 0;
   for (const auto& [name, value] : split.values) {
@@ -157,7 +162,7 @@ double cpuSecondsSince(std::clock_t start) {
 
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
-    return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet});
+    return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet, o.vtk});
   }
   const std::filesystem::path outDir(o.outDir);
   std::error_code ec;
@@ -189,7 +194,15 @@ int runCommand(const Options& o) {
   std::optional<VtkWriter> vtk;
   try {
     writer.emplace(outDir, *scene);
-    if (o.vtk) vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
+    if (o.vtk) {
+      vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
+      for (const std::string& b : vtk->bodiesNotDrawn()) {
+        std::cerr << "flexmbd: warning: --vtk: body \"" << oneLine(b)
+                  << "\" has no points to draw (a flexible_invariants body without \"points\"); it is not in "
+                     "the VTK frames"
+                  << std::endl;
+      }
+    }
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;

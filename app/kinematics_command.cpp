@@ -43,7 +43,8 @@ using cli::printError;
 Options parseOptions(const std::vector<std::string>& args) {
   Options o;
   const cli::SplitArguments split =
-      cli::splitArguments(args, {"--out", "--steps", "--tolerance", "--corrector"}, {}, "kinematics: ");
+      cli::splitArguments(args, cli::withCommon(cli::kCommonValueOptions, {"--steps", "--tolerance", "--corrector"}),
+                          cli::kCommonFlags, "kinematics: ");
   for (const auto& [name, value] : split.values) {
     if (name == "--out") {
       if (value.empty()) throw UsageError("option --out needs a directory");

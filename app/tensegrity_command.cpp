@@ -14,6 +14,7 @@
 #include "core/errors.hpp"
 #include "io/results_writer.hpp"
 #include "io/tensegrity_scene.hpp"
+#include "io/vtk_writer.hpp"
 
 namespace flexmbd {
 
@@ -46,6 +47,10 @@ class TensegrityResults {
     for (int i = 0; i < s.numNodes(); ++i) {
       for (int a = 0; a < s.dimension(); ++a) h << "," << s.node(i).name << ".v" << axes[a];
     }
+    for (int i = 0; i < s.numStruts(); ++i) {
+      const std::string& n = s.strut(i).name;
+      h << "," << n << ".force," << n << ".length";
+    }
     for (int c = 0; c < s.numCables(); ++c) {
       const std::string& n = s.cable(c).name;
       h << "," << n << ".tension," << n << ".slack," << n << ".impulse," << n << ".length";
@@ -74,6 +79,12 @@ class TensegrityResults {
     row << num(smp.t);
     for (int k = 0; k < smp.x.size(); ++k) row << "," << num(smp.x[k]);
     for (int k = 0; k < smp.v.size(); ++k) row << "," << num(smp.v[k]);
+    for (int i = 0; i < s_.numStruts(); ++i) {
+      // N = EA (l - l0) / l0, tension positive (TensegrityStructure::strutForce)
+      const double force = s_.strutForce(smp.x, i), length = s_.strutLength(smp.x, i);
+      check(std::isfinite(force) && std::isfinite(length), "force or length of strut \"" + s_.strut(i).name + "\"");
+      row << "," << num(force) << "," << num(length);
+    }
     for (int c = 0; c < s_.numCables(); ++c) {
       row << "," << num(smp.cableTension[c]) << "," << (smp.slack[c] ? 1 : 0) << "," << num(smp.cableImpulse[c])
           << "," << num(smp.cableLength[c]);
@@ -185,17 +196,20 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
   }
 
   std::optional<TensegrityResults> results;
+  std::optional<TensegrityVtkWriter> vtk;
   try {
     std::filesystem::create_directories(outDir);
     removeStaleResults(outDir);
     reserveSummary(outDir);
     results.emplace(outDir, *scene.structure);
+    if (o.vtk) vtk.emplace(outDir / "vtk", *scene.structure, scene.name);
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;
   }
   const TensegrityObserver observer{[&](const TensegritySample& s) {
                                       results->sample(s);
+                                      if (vtk) vtk->write(s);
                                       cli::stopIfSignalled(s.t);
                                     },
                                     [&](const TensegrityEvent& e) { results->event(e); }};

@@ -1,5 +1,6 @@
 // `flexmbd run SCENE.json --out DIR` for tensegrity scenes ("model": "tensegrity"):
-// writes DIR/results.csv, DIR/events.csv and DIR/summary.json (docs/tensegrity.md).
+// writes DIR/results.csv, DIR/events.csv and DIR/summary.json (docs/tensegrity.md), and
+// with --vtk the frames DIR/vtk/bodies_NNNNNN.vtu and DIR/vtk/bodies.pvd.
 #pragma once
 
 #include <optional>
@@ -14,6 +15,7 @@ struct TensegrityRunOptions {
   std::optional<double> rtol;  ///< massless_cables only: overrides solver.rtol
   std::optional<double> atol;  ///< massless_cables only: overrides solver.atol
   bool quiet = false;
+  bool vtk = false;  ///< also write DIR/vtk/bodies_NNNNNN.vtu (nodes and members) and bodies.pvd
 };
 
 /// True if SCENE is a tensegrity scene (then runTensegrityCommand handles it).

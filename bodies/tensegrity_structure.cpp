@@ -337,6 +337,17 @@ VecX TensegrityStructure::cableLengths(const VecX& x) const {
   return l;
 }
 
+double TensegrityStructure::strutLength(const VecX& x, int i) const {
+  const TensegrityStrut& st = struts_.at(i);
+  return (x.segment(dim_ * st.nodeJ, dim_) - x.segment(dim_ * st.nodeI, dim_)).norm();
+}
+
+double TensegrityStructure::strutForce(const VecX& x, int i) const {
+  const TensegrityStrut& st = struts_.at(i);
+  // N = EA (l - l0) / l0 (BarElement::internalForces), independent of the dimension.
+  return st.axialStiffness * (strutLength(x, i) - st.naturalLength) / st.naturalLength;
+}
+
 VecX TensegrityStructure::elasticCableTensions(const VecX& x) const {
   const VecX l = cableLengths(x);
   VecX tau(numCables());

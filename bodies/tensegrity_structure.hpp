@@ -132,6 +132,11 @@ class TensegrityStructure {
   VecX internalForces(const VecX& x) const;
   /// Current cable lengths.
   VecX cableLengths(const VecX& x) const;
+  /// Axial force of strut i at positions x, N = EA (l - l0) / l0 (BarElement; tension
+  /// positive, a compressed strut negative). No allocation.
+  double strutForce(const VecX& x, int i) const;
+  /// Length of strut i at positions x.
+  double strutLength(const VecX& x, int i) const;
   /// Tensions of the elastic cables at positions x (inextensible: 0).
   VecX elasticCableTensions(const VecX& x) const;
   /// Length gradient of cable c restricted to the free coordinates (row of B_c).

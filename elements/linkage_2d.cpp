@@ -6,19 +6,13 @@
 #include <functional>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 
 namespace flexmbd {
 namespace {
 
 /// Shortest text that reads back as the same double.
-std::string fmt(double x) {
-  char buf[40];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
+std::string fmt(double x) { return shortestNumberText(x); }
 
 void requireFiniteVec(const Vec2& v, const std::string& what) {
   if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {

@@ -1,5 +1,7 @@
 #include "io/json_reader.hpp"
 
+#include "io/scene_keys.hpp"
+
 namespace flexmbd::jsonread {
 
 TimeLawPtr parseTimeLaw(const json& j, const std::string& where) {
@@ -8,23 +10,23 @@ TimeLawPtr parseTimeLaw(const json& j, const std::string& where) {
       readType(r, "law", {"constant", "constant_speed", "polynomial", "harmonic", "spin_up", "tabulated"});
   const std::string forA = " for a " + type + " law";
   if (type == "constant") {
-    r.allowOnly({"type", "value"}, forA);
+    r.allowOnly(scenekeys::kLawConstant, forA);
     const double value = r.number("value");
     return located(where, [&] { return makeConstantLaw(value); });
   }
   if (type == "constant_speed") {
-    r.allowOnly({"type", "speed", "initial"}, forA);
+    r.allowOnly(scenekeys::kLawConstantSpeed, forA);
     const double speed = r.number("speed");
     const double initial = r.number("initial", 0.0);
     return located(where, [&] { return makeConstantSpeedLaw(speed, initial); });
   }
   if (type == "polynomial") {
-    r.allowOnly({"type", "coefficients"}, forA);
+    r.allowOnly(scenekeys::kLawPolynomial, forA);
     std::vector<double> c = r.numbers("coefficients");
     return located(where, [&] { return makePolynomialLaw(std::move(c)); });
   }
   if (type == "harmonic") {
-    r.allowOnly({"type", "amplitude", "omega", "phase", "offset"}, forA);
+    r.allowOnly(scenekeys::kLawHarmonic, forA);
     const double amplitude = r.number("amplitude");
     const double omega = r.number("omega");
     const double phase = r.number("phase", 0.0);
@@ -32,14 +34,14 @@ TimeLawPtr parseTimeLaw(const json& j, const std::string& where) {
     return located(where, [&] { return makeHarmonicLaw(amplitude, omega, phase, offset); });
   }
   if (type == "spin_up") {
-    r.allowOnly({"type", "speed", "ramp_time", "initial"}, forA);
+    r.allowOnly(scenekeys::kLawSpinUp, forA);
     const double speed = r.number("speed");
     const double rampTime = r.positive("ramp_time");
     const double initial = r.number("initial", 0.0);
     return located(where, [&] { return makeSpinUpLaw(speed, rampTime, initial); });
   }
   // tabulated
-  r.allowOnly({"type", "times", "values"}, forA);
+  r.allowOnly(scenekeys::kLawTabulated, forA);
   std::vector<double> times = r.numbers("times");
   std::vector<double> values = r.numbers("values");
   if (times.size() != values.size()) {

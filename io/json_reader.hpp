@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "core/time_law.hpp"
 #include "core/types.hpp"
 
@@ -32,16 +33,8 @@ constexpr double kMaxInputMagnitude = 1e100;
 // ----- formatting ------------------------------------------------------------------
 
 /// Shortest text that reads back as the same double ("-1", "0.1", "1e-08").
-inline std::string fmt(double x) {
-  if (std::isnan(x)) return "nan";
-  if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
-  char buf[40];
-  for (int p = 1; p <= 17; ++p) {
-    std::snprintf(buf, sizeof buf, "%.*g", p, x);
-    if (std::strtod(buf, nullptr) == x) break;
-  }
-  return buf;
-}
+/// Plain decimals from 1e-4 to 1e6 ("-80", not "-8e+01"; core/number_text.hpp).
+inline std::string fmt(double x) { return shortestNumberText(x); }
 
 /// Longest text of a value or name quoted in an error message; longer ones are cut and
 /// end in "...". A message must stay one readable line even for a 100 KB name.
@@ -421,6 +414,47 @@ inline std::string readType(const ObjectReader& r, const std::string& kind,
   return type;
 }
 
+// ----- which command a scene file is for ----------------------------------------------------
+
+/// The three scene formats, told apart by their top-level keys: a tensegrity scene has
+/// "model": "tensegrity"; only multibody scenes have "bodies", "joints", "drivers",
+/// "forces", "outputs"; only kinematics scenes have "links", "inputs", "analysis".
+enum class SceneKind { Multibody, Kinematics, Tensegrity, Unknown };
+
+struct SceneKindGuess {
+  SceneKind kind = SceneKind::Unknown;
+  std::string key;  ///< the key that tells: "\"analysis\"", "\"model\": \"tensegrity\""
+};
+
+inline SceneKindGuess guessSceneKind(const json& j) {
+  if (!j.is_object()) return {};
+  if (const auto it = j.find("model"); it != j.end() && it->is_string() && it->get<std::string>() == "tensegrity") {
+    return {SceneKind::Tensegrity, "\"model\": \"tensegrity\""};
+  }
+  std::string multibody, kinematics;  // the first such key in the file's (sorted) order
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    if (multibody.empty() && (k == "bodies" || k == "joints" || k == "drivers" || k == "forces" || k == "outputs")) {
+      multibody = k;
+    }
+    if (kinematics.empty() && (k == "links" || k == "inputs" || k == "analysis")) kinematics = k;
+  }
+  if (!multibody.empty() && kinematics.empty()) return {SceneKind::Multibody, inQuotes(multibody)};
+  if (!kinematics.empty() && multibody.empty()) return {SceneKind::Kinematics, inQuotes(kinematics)};
+  return {};
+}
+
+/// Refuses a scene of another format than `expected` with a message saying which
+/// command it is for: `four_bar.json is a kinematics scene (key "analysis"): run it with
+/// "flexmbd kinematics"`. A file of no recognisable format is left to the reader.
+inline void checkSceneKind(const json& j, SceneKind expected, const std::string& source) {
+  const SceneKindGuess g = guessSceneKind(j);
+  if (g.kind == SceneKind::Unknown || g.kind == expected) return;
+  const char* kind = g.kind == SceneKind::Multibody ? "multibody" : g.kind == SceneKind::Kinematics ? "kinematics"
+                                                                                                    : "tensegrity";
+  const char* command = g.kind == SceneKind::Kinematics ? "flexmbd kinematics" : "flexmbd run";
+  throw InputError(source + " is a " + kind + " scene (key " + g.key + "): run it with \"" + command + "\"");
+}
 
 /// A time-law object {"type": "constant_speed", "speed": ...} (docs/scene-format.md).
 TimeLawPtr parseTimeLaw(const json& j, const std::string& where);

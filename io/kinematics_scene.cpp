@@ -4,6 +4,7 @@
 #include "io/kinematics_scene.hpp"
 
 #include "io/json_reader.hpp"
+#include "io/scene_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -39,9 +40,9 @@ void parseNode(const json& j, const std::string& at, Linkage2d& linkage) {
   Reader r(j, at);
   const std::string type = r.string("type");
   if (type == "slider") {
-    r.allowOnly({"name", "type", "position", "direction"}, " for a slider node");
+    r.allowOnly(scenekeys::kKinematicsSliderNode, " for a slider node");
   } else if (type == "fixed" || type == "free") {
-    r.allowOnly({"name", "type", "position"}, " for a " + type + " node");
+    r.allowOnly(scenekeys::kKinematicsNode, " for a " + type + " node");
   } else {
     r.fail("key \"type\" must be \"fixed\", \"free\" or \"slider\", got " + inQuotes(type));
   }
@@ -61,7 +62,7 @@ void parseNode(const json& j, const std::string& at, Linkage2d& linkage) {
 
 void parseLink(const json& j, const std::string& at, Linkage2d& linkage) {
   Reader r(j, at);
-  r.allowOnly({"name", "nodes", "length"});
+  r.allowOnly(scenekeys::kKinematicsLink);
   const std::string name = r.name("name");
   const json& nodes = r.required("nodes");
   if (!nodes.is_array() || nodes.size() != 2 || !nodes[0].is_string() || !nodes[1].is_string()) {
@@ -76,13 +77,13 @@ void parseInput(const json& j, const std::string& at, Linkage2d& linkage) {
   const std::string type = r.string("type");
   const std::string name = r.name("name");
   if (type == "link_angle") {
-    r.allowOnly({"name", "type", "link", "node", "ratio"}, " for a link_angle input");
+    r.allowOnly(scenekeys::kLinkAngleInput, " for a link_angle input");
     const std::string link = r.name("link");
     const std::string node = r.has("node") ? r.name("node") : "";
     const double ratio = r.number("ratio", 1.0);
     located(r.where(), [&] { linkage.addLinkAngleInput(name, link, node, ratio); });
   } else if (type == "slider_position" || type == "node_x" || type == "node_y") {
-    r.allowOnly({"name", "type", "node", "ratio"}, " for a " + type + " input");
+    r.allowOnly(scenekeys::kNodeInput, " for a " + type + " input");
     const std::string node = r.name("node");
     const double ratio = r.number("ratio", 1.0);
     located(r.where(), [&] {
@@ -99,8 +100,7 @@ void parseInput(const json& j, const std::string& at, Linkage2d& linkage) {
 
 KinematicSettings parseAnalysis(const json& j) {
   Reader r(j, "analysis");
-  r.allowOnly({"start", "end", "steps", "speed", "acceleration", "tolerance", "max_iterations", "corrector",
-               "singular_tolerance", "locate_tolerance"});
+  r.allowOnly(scenekeys::kAnalysis);
   KinematicSettings s;
   s.start = r.number("start", s.start);
   s.end = r.number("end", s.end);
@@ -144,7 +144,7 @@ class DuplicateKeyCheck {
 
 KinematicsScene parseKinematicsScene(const json& j) {
   Reader top(j, "top level");
-  top.allowOnly({"name", "nodes", "links", "inputs", "analysis"});
+  top.allowOnly(scenekeys::kKinematicsScene);
   KinematicsScene scene;
   scene.name = top.string("name", "");
   Linkage2d& linkage = scene.linkage;
@@ -157,7 +157,15 @@ KinematicsScene parseKinematicsScene(const json& j) {
   const json& inputs = top.requiredArray("inputs");
   for (std::size_t i = 0; i < inputs.size(); ++i) parseInput(inputs[i], "inputs[" + std::to_string(i) + "]", linkage);
   scene.settings = top.has("analysis") ? parseAnalysis(top.required("analysis")) : KinematicSettings{};
-  located("linkage", [&] { linkage.finalize(); });
+  try {  // the linkage's own messages may already start with "linkage: " (not said twice)
+    linkage.finalize();
+  } catch (const ModelError& e) {
+    const std::string m = e.what();
+    throw ModelError(m.rfind("linkage: ", 0) == 0 ? m : "linkage: " + m);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    throw InputError(m.rfind("linkage: ", 0) == 0 ? m : "linkage: " + m);
+  }
   return scene;
 }
 
@@ -175,6 +183,7 @@ KinematicsScene parseKinematicsSceneText(const std::string& text, const std::str
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
+  checkSceneKind(j, SceneKind::Kinematics, source);
   try {
     return parseKinematicsScene(j);
   } catch (const InputError& e) {

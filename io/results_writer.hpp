@@ -15,7 +15,8 @@ namespace flexmbd {
 /// Writes DIR/results.csv: a header row, then one row per OutputSample, each flushed
 /// so that the rows written survive a failure later in the run. Columns: t; every
 /// coordinate "<body>.<coord>" (System::coordinateNames()); every velocity
-/// "<body>.<coord>_dot"; the reaction outputs (reactionOutputNames: "<joint>.fx",
+/// "<body>.<coord>_dot"; every acceleration "<body>.<coord>_ddot" (OutputSample::a, from
+/// the state at the output time); the reaction outputs (reactionOutputNames: "<joint>.fx",
 /// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs.
 /// Numbers are written with 17 significant digits (they read back exactly).
 /// The file is created at the first sample, so a run that fails before its first

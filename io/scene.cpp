@@ -5,6 +5,7 @@
 #include "io/scene.hpp"
 
 #include "io/json_reader.hpp"
+#include "io/scene_keys.hpp"
 
 #include <algorithm>
 #include <array>
@@ -113,7 +114,7 @@ FrameState2d parseFrameState(const ObjectReader& r) {
 
 BeamSection parseSection(const json& j, const std::string& where) {
   ObjectReader r(j, where);
-  r.allowOnly({"area", "inertia", "width", "height", "youngs_modulus", "density", "damping"});
+  r.allowOnly(scenekeys::kSection);
   BeamSection s;
   if (r.has("width") || r.has("height")) {
     if (r.has("area") || r.has("inertia")) r.fail("give either width and height, or area and inertia, not both");
@@ -133,7 +134,7 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
   const ObjectReader ref(r.object("reference"), r.where() + ": reference");
   const std::string type = ref.string("type");
   if (type == "pinned_pinned") {
-    ref.allowOnly({"type", "nodes"}, " for pinned_pinned");
+    ref.allowOnly(scenekeys::kReferencePinnedPinned, " for pinned_pinned");
     o.reference.type = ReferenceConditions::Type::PinnedPinned;
     o.reference.nodeA = 0;
     o.reference.nodeB = numNodes - 1;
@@ -144,11 +145,11 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
       o.reference.nodeB = ref.index(n[1], "nodes[1]");
     }
   } else if (type == "clamped") {
-    ref.allowOnly({"type", "node"}, " for clamped");
+    ref.allowOnly(scenekeys::kReferenceClamped, " for clamped");
     o.reference.type = ReferenceConditions::Type::Clamped;
     o.reference.nodeA = static_cast<int>(ref.integer("node", 0, 0));
   } else if (type == "free_free") {
-    ref.allowOnly({"type"}, " for free_free");
+    ref.allowOnly(scenekeys::kReferenceFreeFree, " for free_free");
     o.reference.type = ReferenceConditions::Type::FreeFree;
   } else {
     ref.fail("unknown reference type " + inQuotes(type) + " (expected one of: pinned_pinned, clamped, free_free)");
@@ -167,15 +168,13 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
 }
 
 void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
-  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "section", "beam", "nodes",
-               "elements", "reference", "modes", "geometric_stiffening", "elastic_coordinates", "elastic_velocities"},
-              " for a flexible body");
+  r.allowOnly(scenekeys::kFlexibleBody, " for a flexible body");
   const BeamSection section = parseSection(r.object("section"), r.where() + ": section");
   BeamMesh2d mesh;
   if (r.has("beam")) {
     if (r.has("nodes") || r.has("elements")) r.fail("give either \"beam\" or \"nodes\" and \"elements\", not both");
     const ObjectReader b(r.object("beam"), r.where() + ": beam");
-    b.allowOnly({"length", "elements", "origin"});
+    b.allowOnly(scenekeys::kBeam);
     const double length = b.positive("length");
     const int n = static_cast<int>(b.integer("elements", 1, 1, kMaxElements));
     mesh = located(b.where(), [&] { return BeamMesh2d::straight(length, n, section, b.vec2("origin", Vec2::Zero())); });
@@ -203,11 +202,9 @@ void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& s
 }
 
 void parseInvariantBody(const ObjectReader& r, const std::string& name, System& sys) {
-  r.allowOnly({"name", "type", "position", "angle", "velocity", "angular_velocity", "invariants",
-               "elastic_coordinates", "elastic_velocities"},
-              " for a flexible_invariants body");
+  r.allowOnly(scenekeys::kInvariantsBody, " for a flexible_invariants body");
   const ObjectReader iv(r.object("invariants"), r.where() + ": invariants");
-  iv.allowOnly({"mass", "first_moment", "polar_moment", "s_bar", "i1", "j0", "m_ff", "s_tilde", "k_ff", "d_ff", "points"});
+  iv.allowOnly(scenekeys::kInvariants);
   FfrInvariants inv;
   inv.mass = iv.positive("mass");
   inv.firstMoment = iv.vec2("first_moment");
@@ -232,7 +229,7 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
   const json& pts = iv.array("points");
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const ObjectReader p(pts[k], iv.where() + ": points[" + std::to_string(k) + "]");
-    p.allowOnly({"position", "shape", "rotation_shape"});
+    p.allowOnly(scenekeys::kInvariantsPoint);
     FfrPoint fp;
     fp.position = p.vec2("position");
     fp.shape = p.matrix("shape");
@@ -262,7 +259,7 @@ void parseBody(const json& j, const std::string& where, System& sys) {
   }
   if (type == "flexible") return parseFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
-  r.allowOnly({"name", "type", "mass", "inertia", "com", "position", "angle", "velocity", "angular_velocity"});
+  r.allowOnly(scenekeys::kRigidBody, " for a rigid body");
   RigidBodyProperties props;
   props.mass = r.positive("mass");
   props.inertia = r.positive("inertia");
@@ -279,9 +276,9 @@ void parseJoint(const json& j, const std::string& where, System& sys) {
     r.fail("key \"axis\" is only allowed for prismatic joints (this joint is " + type + ")");
   }
   if (type == "prismatic") {
-    r.allowOnly({"name", "type", "bodies", "points", "axis"}, " for a prismatic joint");
+    r.allowOnly(scenekeys::kPrismaticJoint, " for a prismatic joint");
   } else {
-    r.allowOnly({"name", "type", "bodies", "points"}, " for a " + type + " joint");
+    r.allowOnly(scenekeys::kJoint, " for a " + type + " joint");
   }
   const std::string name = r.name("name");
   const auto bodyNames = r.namePair("bodies");
@@ -306,7 +303,7 @@ void parseDriver(const json& j, const std::string& where, System& sys) {
   const std::string type =
       readType(r, "driver", {"body_angle", "body_x", "body_y", "joint_angle", "joint_displacement"});
   const bool onJoint = type == "joint_angle" || type == "joint_displacement";
-  r.allowOnly({"name", "type", onJoint ? "joint" : "body", "law"}, " for a " + type + " driver");
+  r.allowOnly(onJoint ? scenekeys::kJointDriver : scenekeys::kBodyDriver, " for a " + type + " driver");
   const std::string name = r.name("name");
   if (onJoint) {
     const std::string jointName = r.name("joint");
@@ -336,7 +333,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
   const std::string type = readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load"});
   const std::string forA = " for a " + type + " force";
   if (type == "spring_damper") {
-    r.allowOnly({"name", "type", "bodies", "points", "stiffness", "damping", "free_length"}, forA);
+    r.allowOnly(scenekeys::kSpringDamper, forA);
     const std::string name = r.name("name");
     const auto bodyNames = r.namePair("bodies");
     const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
@@ -360,7 +357,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
       return sys.addSpringDamper(name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
     });
   } else if (type == "rotational_spring_damper") {
-    r.allowOnly({"name", "type", "joint", "stiffness", "damping", "free_angle"}, forA);
+    r.allowOnly(scenekeys::kRotationalSpringDamper, forA);
     const std::string name = r.name("name");
     const std::string jointName = r.name("joint");
     const ConstraintIndex joint = lookupJoint(sys, jointName, r);
@@ -374,7 +371,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
                                                  : located(r.where(), [&] { return initialJointAngle(sys, joint); });
     located(r.where(), [&] { return sys.addRotationalSpringDamper(name, joint, stiffness, damping, freeAngle); });
   } else {
-    r.allowOnly({"name", "type", "body", "point", "force_x", "force_y", "torque"}, forA);
+    r.allowOnly(scenekeys::kAppliedLoad, forA);
     const std::string name = r.name("name");
     const BodyIndex body = lookupBody(sys, r.name("body"), r);
     const Vec2 point = r.vec2("point", Vec2::Zero());
@@ -396,14 +393,14 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
   const std::string type = readType(r, "output", {"point", "energy", "deflection"});
   OutputRequest out;
   if (type == "energy") {
-    r.allowOnly({"type"}, " for an energy output");
+    r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
     for (const auto& o : earlier) {
       if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
     }
     out.type = OutputRequest::Type::Energy;
     return out;
   }
-  r.allowOnly({"type", "name", "body", "point"}, " for a " + type + " output");
+  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
   out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
   out.name = r.name("name");
   // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
@@ -444,9 +441,7 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
 
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
-  r.allowOnly({"formulation", "rtol", "atol", "atol_velocity", "t_start", "t_end", "output_step", "max_step",
-               "min_step", "max_steps", "max_order", "initial_step", "linear_solver", "fd_jacobian", "integrator", "atol_angle",
-               "atol_elastic", "cross_singular"});
+  r.allowOnly(scenekeys::kSolver);
   SolverSettings s;
   if (r.has("integrator")) {
     const std::string name = r.string("integrator");
@@ -614,7 +609,7 @@ void checkSolverSettings(const SolverSettings& s) {
 
 Scene parseScene(const json& j) {
   ObjectReader top(j, "top level");
-  top.allowOnly({"name", "gravity", "bodies", "joints", "drivers", "forces", "outputs", "solver"});
+  top.allowOnly(scenekeys::kScene);
   Scene scene;
   scene.name = top.string("name", "");
   System& sys = scene.system;
@@ -667,6 +662,7 @@ Scene parseSceneText(const std::string& text, const std::string& source) {
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
+  checkSceneKind(j, SceneKind::Multibody, source);
   try {
     return parseScene(j);
   } catch (const ModelError& e) {

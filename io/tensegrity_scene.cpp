@@ -4,6 +4,7 @@
 #include "io/tensegrity_scene.hpp"
 
 #include "io/json_reader.hpp"
+#include "io/scene_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -95,8 +96,7 @@ TensegrityScene loadTensegrityScene(const std::string& path) {
 
 TensegrityScene parseTensegrityScene(const json& j) {
   Reader top(j, "scene");
-  top.allowOnly({"model", "name", "dimension", "gravity", "nodes", "struts", "cables", "loads", "max_struts_per_node",
-                 "prestress", "solver"});
+  top.allowOnly(scenekeys::kTensegrityScene);
   if (top.string("model") != "tensegrity") top.fail("key \"model\" must be \"tensegrity\"");
   TensegrityScene scene;
   scene.name = top.string("name", "");
@@ -112,7 +112,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   if (nodes.empty()) top.fail("key \"nodes\" must be a non-empty array of nodes");
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     Reader r(nodes[k], "nodes[" + std::to_string(k) + "]");
-    r.allowOnly({"name", "position", "velocity", "mass", "fixed"});
+    r.allowOnly(scenekeys::kTensegrityNode);
     const std::string name = r.string("name");
     const VecX x = r.vector("position", d);
     const VecX v = r.has("velocity") ? r.vector("velocity", d) : VecX::Zero(d);
@@ -137,7 +137,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   const json& struts = top.array("struts");
   for (std::size_t k = 0; k < struts.size(); ++k) {
     Reader r(struts[k], "struts[" + std::to_string(k) + "]");
-    r.allowOnly({"name", "nodes", "EA", "natural_length", "mass", "mass_model", "radius"});
+    r.allowOnly(scenekeys::kStrut);
     const std::string name = r.string("name");
     const auto n = nodePair(s, r);
     const double ea = r.positive("EA");
@@ -156,7 +156,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   const json& cables = top.array("cables");
   for (std::size_t k = 0; k < cables.size(); ++k) {
     Reader r(cables[k], "cables[" + std::to_string(k) + "]");
-    r.allowOnly({"name", "nodes", "EA", "natural_length", "inextensible", "radius"});
+    r.allowOnly(scenekeys::kCable);
     const std::string name = r.string("name");
     const auto n = nodePair(s, r);
     const bool inextensible = r.boolean("inextensible", false);
@@ -169,7 +169,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   const json& loads = top.array("loads");
   for (std::size_t k = 0; k < loads.size(); ++k) {
     Reader r(loads[k], "loads[" + std::to_string(k) + "]");
-    r.allowOnly({"name", "node", "force"});
+    r.allowOnly(scenekeys::kLoad);
     const std::string name = r.string("name", "load" + std::to_string(k));
     const int node = lookupNode(s, r.string("node"), r);
     const json& f = r.required("force");
@@ -186,7 +186,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
 
   if (top.has("prestress")) {
     Reader r(top.required("prestress"), "prestress");
-    r.allowOnly({"cable", "tension"});
+    r.allowOnly(scenekeys::kPrestress);
     const std::string cableName = r.string("cable");
     const double tension = r.positive("tension");
     const SelfStressStates st = computeSelfStress(s, s.initialPositions());
@@ -210,9 +210,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   Reader sv(top.required("solver"), "solver");
   const std::string method = sv.string("method");
   if (method == "time_stepping") {
-    sv.allowOnly({"method", "t_start", "t_end", "time_step", "output_step", "lcp", "lcp_tolerance",
-                  "lcp_max_iterations", "projection", "projection_tolerance", "slack_tolerance", "contacts",
-                  "contact_constraints"});
+    sv.allowOnly(scenekeys::kTimeSteppingSolver, " for method time_stepping");
     scene.method = TensegrityScene::Method::TimeStepping;
     TimeSteppingSettings& o = scene.timeStepping;
     o.tStart = sv.number("t_start", 0.0);
@@ -230,7 +228,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
     if (!(o.tEnd > o.tStart)) sv.fail("key \"t_end\" must be > t_start, got " + fmt(o.tEnd));
     located(sv.where(), [&] { return TensegrityTimeStepper(s, o), 0; });
   } else if (method == "massless_cables") {
-    sv.allowOnly({"method", "t_start", "t_end", "output_step", "rtol", "atol", "max_step", "slack_tolerance", "contacts"});
+    sv.allowOnly(scenekeys::kMasslessCablesSolver, " for method massless_cables");
     scene.method = TensegrityScene::Method::MasslessCables;
     MasslessCableSettings& o = scene.massless;
     o.tStart = sv.number("t_start", 0.0);

@@ -5,114 +5,137 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "bodies/tensegrity_structure.hpp"
 
 namespace flexmbd {
+namespace {
 
-VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix, int subdivisions)
-    : dir_(dir), sys_(sys), prefix_(std::move(prefix)), subdivisions_(std::max(1, subdivisions)) {
-  std::filesystem::create_directories(dir_);
-  rigidPoints_.resize(sys.numBodies());
-  for (int b = 1; b < sys.numBodies(); ++b) {
-    if (const auto* rb = dynamic_cast<const RigidBody2d*>(&sys.body(BodyIndex(b)))) {
-      rigidPoints_[b] = {Vec2::Zero(), rb->com()};
-    }
-  }
-  const auto addPoint = [&](BodyIndex b, const Vec2& p) {
-    auto& pts = rigidPoints_[b.value];
-    if (b.value > 0 && !pts.empty()) {
-      for (const Vec2& q : pts) {
-        if ((q - p).norm() < 1e-12) return;
-      }
-      pts.push_back(p);
-    }
-  };
-  for (int c = 0; c < sys.numConstraints(); ++c) {
-    for (const auto& [b, p] : sys.constraint(ConstraintIndex(c)).attachments()) addPoint(b, p);
-  }
-  for (int f = 0; f < sys.numForces(); ++f) {
-    for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p);
-  }
+constexpr int kVtkLine = 3;      // VTK_LINE
+constexpr int kVtkPolyLine = 4;  // VTK_POLY_LINE
+
+/// One frame: points (3D), cells of one VTK type, named point/cell arrays and the
+/// string arrays of its field data.
+struct Grid {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::vector<int>> cells;
+  int cellType = kVtkPolyLine;
+  std::vector<std::pair<std::string, std::vector<double>>> pointScalars, cellScalars;
+  std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> pointVectors;
+  std::vector<std::pair<std::string, std::vector<int>>> cellInts;
+  std::vector<std::pair<std::string, std::vector<std::string>>> fieldStrings;
+};
+
+/// A name inside an XML comment: "--" may not appear there.
+std::string commentSafe(std::string s) {
+  for (std::size_t k = s.find("--"); k != std::string::npos; k = s.find("--", k)) s.replace(k, 2, "- ");
+  return s;
 }
 
-void VtkWriter::write(const OutputSample& s) {
-  std::vector<Vec2> points;
-  std::vector<Vec2> displacement;
-  std::vector<double> axial, moment;
-  std::vector<std::vector<int>> lines;
-  for (int b = 1; b < sys_.numBodies(); ++b) {
-    const Body& body = sys_.body(BodyIndex(b));
-    const auto q = s.q.segment(sys_.coordinateOffset(BodyIndex(b)), body.numCoordinates());
-    if (const auto* fb = dynamic_cast<const FfrBody2d*>(&body); fb && fb->beamModel()) {
-      const FfrBeamModel& m = *fb->beamModel();
-      const VecX qf = q.tail(m.numElastic());
-      const Mat2 A = rotation(q[2]);
-      for (int e = 0; e < static_cast<int>(m.elements().size()); ++e) {
-        std::vector<int> line;
-        for (int k = 0; k <= subdivisions_; ++k) {
-          const double xi = static_cast<double>(k) / subdivisions_;
-          const FfrPoint p = m.materialPoint(e, xi);
-          const Vec2 u = p.shape * qf;
-          line.push_back(static_cast<int>(points.size()));
-          points.push_back(q.head<2>() + A * (p.position + u));
-          displacement.push_back(A * u);
-          const Vec2 nm = m.sectionForces(qf, e, xi);
-          axial.push_back(nm.x());
-          moment.push_back(nm.y());
-        }
-        lines.push_back(line);
-      }
-    } else if (!rigidPoints_[b].empty()) {
-      std::vector<int> line;
-      for (const Vec2& p : rigidPoints_[b]) {
-        line.push_back(static_cast<int>(points.size()));
-        points.push_back(body.pointKinematics(q, p, false).r);
-        displacement.push_back(Vec2::Zero());
-        axial.push_back(0.0);
-        moment.push_back(0.0);
-      }
-      lines.push_back(line);
-    }
-  }
-  char name[64];
-  std::snprintf(name, sizeof(name), "_%06ld.vtu", static_cast<long>(times_.size()));
-  const std::filesystem::path path = dir_ / (prefix_ + name);
+std::string timeText(double t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", t);
+  return buf;
+}
+
+/// Writes the frame as an ASCII .vtu; a frame that cannot be written whole is removed.
+void writeVtu(const std::filesystem::path& path, const Grid& g, double t) {
   std::ofstream out(path);
-  if (!out) throw OutputWriteError("cannot write '" + path.string() + "' at t = " + std::to_string(s.t));
+  if (!out) throw OutputWriteError("cannot write '" + path.string() + "' at t = " + timeText(t));
   out.precision(12);
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << points.size() << "\" NumberOfCells=\"" << lines.size()
+  out << "<?xml version=\"1.0\"?>\n";
+  for (const auto& [name, values] : g.fieldStrings) {
+    out << "<!-- " << name << ":";
+    for (std::size_t k = 0; k < values.size(); ++k) out << (k ? ", " : " ") << commentSafe(values[k]);
+    out << " -->\n";
+  }
+  out << "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n<UnstructuredGrid>\n";
+  if (!g.fieldStrings.empty()) {
+    // String arrays in ASCII: the character codes of every string, each string ended by 0
+    // (as vtkXMLWriter writes them); ParaView reads them back as strings.
+    out << "<FieldData>\n";
+    for (const auto& [name, values] : g.fieldStrings) {
+      out << "<DataArray type=\"String\" Name=\"" << name << "\" NumberOfTuples=\"" << values.size()
+          << "\" format=\"ascii\">\n";
+      for (const std::string& v : values) {
+        for (char c : v) out << static_cast<int>(static_cast<signed char>(c)) << ' ';  // as VTK: short(char)
+        out << "0\n";
+      }
+      out << "</DataArray>\n";
+    }
+    out << "</FieldData>\n";
+  }
+  out << "<Piece NumberOfPoints=\"" << g.points.size() << "\" NumberOfCells=\"" << g.cells.size()
       << "\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const Vec2& p : points) out << p.x() << " " << p.y() << " 0\n";
+  for (const auto& p : g.points) out << p.x() << " " << p.y() << " " << p.z() << "\n";
   out << "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& l : lines) {
+  for (const auto& l : g.cells) {
     for (int i : l) out << i << " ";
     out << "\n";
   }
   out << "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n";
   long offset = 0;
-  for (const auto& l : lines) out << (offset += static_cast<long>(l.size())) << " ";
+  for (const auto& l : g.cells) out << (offset += static_cast<long>(l.size())) << " ";
   out << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (size_t k = 0; k < lines.size(); ++k) out << "4 ";  // VTK_POLY_LINE
-  out << "\n</DataArray>\n</Cells>\n<PointData Scalars=\"axial_force\">\n"
-      << "<DataArray type=\"Float64\" Name=\"axial_force\" format=\"ascii\">\n";
-  for (double v : axial) out << v << "\n";
-  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"bending_moment\" format=\"ascii\">\n";
-  for (double v : moment) out << v << "\n";
-  out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"elastic_displacement\" NumberOfComponents=\"3\" "
-         "format=\"ascii\">\n";
-  for (const Vec2& d : displacement) out << d.x() << " " << d.y() << " 0\n";
-  out << "</DataArray>\n</PointData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+  for (size_t k = 0; k < g.cells.size(); ++k) out << g.cellType << " ";
+  out << "\n</DataArray>\n</Cells>\n";
+  if (!g.pointScalars.empty() || !g.pointVectors.empty()) {
+    out << "<PointData";
+    if (!g.pointScalars.empty()) out << " Scalars=\"" << g.pointScalars.front().first << "\"";
+    out << ">\n";
+    for (const auto& [name, values] : g.pointScalars) {
+      out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (double v : values) out << v << "\n";
+      out << "</DataArray>\n";
+    }
+    for (const auto& [name, values] : g.pointVectors) {
+      out << "<DataArray type=\"Float64\" Name=\"" << name << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+      for (const auto& d : values) out << d.x() << " " << d.y() << " " << d.z() << "\n";
+      out << "</DataArray>\n";
+    }
+    out << "</PointData>\n";
+  }
+  if (!g.cellScalars.empty() || !g.cellInts.empty()) {
+    out << "<CellData>\n";
+    for (const auto& [name, values] : g.cellScalars) {
+      out << "<DataArray type=\"Float64\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (double v : values) out << v << "\n";
+      out << "</DataArray>\n";
+    }
+    for (const auto& [name, values] : g.cellInts) {
+      out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"ascii\">\n";
+      for (int v : values) out << v << "\n";
+      out << "</DataArray>\n";
+    }
+    out << "</CellData>\n";
+  }
+  out << "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   out.close();
   if (!out) {
     std::error_code ec;
     std::filesystem::remove(path, ec);  // no partial frame
-    throw OutputWriteError("cannot write '" + path.string() + "' at t = " + std::to_string(s.t) + " (disk full?)");
+    throw OutputWriteError("cannot write '" + path.string() + "' at t = " + timeText(t) + " (disk full?)");
   }
-  times_.push_back(s.t);
-  writeCollection();
 }
 
-void VtkWriter::writeCollection() const {
+Eigen::Vector3d in3d(const Vec2& p) { return {p.x(), p.y(), 0.0}; }
+
+}  // namespace
+
+// ----- the collection -----------------------------------------------------------------------
+
+VtkCollection::VtkCollection(const std::filesystem::path& dir, std::string prefix)
+    : dir_(dir), prefix_(std::move(prefix)) {
+  std::filesystem::create_directories(dir_);
+}
+
+std::filesystem::path VtkCollection::nextFrame() const {
+  char name[64];
+  std::snprintf(name, sizeof(name), "_%06ld.vtu", static_cast<long>(times_.size()));
+  return dir_ / (prefix_ + name);
+}
+
+void VtkCollection::add(double t) {
+  times_.push_back(t);
   const std::filesystem::path path = dir_ / (prefix_ + ".pvd");
   std::ofstream out(path);
   if (!out) throw std::runtime_error("cannot write " + path.string());
@@ -124,6 +147,142 @@ void VtkWriter::writeCollection() const {
     out << "<DataSet timestep=\"" << times_[k] << "\" file=\"" << prefix_ << name << "\"/>\n";
   }
   out << "</Collection>\n</VTKFile>\n";
+}
+
+// ----- multibody systems ----------------------------------------------------------------------
+
+VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix, int subdivisions)
+    : collection_(dir, std::move(prefix)), sys_(sys), subdivisions_(std::max(1, subdivisions)) {
+  rigidPoints_.resize(sys.numBodies());
+  for (int b = 1; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    if (const auto* rb = dynamic_cast<const RigidBody2d*>(&body)) {
+      rigidPoints_[b] = {Vec2::Zero(), rb->com()};
+    } else if (const auto* fb = dynamic_cast<const FfrBody2d*>(&body); fb && !fb->beamModel()) {
+      // flexible_invariants: its attachment points are the only points it can place
+      for (const FfrPoint& p : fb->invariants().points) rigidPoints_[b].push_back(p.position);
+    }
+  }
+  const auto addPoint = [&](BodyIndex b, const Vec2& p) {
+    if (b.value <= 0 || !dynamic_cast<const RigidBody2d*>(&sys.body(b))) return;
+    auto& pts = rigidPoints_[b.value];
+    for (const Vec2& q : pts) {
+      if ((q - p).norm() < 1e-12) return;
+    }
+    pts.push_back(p);
+  };
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    for (const auto& [b, p] : sys.constraint(ConstraintIndex(c)).attachments()) addPoint(b, p);
+  }
+  for (int f = 0; f < sys.numForces(); ++f) {
+    for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p);
+  }
+  for (int b = 1; b < sys.numBodies(); ++b) {
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex(b)));
+    if (rigidPoints_[b].empty() && !(fb && fb->beamModel())) notDrawn_.push_back(sys.body(BodyIndex(b)).name());
+  }
+}
+
+void VtkWriter::write(const OutputSample& s) {
+  Grid g;
+  std::vector<double> axial, moment;
+  std::vector<Eigen::Vector3d> displacement;
+  std::vector<int> bodyIndex;
+  std::vector<std::string> bodyNames;
+  for (int b = 1; b < sys_.numBodies(); ++b) {
+    const Body& body = sys_.body(BodyIndex(b));
+    const auto q = s.q.segment(sys_.coordinateOffset(BodyIndex(b)), body.numCoordinates());
+    const int cellsBefore = static_cast<int>(g.cells.size());
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&body);
+    if (fb && fb->beamModel()) {
+      const FfrBeamModel& m = *fb->beamModel();
+      const VecX qf = q.tail(m.numElastic());
+      const Mat2 A = rotation(q[2]);
+      for (int e = 0; e < static_cast<int>(m.elements().size()); ++e) {
+        std::vector<int> line;
+        for (int k = 0; k <= subdivisions_; ++k) {
+          const double xi = static_cast<double>(k) / subdivisions_;
+          const FfrPoint p = m.materialPoint(e, xi);
+          const Vec2 u = p.shape * qf;
+          line.push_back(static_cast<int>(g.points.size()));
+          g.points.push_back(in3d(q.head<2>() + A * (p.position + u)));
+          displacement.push_back(in3d(A * u));
+          const Vec2 nm = m.sectionForces(qf, e, xi);
+          axial.push_back(nm.x());
+          moment.push_back(nm.y());
+        }
+        g.cells.push_back(line);
+      }
+    } else if (!rigidPoints_[b].empty()) {
+      std::vector<int> line;
+      const Mat2 A = rotation(q[2]);
+      for (std::size_t k = 0; k < rigidPoints_[b].size(); ++k) {
+        line.push_back(static_cast<int>(g.points.size()));
+        g.points.push_back(in3d(body.pointKinematics(q, rigidPoints_[b][k], false).r));
+        // invariants body: u = S_k q_f of its k-th point, world axes
+        displacement.push_back(fb ? in3d(A * (fb->invariants().points[k].shape * q.tail(fb->numElastic())))
+                                  : Eigen::Vector3d::Zero());
+        axial.push_back(0.0);
+        moment.push_back(0.0);
+      }
+      g.cells.push_back(line);
+    }
+    if (static_cast<int>(g.cells.size()) > cellsBefore) {
+      bodyIndex.resize(g.cells.size(), static_cast<int>(bodyNames.size()));
+      bodyNames.push_back(body.name());
+    }
+  }
+  g.pointScalars = {{"axial_force", std::move(axial)}, {"bending_moment", std::move(moment)}};
+  g.pointVectors = {{"elastic_displacement", std::move(displacement)}};
+  g.cellInts = {{"body_index", std::move(bodyIndex)}};
+  g.fieldStrings = {{"body_names", std::move(bodyNames)}};
+  writeVtu(collection_.nextFrame(), g, s.t);
+  collection_.add(s.t);
+}
+
+// ----- tensegrity structures ------------------------------------------------------------------
+
+TensegrityVtkWriter::TensegrityVtkWriter(const std::filesystem::path& dir, const TensegrityStructure& s,
+                                         std::string name, std::string prefix)
+    : collection_(dir, std::move(prefix)), s_(s), name_(name.empty() ? "tensegrity" : std::move(name)) {}
+
+void TensegrityVtkWriter::write(const TensegritySample& smp) {
+  Grid g;
+  g.cellType = kVtkLine;
+  const int d = s_.dimension();
+  std::vector<Eigen::Vector3d> velocity;
+  for (int i = 0; i < s_.numNodes(); ++i) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero(), v = Eigen::Vector3d::Zero();
+    for (int a = 0; a < d; ++a) {
+      x[a] = smp.x[d * i + a];
+      v[a] = smp.v[d * i + a];
+    }
+    g.points.push_back(x);
+    velocity.push_back(v);
+  }
+  std::vector<double> force;
+  std::vector<int> type, slack;
+  std::vector<std::string> names;
+  for (int i = 0; i < s_.numStruts(); ++i) {
+    g.cells.push_back({s_.strut(i).nodeI, s_.strut(i).nodeJ});
+    force.push_back(s_.strutForce(smp.x, i));  // N = EA (l - l0) / l0
+    type.push_back(0);
+    slack.push_back(0);
+    names.push_back(s_.strut(i).name);
+  }
+  for (int c = 0; c < s_.numCables(); ++c) {
+    g.cells.push_back({s_.cable(c).nodeI, s_.cable(c).nodeJ});
+    force.push_back(smp.cableTension[c]);
+    type.push_back(1);
+    slack.push_back(smp.slack[c] ? 1 : 0);
+    names.push_back(s_.cable(c).name);
+  }
+  g.pointVectors = {{"velocity", std::move(velocity)}};
+  g.cellScalars = {{"axial_force", std::move(force)}};
+  g.cellInts = {{"member_type", std::move(type)}, {"slack", std::move(slack)}};
+  g.fieldStrings = {{"body_names", {name_}}, {"member_names", std::move(names)}};
+  writeVtu(collection_.nextFrame(), g, smp.t);
+  collection_.add(smp.t);
 }
 
 }  // namespace flexmbd

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Figures of source document 000 from `flexmbd kinematics` results (kinematics.csv).
 
-  python3 scripts/plot_kinematics.py --slider DIR1 --four-bar DIR2 --out FIGDIR
+  /usr/bin/python3 scripts/plot_kinematics.py --slider DIR1 --four-bar DIR2 --out FIGDIR
       [--slider-node O3] [--four-bar-node O3] [--l1 1 --l2 2]
 
 writes FIGDIR/slider_crank.png (Fig. 5: the slider's x position, velocity and
@@ -9,7 +9,9 @@ acceleration against the crank angle; with --l1/--l2 the exact eqs. 30-32 are dr
 over the computed points), FIGDIR/four_bar_velocity.png (Fig. 7) and
 FIGDIR/four_bar_acceleration.png (Fig. 8): the velocity and acceleration vectors of the
 node at every step, drawn from its position on its path. Either input may be omitted.
-Needs Debian's python3-matplotlib (installed by scripts/setup.sh).
+Needs matplotlib: Debian's python3-matplotlib, installed by scripts/setup.sh for
+/usr/bin/python3. Started by another python3 without matplotlib, the script runs
+itself again with /usr/bin/python3 (or says what is missing).
 """
 import argparse
 import csv
@@ -17,7 +19,23 @@ import math
 import os
 import sys
 
-import matplotlib
+# The set-up (scripts/setup.sh) installs matplotlib for Debian's /usr/bin/python3; the
+# python3 first on a user's PATH (a virtualenv, conda, pyenv) may lack it. Then the
+# script runs itself again through /usr/bin/python3, or says clearly what is missing.
+SYSTEM_PYTHON = "/usr/bin/python3"
+try:
+    import matplotlib
+except ImportError:
+    here = os.path.realpath(sys.executable or "")
+    if (os.path.exists(SYSTEM_PYTHON) and here != os.path.realpath(SYSTEM_PYTHON)
+            and not os.environ.get("FLEXMBD_PLOT_REEXEC")):
+        os.environ["FLEXMBD_PLOT_REEXEC"] = "1"
+        print(f"plot_kinematics: {sys.executable} has no matplotlib; running with {SYSTEM_PYTHON}",
+              file=sys.stderr)
+        os.execv(SYSTEM_PYTHON, [SYSTEM_PYTHON, os.path.abspath(__file__)] + sys.argv[1:])
+    sys.exit(f"plot_kinematics: the Python interpreter {sys.executable} has no matplotlib. "
+             f"Run the script with {SYSTEM_PYTHON} after scripts/setup.sh (which installs "
+             f"Debian's python3-matplotlib), or install matplotlib for this interpreter.")
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

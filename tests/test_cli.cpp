@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -178,4 +180,230 @@ TEST_F(Cli, MechanismThatCannotBeAssembledExitsWith2NamingJoints) {
   EXPECT_NE(r.err.find("residual"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("joint '"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out / "results.csv"));
+}
+
+// ----- issue 12: findings to fix ------------------------------------------------------------
+
+namespace {
+
+const std::string kSourceDir = FLEXMBD_SOURCE_DIR;
+
+/// A results file as columns by name (every cell a number).
+std::map<std::string, std::vector<double>> readColumns(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> names;
+  {
+    std::istringstream h(line);
+    for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  }
+  std::map<std::string, std::vector<double>> cols;
+  while (std::getline(in, line)) {
+    std::istringstream r(line);
+    std::size_t k = 0;
+    for (std::string cell; std::getline(r, cell, ','); ++k) {
+      if (k < names.size()) cols[names[k]].push_back(std::strtod(cell.c_str(), nullptr));
+    }
+  }
+  return cols;
+}
+
+}  // namespace
+
+TEST_F(Cli, SceneOfTheOtherCommandIsRefusedNamingTheCommandItIsFor) {
+  struct Case {
+    std::string command, scene, says;
+  };
+  const std::vector<Case> cases = {
+      {"run", "kinematics_four_bar.json", "is a kinematics scene (key \"analysis\"): run it with \"flexmbd kinematics\""},
+      {"kinematics", "slider_crank_rigid.json", "is a multibody scene (key \"bodies\"): run it with \"flexmbd run\""},
+      {"kinematics", "tensegrity_two_masses.json",
+       "is a tensegrity scene (key \"model\": \"tensegrity\"): run it with \"flexmbd run\""},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.command + " " + c.scene);
+    const fs::path out = dir_ / ("out_" + c.command);
+    const std::string scene = kSourceDir + "/examples/" + c.scene;
+    const CliResult r = run(c.command + " " + shellQuote(scene) + " --out " + shellQuote(out.string()));
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_TRUE(IsOneErrorLine(r.err));
+    EXPECT_NE(r.err.find(scene + " " + c.says), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("unknown key"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out / "results.csv"));
+    EXPECT_FALSE(fs::exists(out / "kinematics.csv"));
+  }
+  // A kinematics scene without "analysis" is still recognised by its links.
+  nlohmann::json k = nlohmann::json::parse(readFile(kSourceDir + "/examples/kinematics_four_bar.json"));
+  k.erase("analysis");
+  const CliResult r = run("run " + shellQuote(writeScene("k.json", k).string()) + " --out " +
+                          shellQuote((dir_ / "out").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("is a kinematics scene (key \"inputs\")"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, QuietIsAcceptedByEveryCommand) {
+  const std::string four = shellQuote(kSourceDir + "/examples/kinematics_four_bar.json");
+  const std::string tens = shellQuote(kSourceDir + "/examples/tensegrity_two_masses.json");
+  const std::vector<std::string> commandLines = {
+      "run " + shellQuote(kExample) + " --t-end 0.2 --quiet",
+      "run " + shellQuote(kExample) + " --t-end 0.2 -q",
+      "kinematics " + four + " --steps 6 --quiet",
+      "kinematics " + four + " --steps 6 -q",
+      "run " + tens + " --quiet",
+      "run " + tens + " -q",
+  };
+  for (std::size_t k = 0; k < commandLines.size(); ++k) {
+    SCOPED_TRACE("flexmbd " + commandLines[k]);
+    const CliResult r = run(commandLines[k] + " --out " + shellQuote((dir_ / ("out" + std::to_string(k))).string()));
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+  }
+}
+
+TEST_F(Cli, LinkageErrorsSayLinkageOnce) {
+  nlohmann::json k = nlohmann::json::parse(readFile(kSourceDir + "/examples/kinematics_four_bar.json"));
+  k["inputs"] = nlohmann::json::array();  // mobility 1, no input
+  const CliResult r = run("kinematics " + shellQuote(writeScene("k.json", k).string()) + " --out " +
+                          shellQuote((dir_ / "out").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("linkage: mobility 1"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("linkage: linkage:"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, NumbersInMessagesArePlainDecimals) {
+  nlohmann::json k = nlohmann::json::parse(readFile(kSourceDir + "/examples/kinematics_four_bar.json"));
+  k["links"][0]["length"] = -80;
+  CliResult r = run("kinematics " + shellQuote(writeScene("k.json", k).string()) + " --out " +
+                    shellQuote((dir_ / "out").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("key \"length\" must be > 0, got -80\n"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("e+01"), std::string::npos) << r.err;
+
+  nlohmann::json j = example();
+  j["bodies"][0]["mass"] = -80;
+  r = run("run " + shellQuote(writeScene("m.json", j).string()) + " --out " + shellQuote((dir_ / "out").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("key \"mass\" must be > 0, got -80\n"), std::string::npos) << r.err;
+  j["bodies"][0]["mass"] = -0.001;
+  r = run("run " + shellQuote(writeScene("m.json", j).string()) + " --out " + shellQuote((dir_ / "out").string()));
+  EXPECT_NE(r.err.find("got -0.001\n"), std::string::npos) << r.err;
+  j["bodies"][0]["mass"] = -2.5e-20;  // far from 1: exponent notation stays
+  r = run("run " + shellQuote(writeScene("m.json", j).string()) + " --out " + shellQuote((dir_ / "out").string()));
+  EXPECT_NE(r.err.find("got -2.5e-20\n"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, ResultsHoldAccelerationsThatMatchTheVelocities) {
+  // The rigid slider-crank driven at 1 rad/s: smooth, so a central difference of a
+  // velocity column over the output step h matches its acceleration column to
+  // h^2/6 |v'''| (about 1e-5 here) plus the integration error.
+  constexpr double kOutputStep = 0.01;
+  constexpr double kFiniteDifferenceTolerance = 1e-4;  // relative to the largest |acceleration|
+  nlohmann::json j = example();
+  j["solver"]["output_step"] = kOutputStep;
+  j["solver"]["t_end"] = 1.0;
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(writeScene("sc.json", j).string()) + " --out " +
+                          shellQuote(out.string()) + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto cols = readColumns(out / "results.csv");
+  for (const char* body : {"crank", "rod", "slider"}) {
+    for (const char* c : {".x", ".y", ".theta"}) {
+      const std::string name = std::string(body) + c;
+      ASSERT_TRUE(cols.count(name + "_ddot")) << name << "_ddot missing";
+      const std::vector<double>& v = cols[name + "_dot"];
+      const std::vector<double>& a = cols[name + "_ddot"];
+      ASSERT_EQ(v.size(), a.size());
+      double scale = 1e-12;
+      for (double x : a) scale = std::max(scale, std::fabs(x));
+      for (std::size_t k = 1; k + 1 < v.size(); ++k) {
+        const double dvdt = (v[k + 1] - v[k - 1]) / (2 * kOutputStep);
+        EXPECT_NEAR(a[k], dvdt, kFiniteDifferenceTolerance * std::max(scale, 1.0)) << name << " at row " << k;
+      }
+    }
+  }
+  // Driven at constant speed: the crank has no angular acceleration; the slider's
+  // x'' = d2/dt2 (cos t + sqrt(4 - sin^2 t)) at t = 0 is -1 - 1/2.
+  for (double x : cols["crank.theta_ddot"]) EXPECT_NEAR(x, 0.0, 1e-8);
+  EXPECT_NEAR(cols["slider.x_ddot"].front(), -1.5, 1e-6);
+  // The order of the columns: positions, velocities, accelerations, then reactions.
+  std::ifstream csv(out / "results.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_LT(header.find("slider.theta_dot,"), header.find("crank.x_ddot,")) << header;
+  EXPECT_LT(header.find("slider.theta_ddot,"), header.find("O1.fx")) << header;
+}
+
+TEST_F(Cli, TensegrityResultsHoldStrutForcesInEquilibrium) {
+  // A mass m hangs at rest from a strut of stiffness EA under gravity g, in its
+  // equilibrium: the strut carries N = m g (tension), length l0 (1 + m g / EA).
+  constexpr double m = 2.0, g = 9.81, EA = 1e4, l0 = 1.0;
+  const double l = l0 * (1.0 + m * g / EA);
+  constexpr double kForceTolerance = 1e-9;  // relative to m g: rounding of l - l0
+  for (const char* method : {"time_stepping", "massless_cables"}) {
+    SCOPED_TRACE(method);
+    nlohmann::json j = {{"model", "tensegrity"}, {"dimension", 2}, {"gravity", {0.0, -g}}};
+    j["nodes"] = {{{"name", "top"}, {"position", {0.0, 0.0}}, {"fixed", true}},
+                  {{"name", "mass"}, {"position", {0.0, -l}}, {"mass", m}}};
+    j["struts"] = {{{"name", "hanger"}, {"nodes", {"top", "mass"}}, {"EA", EA}, {"natural_length", l0}}};
+    if (std::string(method) == "time_stepping") {
+      j["solver"] = {{"method", method}, {"t_end", 0.05}, {"time_step", 1e-3}, {"output_step", 0.01}};
+    } else {
+      j["solver"] = {{"method", method}, {"t_end", 0.05}, {"output_step", 0.01}};
+    }
+    const fs::path out = dir_ / method;
+    const CliResult r = run("run " + shellQuote(writeScene(std::string(method) + ".json", j).string()) + " --out " +
+                            shellQuote(out.string()));
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto cols = readColumns(out / "results.csv");
+    ASSERT_TRUE(cols.count("hanger.force")) << "no strut force column";
+    ASSERT_TRUE(cols.count("hanger.length"));
+    ASSERT_GE(cols["hanger.force"].size(), 5u);
+    for (double N : cols["hanger.force"]) EXPECT_NEAR(N, m * g, kForceTolerance * m * g);
+    for (double L : cols["hanger.length"]) EXPECT_NEAR(L, l, 1e-12);
+  }
+}
+
+TEST_F(Cli, VtkFramesOfATensegritySceneHoldItsNodesMembersAndName) {
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(kSourceDir + "/examples/tensegrity_two_masses.json") + " --out " +
+                          shellQuote(out.string()) + " --vtk");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_TRUE(fs::exists(out / "vtk" / "bodies.pvd"));
+  const std::string vtu = readFile(out / "vtk" / "bodies_000000.vtu");
+  EXPECT_NE(vtu.find("NumberOfPoints=\"2\" NumberOfCells=\"1\""), std::string::npos) << vtu;
+  EXPECT_NE(vtu.find("Name=\"body_names\""), std::string::npos) << vtu;
+  EXPECT_NE(vtu.find("Name=\"member_names\""), std::string::npos) << vtu;
+  EXPECT_NE(vtu.find("<!-- member_names: c -->"), std::string::npos) << vtu;
+  EXPECT_NE(vtu.find("<!-- body_names: two masses"), std::string::npos) << vtu;
+  // Every row of results.csv has its frame.
+  const std::string csv = readFile(out / "results.csv");
+  const long rows = std::count(csv.begin(), csv.end(), '\n') - 1;
+  char last[64];
+  std::snprintf(last, sizeof last, "bodies_%06ld.vtu", rows - 1);
+  EXPECT_TRUE(fs::exists(out / "vtk" / last)) << last;
+}
+
+TEST_F(Cli, VtkSaysOnStderrWhichBodyItCannotDraw) {
+  // A flexible_invariants body without attachment points has nothing to draw.
+  nlohmann::json j = nlohmann::json::parse(readFile(kSourceDir + "/examples/bari_slider_crank.json"));
+  nlohmann::json loose;
+  for (const auto& b : j["bodies"]) {
+    if (b["type"] == "flexible_invariants") loose = b;
+  }
+  ASSERT_FALSE(loose.is_null());
+  loose["name"] = "loose";
+  loose["invariants"].erase("points");
+  loose["position"] = {5.0, 5.0};
+  j["bodies"].push_back(loose);
+  j["solver"]["t_end"] = 0.001;
+  j["solver"]["output_step"] = 0.001;
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(writeScene("loose.json", j).string()) + " --out " +
+                          shellQuote(out.string()) + " --vtk --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: --vtk: body \"loose\" has no points to draw"), std::string::npos) << r.err;
+  const std::string vtu = readFile(out / "vtk" / "bodies_000000.vtu");
+  EXPECT_NE(vtu.find("<!-- body_names: crank, rod, slider -->"), std::string::npos) << vtu.substr(0, 200);
 }

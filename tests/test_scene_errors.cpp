@@ -10,7 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
+#include "io/kinematics_scene.hpp"
 #include "io/scene.hpp"
 
 namespace flexmbd {
@@ -560,4 +562,48 @@ TEST(SceneParse, ToleranceClassesAndIntegrator) {
 }
 
 }  // namespace
+// ----- issue 12 ---------------------------------------------------------------------------
+
+TEST(NumberText, PlainDecimalsNearOneExponentsFarFromIt) {
+  EXPECT_EQ(shortestNumberText(-80), "-80");  // was "-8e+01"
+  EXPECT_EQ(shortestNumberText(100), "100");
+  EXPECT_EQ(shortestNumberText(123456.5), "123456.5");
+  EXPECT_EQ(shortestNumberText(999999), "999999");
+  EXPECT_EQ(shortestNumberText(1e6), "1e+06");
+  EXPECT_EQ(shortestNumberText(0.1), "0.1");
+  EXPECT_EQ(shortestNumberText(1e-4), "0.0001");
+  EXPECT_EQ(shortestNumberText(1e-5), "1e-05");
+  EXPECT_EQ(shortestNumberText(0.0), "0");
+  EXPECT_EQ(shortestNumberText(-2.5e-20), "-2.5e-20");
+  for (double x : {-80.0, 0.1, 1.0 / 3.0, 123456.789, 6.02214076e23, 1e-300}) {
+    EXPECT_EQ(std::strtod(shortestNumberText(x).c_str(), nullptr), x) << shortestNumberText(x);
+  }
+}
+
+TEST(SceneKind, ASceneOfAnotherFormatNamesTheCommandItIsFor) {
+  const std::string kinematics = R"({"nodes": [], "links": [], "inputs": [], "analysis": {}})";
+  try {
+    parseSceneText(kinematics, "four_bar.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "four_bar.json is a kinematics scene (key \"analysis\"): run it with \"flexmbd kinematics\"");
+  }
+  try {
+    parseKinematicsSceneText(baseScene().dump(), "crank.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "crank.json is a multibody scene (key \"bodies\"): run it with \"flexmbd run\"");
+  }
+  // Keys of both formats: not recognised, the reader names the foreign key.
+  json mixed = baseScene();
+  mixed["links"] = json::array();
+  try {
+    parseSceneText(mixed.dump(), "mixed.json");
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key \"links\""), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace flexmbd

@@ -10,7 +10,10 @@
 #include <regex>
 #include <sstream>
 
+#include "bodies/ffr_body_2d.hpp"
+#include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
+#include "bodies/tensegrity_structure.hpp"
 #include "tests/ffr_test_models.hpp"
 
 using namespace flexmbd;
@@ -27,13 +30,42 @@ std::string read(const fs::path& p) {
 
 /// The numbers of the first DataArray named `name` (or of the Points array if empty).
 std::vector<double> dataArray(const std::string& xml, const std::string& name) {
-  const std::string key = name.empty() ? "<Points>" : "Name=\"" + name + "\"";
-  const size_t start = xml.find('>', xml.find("<DataArray", xml.find(key))) + 1;
+  // The array's own tag: the first after <Points>, or the one holding Name="name".
+  const size_t tag = name.empty() ? xml.find("<DataArray", xml.find("<Points>"))
+                                  : xml.rfind("<DataArray", xml.find("Name=\"" + name + "\""));
+  if (tag == std::string::npos || (!name.empty() && xml.find("Name=\"" + name + "\"") == std::string::npos)) return {};
+  const size_t start = xml.find('>', tag) + 1;
   const size_t end = xml.find("</DataArray>", start);
   std::istringstream in(xml.substr(start, end - start));
   std::vector<double> v;
   for (double x; in >> x;) v.push_back(x);
   return v;
+}
+
+/// The strings of the FieldData String array `name`: ASCII character codes, each string
+/// ended by 0 (the format vtkXMLWriter uses for string arrays).
+std::vector<std::string> stringArray(const std::string& xml, const std::string& name) {
+  const size_t at = xml.find("<DataArray type=\"String\" Name=\"" + name + "\"");
+  if (at == std::string::npos) return {};
+  const size_t start = xml.find('>', at) + 1;
+  std::istringstream in(xml.substr(start, xml.find("</DataArray>", start) - start));
+  std::vector<std::string> out(1);
+  for (int c; in >> c;) {
+    if (c == 0) {
+      out.emplace_back();
+    } else {
+      out.back() += static_cast<char>(c);
+    }
+  }
+  out.pop_back();  // after the last 0
+  return out;
+}
+
+/// The integers of the DataArray named `name`.
+std::vector<int> intArray(const std::string& xml, const std::string& name) {
+  std::vector<int> out;
+  for (double x : dataArray(xml, name)) out.push_back(static_cast<int>(x));
+  return out;
 }
 
 }  // namespace
@@ -74,5 +106,103 @@ TEST(VtkWriter, WritesOneFilePerOutputAndTheBeamAxisMeetsTheJoints) {
     if ((Vec2(pts[k], pts[k + 1]) - tip).norm() < 1e-6) ++matches;  // written with 12 digits
   }
   EXPECT_GE(matches, 2);  // the crank's point and the rod's first point
+  // The frame names its bodies: one entry per body drawn, one index per cell.
+  std::vector<std::string> names;
+  for (int b = 1; b < sys.numBodies(); ++b) names.push_back(sys.body(BodyIndex(b)).name());
+  EXPECT_EQ(stringArray(vtu, "body_names"), names);
+  const std::vector<int> index = intArray(vtu, "body_index");
+  EXPECT_EQ(index.size(), dataArray(vtu, "offsets").size());
+  for (int b : index) EXPECT_TRUE(b >= 0 && b < static_cast<int>(names.size())) << b;
+  EXPECT_EQ(index.front(), 0);
+  EXPECT_EQ(index.back(), static_cast<int>(names.size()) - 1);
+  fs::remove_all(dir);
+}
+
+TEST(VtkWriter, InvariantsBodyIsDrawnThroughItsAttachmentPoints) {
+  // examples/bari_slider_crank.json: the rod is a flexible_invariants body with two
+  // attachment points, deformed by its initial elastic coordinates.
+  const Scene scene = loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json");
+  const System& sys = scene.system;
+  const fs::path dir = fs::temp_directory_path() / ("flexmbd_vtk_inv_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  OutputSample sample;
+  sample.q = sys.initialCoordinates();
+  sample.v = VecX::Zero(sample.q.size());
+  sample.a = sample.v;
+  sample.lambda = VecX::Zero(sys.numConstraintEquations());
+  {
+    VtkWriter vtk(dir, sys);
+    vtk.write(sample);
+  }
+  const std::string vtu = read(dir / "bodies_000000.vtu");
+  const std::vector<std::string> names = stringArray(vtu, "body_names");
+  ASSERT_EQ(names, (std::vector<std::string>{"crank", "rod", "slider"}));
+  EXPECT_NE(vtu.find("<!-- body_names: crank, rod, slider -->"), std::string::npos);
+  // The rod's cell: its points are the attachment points where the body places them.
+  const BodyIndex rod = sys.findBody("rod");
+  const auto& body = dynamic_cast<const FfrBody2d&>(sys.body(rod));
+  const std::vector<int> index = intArray(vtu, "body_index"), offsets = intArray(vtu, "offsets"),
+                         connectivity = intArray(vtu, "connectivity");
+  const std::vector<double> pts = dataArray(vtu, "");
+  ASSERT_EQ(index.size(), 3u);
+  ASSERT_EQ(index[1], 1);
+  const int first = offsets[0], count = offsets[1] - offsets[0];
+  ASSERT_EQ(count, static_cast<int>(body.invariants().points.size()));
+  const auto q = sample.q.segment(sys.coordinateOffset(rod), body.numCoordinates());
+  for (int k = 0; k < count; ++k) {
+    const int p = connectivity[first + k];
+    const Vec2 expected = body.pointKinematics(q, body.invariants().points[k].position, false).r;
+    EXPECT_NEAR(pts[3 * p], expected.x(), 1e-9);
+    EXPECT_NEAR(pts[3 * p + 1], expected.y(), 1e-9);
+  }
+  // Its elastic displacement is drawn (the example starts deformed).
+  const std::vector<double> u = dataArray(vtu, "elastic_displacement");
+  double largest = 0.0;
+  for (int k = 0; k < count; ++k) {
+    const int p = connectivity[first + k];
+    largest = std::max({largest, std::fabs(u[3 * p]), std::fabs(u[3 * p + 1])});
+  }
+  EXPECT_GT(largest, 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(VtkWriter, TensegrityFramesHoldNodesMembersForcesAndNames) {
+  // A 2D triangle: two struts and a cable; the strut force is EA (l - l0) / l0.
+  TensegrityStructure s(2);
+  s.setMaxStrutsPerNode(2);
+  s.addNode("a", Vec2(0, 0), 1.0, {true, true}, Vec2::Zero());
+  s.addNode("b", Vec2(1, 0), 1.0, {false, false}, Vec2::Zero());
+  s.addNode("c", Vec2(0, 1), 1.0, {false, false}, Vec2::Zero());
+  s.addStrut("ab", 0, 1, 100.0, 0.9, 0.0, BarMassModel::Lumped);
+  s.addStrut("ac", 0, 2, 100.0, 1.0, 0.0, BarMassModel::Lumped);
+  s.addCable("bc", 1, 2, 50.0, 1.0, false);
+  s.finalize();
+  TensegritySample smp;
+  smp.x = s.initialPositions();
+  smp.v = VecX::Zero(smp.x.size());
+  smp.cableTension = VecX::Constant(1, 7.5);
+  smp.cableImpulse = VecX::Zero(1);
+  smp.cableLength = VecX::Constant(1, std::sqrt(2.0));
+  smp.slack = {false};
+  const fs::path dir = fs::temp_directory_path() / ("flexmbd_vtk_tens_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  {
+    TensegrityVtkWriter vtk(dir, s, "");
+    vtk.write(smp);
+    EXPECT_EQ(vtk.filesWritten(), 1);
+  }
+  const std::string vtu = read(dir / "bodies_000000.vtu");
+  EXPECT_EQ(stringArray(vtu, "body_names"), (std::vector<std::string>{"tensegrity"}));
+  EXPECT_EQ(stringArray(vtu, "member_names"), (std::vector<std::string>{"ab", "ac", "bc"}));
+  EXPECT_EQ(dataArray(vtu, "").size(), 9u);  // three nodes, z = 0
+  EXPECT_EQ(intArray(vtu, "connectivity"), (std::vector<int>{0, 1, 0, 2, 1, 2}));
+  EXPECT_EQ(intArray(vtu, "types"), (std::vector<int>{3, 3, 3}));  // VTK_LINE
+  EXPECT_EQ(intArray(vtu, "member_type"), (std::vector<int>{0, 0, 1}));
+  const std::vector<double> N = dataArray(vtu, "axial_force");
+  ASSERT_EQ(N.size(), 3u);
+  EXPECT_NEAR(N[0], 100.0 * (1.0 - 0.9) / 0.9, 1e-9);
+  EXPECT_NEAR(N[1], 0.0, 1e-12);
+  EXPECT_NEAR(N[2], 7.5, 1e-12);
+  EXPECT_TRUE(fs::exists(dir / "bodies.pvd"));
   fs::remove_all(dir);
 }
