@@ -26,7 +26,11 @@ constexpr int kMaxNewtonIterations = 10;
 /// Convergence where the multiplier iteration stalls on a nearly dependent constraint: the
 /// violation below kConstraintTolerance of the smallest error weight, the last correction
 /// below kSingularNewtonTolerance of the weights (the step's local error is 1 in them).
-constexpr double kConstraintTolerance = 1e-2, kSingularNewtonTolerance = 0.5;
+constexpr double kConstraintTolerance = 1.0, kSingularNewtonTolerance = 0.5;
+/// ... or the iteration has stalled (corrections shrinking by less than this factor): the
+/// violation left is along a nearly dependent direction, which only a move along the
+/// bifurcation direction could remove.
+constexpr double kStalledContraction = 0.8;
 /// Round-off levels, in units of epsilon (|q| + model size): a constraint violation below
 /// kRoundOffViolation is not fed into the multipliers, a Newton correction below
 /// kRoundOffCorrection ends the iteration (tight atol can ask for less than round-off).
@@ -67,6 +71,8 @@ struct AugmentedLagrangianIntegrator::Impl {
   VecX q, v, a, lam, qPrev, vPrev, aPrev;
   IntegratorStats stats;
   long forcedSteps = 0;  ///< steps accepted with an error estimate that is not truncation error
+  bool errorTest = true;
+  double fixedStep = 0.0;  ///< step size without the error test
 
   Impl(const System& s, const AugmentedLagrangianOptions& o)
       : sys(s), opt(o), ggl(s, Formulation::Ggl), index1(s, Formulation::Index1),
@@ -125,6 +131,8 @@ struct AugmentedLagrangianIntegrator::Impl {
     lamN = lam;
     weights(q);
     const double roundOffScale = std::numeric_limits<double>::epsilon() * (opt.lengthScale + q.cwiseAbs().maxCoeff());
+    // tolerance of a constraint violation (length units): the error weight of a coordinate of the model's size
+    const double constraintScaleTolerance = opt.rtol * opt.lengthScale + opt.atolPosition.minCoeff();
     double lastNorm = 0.0;
     bool converged = false;
     for (int it = 0; it < kMaxNewtonIterations; ++it) {
@@ -157,8 +165,9 @@ struct AugmentedLagrangianIntegrator::Impl {
       // Near a singular position the multiplier iteration barely moves a violation along the
       // nearly dependent constraint direction (contraction 1 - alpha sigma_min^2 / ...): a
       // violation far below atol with corrections inside the error weights is converged.
-      const bool satisfied = it > 0 && m > 0 && norm <= kSingularNewtonTolerance &&
-                             g.cwiseAbs().maxCoeff() <= kConstraintTolerance * w.minCoeff();
+      const bool stalled = it > 1 && norm > kStalledContraction * lastNorm;
+      const bool satisfied = it > 0 && m > 0 && (norm <= kSingularNewtonTolerance || stalled) &&
+                             g.cwiseAbs().maxCoeff() <= kConstraintTolerance * constraintScaleTolerance;
       if ((norm <= kNewtonTolerance && it > 0) || atRoundOff || satisfied) {
         converged = true;
         break;
@@ -254,10 +263,10 @@ double AugmentedLagrangianIntegrator::step(double tStop) {
     // An error that does not fall as the step shrinks is not the truncation error (h^3): near
     // a singular position it is the correction of the last step's violation along a nearly
     // dependent constraint, (4/h^2) delta q in the accelerations. Bounded, it is accepted.
-    const bool notTruncation = rejectedStep >= kArtifactShrink * hh && e >= kArtifactPersistence * rejectedError &&
-                               e <= kMaxArtifactError;
+    const bool notTruncation = rejectedStep >= kArtifactShrink * hh &&
+                               e >= kArtifactPersistence * rejectedError * (hh / rejectedStep) && e <= kMaxArtifactError;
     if (notTruncation) ++s.forcedSteps;
-    if (!(e <= 1.0) && !notTruncation) {
+    if (!(e <= 1.0) && !notTruncation && s.errorTest) {
       if (rejectedStep == 0.0) {
         rejectedError = e;
         rejectedStep = hh;
@@ -279,8 +288,13 @@ double AugmentedLagrangianIntegrator::step(double tStop) {
     s.stats.lastStepSize = hh;
     s.stats.currentTime = s.t;
     // a step shortened to land on tStop does not shrink the next one
-    s.h = last ? std::max(s.h, hh * std::clamp(factor, kMinShrink, kMaxGrowth))
-               : hh * std::clamp(factor, kMinShrink, kMaxGrowth);
+    if (s.errorTest) {
+      s.h = last ? std::max(s.h, hh * std::clamp(factor, kMinShrink, kMaxGrowth))
+                 : hh * std::clamp(factor, kMinShrink, kMaxGrowth);
+    } else if (!last) {
+      // without the error test: the size set when it was switched off, regained after Newton failures
+      s.h = std::min(kMaxGrowth * hh, s.fixedStep);
+    }
     if (s.opt.maxStepSize > 0.0) s.h = std::min(s.h, s.opt.maxStepSize);
     return s.t;
   }
@@ -293,6 +307,11 @@ const VecX& AugmentedLagrangianIntegrator::a() const { return impl_->a; }
 const VecX& AugmentedLagrangianIntegrator::lambda() const { return impl_->lam; }
 IntegratorStats AugmentedLagrangianIntegrator::stats() const { return impl_->stats; }
 long AugmentedLagrangianIntegrator::forcedSteps() const { return impl_->forcedSteps; }
+void AugmentedLagrangianIntegrator::setErrorTest(bool on) {
+  if (!on && impl_->errorTest) impl_->fixedStep = impl_->h;
+  impl_->errorTest = on;
+}
+double AugmentedLagrangianIntegrator::nextStepSize() const { return impl_->h; }
 
 void AugmentedLagrangianIntegrator::interpolate(double tt, VecX& qq, VecX& vv) const {
   const Impl& s = *impl_;

@@ -63,6 +63,12 @@ class AugmentedLagrangianIntegrator {
   /// the step shrank (not a truncation error: the correction of a constraint violation
   /// along a nearly dependent direction at a singular position).
   long forcedSteps() const;
+  /// Off: every step whose Newton iteration converges is accepted and the step size is
+  /// the one planned when it was switched off (shrunk by Newton failures, regained after). For the core of a singular position, where
+  /// positions along the nearly dependent directions are determined only to the Newton
+  /// tolerance and the error estimate measures that, not the truncation error.
+  void setErrorTest(bool on);
+  double nextStepSize() const;
 
  private:
   struct Impl;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/SVD>
@@ -97,6 +98,13 @@ constexpr double kCrossingTrigger = 0.5;
 /// times its value where it began (at most kCrossingEndConditioning of the start's): IDA
 /// fails where the ratio is so small for its tolerance, so it restarts well above that.
 constexpr double kCrossingEndFactor = 4.0, kCrossingEndConditioning = 0.9;
+/// The core of a crossing, from where it begins until the singular value ratio of G, past
+/// its minimum, is back at its value there: ALI3-P takes steps of 1/kCoreStepDivisor of the
+/// DAE integrator's last regular step (at its last output) without error test (see
+/// AugmentedLagrangianIntegrator::setErrorTest): its error estimate measures the positions
+/// along the nearly dependent directions, known only to the Newton tolerance, not the
+/// truncation error, and collapses the steps (measured on a multi-parallelogram).
+constexpr double kCoreStepDivisor = 2.0;
 /// Tolerances of a crossing relative to the run's: ALI3-P is of order 2 against IDA's 5, so
 /// its local errors are held smaller for global errors of the same size.
 constexpr double kCrossingToleranceFactor = 1e-2;
@@ -104,6 +112,8 @@ constexpr double kCrossingToleranceFactor = 1e-2;
 /// round-off near the singular position (accelerations along the nearly dependent
 /// direction are determined to 1/sigma_min) and the steps collapse (measured).
 constexpr double kMinCrossingRtol = 1e-12;
+/// ... and absolute ones not below 1e3 round-offs of the model size.
+constexpr double kMinCrossingAtolRoundOffs = 1e3;
 /// An integrator that fails within this many steps of its restart after a crossing has not
 /// left the singular position's neighbourhood: the crossing goes on, to twice the ratio.
 constexpr long kRestartSteps = 50;
@@ -501,6 +511,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   const long nOut = std::max(1L, static_cast<long>(std::ceil((tEnd - t0) / settings.outputStep - 1e-9)));
   const auto outputTime = [&](long k) { return k == nOut ? tEnd : std::min(tEnd, t0 + k * settings.outputStep); };
   long k = 1;  // the next output
+  double regularStep = 0.0;  // the DAE integrator's last step size at an output: the size of a crossing's steps
   const auto totalSteps = [&] { return finished.steps + (integrator ? integrator->stats().steps : 0); };
 
   // Across a singular position where the integrator stopped: ALI3-P from the last output
@@ -515,13 +526,18 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     AugmentedLagrangianOptions bo;
     const double factor = std::max(kCrossingToleranceFactor, kMinCrossingRtol / settings.rtol);
     bo.rtol = settings.rtol * factor;
-    bo.atolPosition = factor * o.atol.segment(L.q, L.nq);
+    // not below round-off of the model's size (coordinates near 0 have weight atol alone)
+    bo.atolPosition = (factor * o.atol.segment(L.q, L.nq))
+                          .cwiseMax(kMinCrossingAtolRoundOffs * std::numeric_limits<double>::epsilon() * modelSize);
     bo.maxStepSize = settings.maxStepSize;
     bo.minStepSize = o.minStepSize;
     bo.lengthScale = modelSize;
+    bo.initialStepSize = regularStep / kCoreStepDivisor;
     AugmentedLagrangianIntegrator ali(sys, start.t, start.q, start.v, start.a, start.lambda, bo);
-    const double endRatio =
-        std::min(endFactor * ali.constraintConditioning(), kCrossingEndConditioning * startRatio);
+    const double ratio0 = ali.constraintConditioning();
+    const double endRatio = std::min(endFactor * ratio0, kCrossingEndConditioning * startRatio);
+    double minRatio = ratio0;
+    ali.setErrorTest(false);
     VecX qi, vi;
     try {
       for (long steps = 0;; ++steps) {
@@ -536,7 +552,10 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
           progress.update(outputTime(k), totalSteps() + ali.stats().steps);
         }
         if (t >= tEnd) break;
-        if (t > failure.time() && ali.constraintConditioning() >= endRatio) break;
+        const double ratio = ali.constraintConditioning();
+        minRatio = std::min(minRatio, ratio);
+        if (ratio > minRatio && ratio >= ratio0) ali.setErrorTest(true);  // the core is passed
+        if (t > failure.time() && ratio >= endRatio) break;
       }
     } catch (const SolverError& e) {
       addStats(finished, ali.stats());
@@ -582,6 +601,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
           const double t = integrator->advance(outputTime(k), tEnd);
           emit(t, integrator->y().segment(L.q, L.nq), integrator->y().segment(L.v, L.nq));
           progress.update(t, totalSteps());
+          regularStep = integrator->stats().lastStepSize;
         }
       } catch (const SolverError& e) {
         if (!mayCross || largestCoordinate > kDivergedSize * modelSize) throw;
