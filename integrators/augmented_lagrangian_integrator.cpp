@@ -5,6 +5,7 @@
 #include <sstream>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
@@ -19,6 +20,14 @@ namespace {
 /// constraint direction by ~1/kPenalty per Newton iteration, while the Newton matrix loses
 /// ~log10(kPenalty) = 6 of its 16 digits: enough for rtol down to 1e-10.
 constexpr double kPenalty = 1e6;
+/// Constraint directions whose singular value is below this fraction of the largest are
+/// nearly dependent: the multiplier iteration contracts there by 1 / (1 + kPenalty
+/// kDependentRatio^2) = 1e-2 per iteration at best, and not at all at the singular position.
+constexpr double kDependentRatio = 3e-3;
+/// A converged position may violate the constraints by at most kMaxViolation error weights
+/// of a coordinate of the model's size: more is left only where no position satisfies
+/// them (past a driven lock-up, with the nearly dependent directions not corrected).
+constexpr double kMaxViolation = 10.0;
 /// Newton on the positions has converged when the correction is below this fraction of
 /// the error weights (the step's local error is 1 in these units).
 constexpr double kNewtonTolerance = 1e-3;
@@ -65,7 +74,9 @@ struct AugmentedLagrangianIntegrator::Impl {
   VecX y, yp, F, y1, yp1, F1;
   MatX J, P, G;
   Eigen::PartialPivLU<MatX> lu;
-  VecX r, dq, w, qN, vN, aN, lamN, err;
+  VecX r, dq, w, qN, vN, aN, lamN, err, g;
+  MatX gram;  // G G^T (m x m) and its eigen-decomposition: the nearly dependent constraint directions
+  Eigen::SelfAdjointEigenSolver<MatX> eig;
   // state at the end of the last step and at its start
   double t = 0.0, tPrev = 0.0, h = 0.0, massScale = 1.0, constraintScale = 1.0;
   VecX q, v, a, lam, qPrev, vPrev, aPrev;
@@ -85,7 +96,9 @@ struct AugmentedLagrangianIntegrator::Impl {
     G = MatX::Zero(m, nq);
     lu = Eigen::PartialPivLU<MatX>(nq);
     r = dq = w = qN = vN = aN = err = VecX::Zero(nq);
-    lamN = VecX::Zero(m);
+    lamN = g = VecX::Zero(m);
+    gram = MatX::Zero(m, m);
+    eig = Eigen::SelfAdjointEigenSolver<MatX>(m);
   }
 
   /// F (GGL, mu = 0) at (q, v, a) with multipliers lam; with the Jacobian dF/dy + cj dF/dy' if asked.
@@ -141,7 +154,22 @@ struct AugmentedLagrangianIntegrator::Impl {
       aN = (4.0 / (hh * hh)) * (qN - q) - (4.0 / hh) * v - a;
       evaluate(tn, qN, vN, aN, lamN, true, 2.0 / hh);
       ++stats.nonlinearIterations;
-      const auto g = F.segment(L.lambda, m);
+      // the violation to correct: g without its components along the nearly dependent
+      // constraint directions (u_k of G G^T = U S^2 U^T with s_k < kDependentRatio s_max).
+      // There a violation is of second order in a move along the bifurcation direction,
+      // which the multiplier iteration would make in ill-conditioned small steps; the
+      // position along it is left to the inertia (the predictor), as in the exact motion.
+      g = F.segment(L.lambda, m);
+      const double violation = m > 0 ? g.cwiseAbs().maxCoeff() : 0.0;
+      if (m > 0) {
+        gram.noalias() = G * G.transpose();
+        eig.compute(gram);
+        const double cut = kDependentRatio * kDependentRatio * std::max(eig.eigenvalues()[m - 1], 0.0);
+        for (int k = 0; k < m && eig.eigenvalues()[k] < cut; ++k) {
+          const auto u = eig.eigenvectors().col(k);
+          g -= u.dot(g) * u;
+        }
+      }
       r = F.segment(L.v, nq);
       if (m > 0) {
         // multiplier update lambda* += alpha g(q_{k+1}) (Bayo & Ledesma 1996, eq. 20), not on a
@@ -169,7 +197,9 @@ struct AugmentedLagrangianIntegrator::Impl {
       const bool satisfied = it > 0 && m > 0 && (norm <= kSingularNewtonTolerance || stalled) &&
                              g.cwiseAbs().maxCoeff() <= kConstraintTolerance * constraintScaleTolerance;
       if ((norm <= kNewtonTolerance && it > 0) || atRoundOff || satisfied) {
-        converged = true;
+        // the whole violation, the nearly dependent directions included: where it is not
+        // small no position satisfies the constraints (a driven lock-up), not a crossing
+        converged = violation <= kMaxViolation * constraintScaleTolerance;
         break;
       }
       if (it > 1 && norm > 2.0 * lastNorm) return false;  // diverging

@@ -13,6 +13,9 @@ namespace flexmbd {
 namespace {
 
 constexpr int kMaxProjectionIterations = 50;
+/// Relative residual up to which dependent constraint rows count as agreeing (their
+/// accelerations determined): 1e-8, far above round-off, far below a real conflict.
+constexpr double kConsistentRows = 1e-8;
 /// Above this size the augmented system is solved with a sparse LU.
 constexpr int kDenseAugmentedLimit = 200;
 
@@ -93,10 +96,30 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
   MatX G;
   evaluateConstraints(sys, q, t, nullptr, &G);
   const MatX M = massMatrix(sys, q);
+  const VecX Q = generalizedForces(sys, t, q, v), rhs = accelerationConstraintRhs(sys, q, v, t);
   try {
-    solveAugmented(M, G, generalizedForces(sys, t, q, v), accelerationConstraintRhs(sys, q, v, t), a, lambda);
+    solveAugmented(M, G, Q, rhs, a, lambda);
   } catch (const ModelError& e) {
     const std::vector<int> rows = dependentRows(G);
+    // At a singular position the accelerations are still unique (M is regular) when the
+    // constraint rows agree: a = M^-1 (Q - G^T lambda) with the minimum-norm multipliers of
+    // (G M^-1 G^T) lambda = G M^-1 Q - rhs (the mass-orthogonal projection of M^-1 Q).
+    if (!rows.empty()) {
+      const Eigen::LDLT<MatX> Mf(M);
+      if (Mf.info() == Eigen::Success) {
+        const MatX MiGt = Mf.solve(G.transpose());
+        const VecX MiQ = Mf.solve(Q);
+        const VecX l = (G * MiGt).completeOrthogonalDecomposition().solve(G * MiQ - rhs);
+        const VecX acc = MiQ - MiGt * l;
+        // the rows agree when the projected accelerations satisfy them (to round-off of the terms)
+        const double scale = (G * MiQ).cwiseAbs().maxCoeff() + rhs.cwiseAbs().maxCoeff() + 1.0;
+        if (acc.allFinite() && l.allFinite() && (G * acc - rhs).cwiseAbs().maxCoeff() <= kConsistentRows * scale) {
+          a = acc;
+          lambda = l;
+          return;
+        }
+      }
+    }
     std::string rank;
     for (size_t k = 0; k < rows.size(); ++k) rank += (k ? "; " : "") + sys.describeEquation(rows[k]);
     throw ModelError(e.what() + massDiagonalReport(sys, M) +

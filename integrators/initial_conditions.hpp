@@ -25,7 +25,9 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
 
 /// Accelerations and multipliers of the state (q, v) at time t, from the augmented
-/// system [M G^T; G 0][a; lambda] = [Q; f'' - v^T H v] (index-1 equations).
+/// system [M G^T; G 0][a; lambda] = [Q; f'' - v^T H v] (index-1 equations). At a
+/// singular position (G rank-deficient, its rows consistent) the accelerations are the
+/// unique mass-orthogonal projection and the multipliers the minimum-norm ones.
 void computeAccelerations(const System& sys, double t, const VecX& q, const VecX& v, VecX& a,
                           VecX& lambda);
 
