@@ -43,8 +43,9 @@ struct FfrBeamOptions {
   /// (under the reference conditions); `modeSet` (1-based) keeps a chosen set instead.
   int modes = 0;
   std::vector<int> modeSet;
-  /// Second-order axial strain eps = u' + v'^2/2 in the strain energy (stiffening by
-  /// axial load); off: the linear FFR model (docs/flexible-bodies.md).
+  /// Second-order axial strain in the strain energy (stiffening by axial load), as the
+  /// element-averaged membrane strain u' + (1/2l) int v'^2 dx (locking-free); off: the
+  /// linear FFR model (docs/flexible-bodies.md).
   bool geometricStiffening = false;
 };
 

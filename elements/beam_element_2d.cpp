@@ -68,6 +68,15 @@ BeamElement2d::BeamElement2d(const Vec2& start, const Vec2& end, const BeamSecti
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) K_(b[i], b[j]) = ei * kb[i][j];
   }
+  Kb_ = K_;
+  Kb_(0, 0) = Kb_(3, 3) = Kb_(0, 3) = Kb_(3, 0) = 0.0;
+  // Slope-shape integral G = int_0^l b^T b dx (degree 4: the 5-point rule is exact);
+  // its transverse block is the classical geometric stiffness (1/(30 l)) [36, 3l, ...].
+  G_.setZero();
+  for (size_t g = 0; g < kGaussXi.size(); ++g) {
+    const Row6 bg = slopeShape(kGaussXi[g], l);
+    G_ += (kGaussW[g] * l) * bg.transpose() * bg;
+  }
 }
 
 BeamElement2d::Mat26 BeamElement2d::shape(double xi, double l) {
@@ -97,58 +106,44 @@ BeamElement2d::Row6 BeamElement2d::axialStrainShape(double l) {
   return r;
 }
 
+// Membrane locking and the averaged membrane strain: Stolarski & Belytschko, "Membrane
+// locking and reduced integration for curved elements", J. Appl. Mech. 49 (1982);
+// Crisfield, Non-linear Finite Element Analysis of Solids and Structures vol. 1 (1991).
+// With a = axialStrainShape, G = int b^T b dx and d = a^T + G e / l:
+
+double BeamElement2d::membraneStrain(const Vec6& e, bool stiffening) const {
+  const double du = axialStrainShape(l_).dot(e);
+  if (!stiffening) return du;
+  return du + 0.5 * e.dot(G_ * e) / l_;  // eps_m = a e + e^T G e / (2l)
+}
+
 double BeamElement2d::strainEnergy(const Vec6& e, bool stiffening) const {
   if (!stiffening) return 0.5 * e.dot(K_ * e);
-  const double EA = section_.axialStiffness(), EI = section_.bendingStiffness();
-  const double du = axialStrainShape(l_).dot(e);
-  double U = 0.0;
-  for (size_t g = 0; g < kGaussXi.size(); ++g) {
-    const double xi = kGaussXi[g], w = kGaussW[g] * l_;
-    const double dv = slopeShape(xi, l_).dot(e), kappa = curvatureShape(xi, l_).dot(e);
-    const double eps = du + 0.5 * dv * dv;  // second-order axial strain
-    U += w * 0.5 * (EA * eps * eps + EI * kappa * kappa);
-  }
-  return U;
+  const double eps = membraneStrain(e, true);
+  // U = EA l eps_m^2 / 2 + e^T K_b e / 2 (int EI kappa^2 / 2 dx)
+  return 0.5 * section_.axialStiffness() * l_ * eps * eps + 0.5 * e.dot(Kb_ * e);
 }
 
 BeamElement2d::Vec6 BeamElement2d::strainEnergyGradient(const Vec6& e, bool stiffening) const {
   if (!stiffening) return K_ * e;
-  const double EA = section_.axialStiffness(), EI = section_.bendingStiffness();
-  const Row6 a = axialStrainShape(l_);
-  const double du = a.dot(e);
-  Vec6 grad = Vec6::Zero();
-  for (size_t g = 0; g < kGaussXi.size(); ++g) {
-    const double xi = kGaussXi[g], w = kGaussW[g] * l_;
-    const Row6 b = slopeShape(xi, l_), c = curvatureShape(xi, l_);
-    const double dv = b.dot(e), eps = du + 0.5 * dv * dv;
-    grad += w * (EA * eps * (a + dv * b).transpose() + EI * c.dot(e) * c.transpose());
-  }
-  return grad;
+  const double eps = membraneStrain(e, true);
+  const Vec6 d = axialStrainShape(l_).transpose() + G_ * e / l_;  // d eps_m / de
+  // dU/de = EA l eps_m d + K_b e
+  return (section_.axialStiffness() * l_ * eps) * d + Kb_ * e;
 }
 
 BeamElement2d::Mat6 BeamElement2d::strainEnergyHessian(const Vec6& e, bool stiffening) const {
   if (!stiffening) return K_;
-  const double EA = section_.axialStiffness(), EI = section_.bendingStiffness();
-  const Row6 a = axialStrainShape(l_);
-  const double du = a.dot(e);
-  Mat6 H = Mat6::Zero();
-  for (size_t g = 0; g < kGaussXi.size(); ++g) {
-    const double xi = kGaussXi[g], w = kGaussW[g] * l_;
-    const Row6 b = slopeShape(xi, l_), c = curvatureShape(xi, l_);
-    const double dv = b.dot(e), eps = du + 0.5 * dv * dv;
-    const Row6 deps = a + dv * b;
-    H += w * (EA * (deps.transpose() * deps + eps * b.transpose() * b) + EI * c.transpose() * c);
-  }
-  return H;
+  const double EA = section_.axialStiffness(), eps = membraneStrain(e, true);
+  const Vec6 d = axialStrainShape(l_).transpose() + G_ * e / l_;
+  // d2U/de2 = EA l d d^T + EA eps_m G (geometric stiffness, N = EA eps_m) + K_b
+  return (EA * l_) * d * d.transpose() + (EA * eps) * G_ + Kb_;
 }
 
 Vec2 BeamElement2d::sectionForces(const Vec6& e, double xi, bool stiffening) const {
-  double eps = axialStrainShape(l_).dot(e);
-  if (stiffening) {
-    const double dv = slopeShape(xi, l_).dot(e);
-    eps += 0.5 * dv * dv;
-  }
-  return Vec2(section_.axialStiffness() * eps, section_.bendingStiffness() * curvatureShape(xi, l_).dot(e));
+  // N = EA eps_m (constant per element, consistent with U), M = EI kappa(xi)
+  return Vec2(section_.axialStiffness() * membraneStrain(e, stiffening),
+              section_.bendingStiffness() * curvatureShape(xi, l_).dot(e));
 }
 
 }  // namespace flexmbd

@@ -55,13 +55,24 @@ class BeamElement2d {
   /// Linear stiffness (axial EA/l and Hermite bending EI/l^3 blocks), element frame.
   const Mat6& stiffness() const { return K_; }
 
-  /// Strain energy U(e) = int (EA eps^2 / 2 + EI kappa^2 / 2) dx with eps = u' (linear)
-  /// or eps = u' + v'^2 / 2 (second-order axial strain: geometric stiffening).
+  /// G = int_0^l b^T b dx, b = slopeShape (constant 6 x 6; transverse block only): the
+  /// slope-shape integral of the membrane strain, (1/2) int v'^2 dx = e^T G e / 2.
+  const Mat6& slopeIntegral() const { return G_; }
+
+  /// Strain energy U(e) = EA l eps^2 / 2 + int EI kappa^2 / 2 dx with the membrane strain
+  /// eps = u' (linear model) or, with geometric stiffening, the element-averaged
+  /// second-order strain eps_m = u' + (1/2l) int_0^l v'^2 dx = a e + e^T G e / (2l)
+  /// (constant along the element). The pointwise u' + v'^2/2 cannot vanish in bending
+  /// with a linear u and a cubic v and locks coarse meshes (membrane locking, issue 11
+  /// item 8; docs/flexible-bodies.md); the averaged strain is the standard remedy.
   double strainEnergy(const Vec6& e, bool stiffening) const;
   /// dU/de and d2U/de2 (for the linear model: K e and K).
   Vec6 strainEnergyGradient(const Vec6& e, bool stiffening) const;
   Mat6 strainEnergyHessian(const Vec6& e, bool stiffening) const;
-  /// Axial force N = EA eps and bending moment M = EI kappa at xi.
+  /// Membrane strain: u' (linear) or the averaged eps_m (stiffening), as above.
+  double membraneStrain(const Vec6& e, bool stiffening) const;
+  /// Axial force N = EA eps (constant along the element) and bending moment M = EI kappa
+  /// at xi.
   Vec2 sectionForces(const Vec6& e, double xi, bool stiffening) const;
 
  private:
@@ -72,6 +83,8 @@ class BeamElement2d {
   double mass_ = 0.0;
   Mat26 sBar_, sX_;
   Mat6 sXX_, sYY_, sXY_, K_;
+  Mat6 Kb_;  // bending part of K_ (axial entries zero): int EI c^T c dx
+  Mat6 G_;   // int b^T b dx
 };
 
 }  // namespace flexmbd

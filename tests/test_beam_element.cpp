@@ -374,9 +374,10 @@ Mat6 classicalGeometricStiffness(double N, double l) {
 }
 
 TEST(BeamElement2d, StretchedElementHessianContainsGeometricStiffness) {
-  // With eps = u' + v'^2/2, d2U/de2 = int EA (eps' ^T eps' + eps b^T b) + EI c^T c,
-  // eps' = a + v' b. At a purely axial state (u2 - u1 = delta, v = 0): eps = delta/l
-  // exactly and v' = 0, so H = K + (EA delta / l) int b^T b dx, and int b^T b dx is
+  // With the averaged membrane strain eps_m = a e + e^T G e / (2l), G = int b^T b dx,
+  // d2U/de2 = EA l d d^T + EA eps_m G + K_b, d = a^T + G e / l. At a purely axial state
+  // (u2 - u1 = delta, v = 0): eps_m = delta/l exactly and G e = 0, so
+  // H = K + (EA delta / l) int b^T b dx, and int b^T b dx is
   // the classical geometric stiffness matrix (1/(30 l))[36, 3l, ...]. The relation is
   // therefore not only first order in delta but exact (no delta^2 term: eps is linear
   // in u), and the tolerance is roundoff: each entry is a 5-point quadrature sum of
@@ -405,9 +406,10 @@ TEST(BeamElement2d, StretchedElementHessianContainsGeometricStiffness) {
     }
   }
   // Adding a small transverse deformation of amplitude s changes the vv block by
-  // (3/2) EA int v'^2 b^T b dx (the eps' ^T eps' and eps b^T b terms): exactly
-  // quadratic in s, so halving s divides the deviation by 4 (up to roundoff of the
-  // subtraction, ~1e-13 |K_b| / deviation ~ 1e-8 here).
+  // EA (G e)(G e)^T / l + EA (e^T G e / 2l) G (the averaged membrane strain, G = int
+  // b^T b dx: the d d^T and eps_m G terms): exactly quadratic in s, so halving s divides
+  // the deviation by 4 (up to roundoff of the subtraction, ~1e-13 |K_b| / deviation
+  // ~ 1e-8 here).
   Vec6 shape;
   shape << 0, 0.3, 1.0, 0, -0.2, 0.6;  // slopes ~ s, displacements ~ s l
   shape[1] *= l;
@@ -425,7 +427,7 @@ TEST(BeamElement2d, StretchedElementHessianContainsGeometricStiffness) {
   };
   const double d1 = deviation(2e-3), d2 = deviation(1e-3);
   EXPECT_NEAR(d1 / d2, 4.0, 1e-5) << "deviation " << d1 << ", " << d2;
-  // and it is a small (second-order) correction: (3/2) v'^2 / eps ~ 1e-2 of K_g
+  // and it is a small (second-order) correction: ~ v'^2 / eps ~ 1e-2 of K_g
   EXPECT_LT(d2, 0.05 * classicalGeometricStiffness(EA * delta / l, l).cwiseAbs().maxCoeff());
 }
 
@@ -462,9 +464,9 @@ TEST(BeamElement2d, SectionForcesOfStretchAndConstantCurvature) {
       EXPECT_NEAR(nl.y(), EI * kappa, 1e-12 * EI * kappa) << "xi " << xi;
       EXPECT_NEAR(lin.x(), 0.0, 1e-12 * EA * kappa * l) << "xi " << xi;
       if (ee == bend) {
-        // with stiffening the axial strain is v'^2/2 = (kappa x)^2 / 2
-        const double x = xi * l;
-        EXPECT_NEAR(nl.x(), 0.5 * EA * kappa * kappa * x * x, 1e-12 * EA * kappa * kappa * l * l) << "xi " << xi;
+        // with stiffening the membrane strain is the element average of v'^2/2 =
+        // (kappa x)^2 / 2: kappa^2 l^2 / 6, the same at every section (issue 11, item 8)
+        EXPECT_NEAR(nl.x(), EA * kappa * kappa * l * l / 6.0, 1e-12 * EA * kappa * kappa * l * l) << "xi " << xi;
       }
     }
   }
