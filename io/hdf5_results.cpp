@@ -1,9 +1,14 @@
 #include "io/hdf5_results.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <stdexcept>
 #include <type_traits>
 
@@ -32,20 +37,31 @@ class QuietHdf5Errors {
   void* data_ = nullptr;
 };
 
-/// The innermost message of HDF5's current error stack (where the failure was detected:
-/// it carries the system's reason, e.g. "... errno = 28, error message = 'No space left
-/// on device'"), or "HDF5 error" if the stack is empty.
+/// The message of HDF5's current error stack that carries the system's reason ("...
+/// errno = 28, error message = 'No space left on device'"), else the innermost non-empty
+/// one (where the failure was detected), or "HDF5 error" if there is none.
 std::string hdf5Reason() {
-  std::string reason;
+  std::vector<std::string> messages;  // innermost first
   H5Ewalk2(
       H5E_DEFAULT, H5E_WALK_UPWARD,
-      [](unsigned n, const H5E_error2_t* e, void* out) -> herr_t {
-        if (n == 0 && e->desc) *static_cast<std::string*>(out) = e->desc;
+      [](unsigned, const H5E_error2_t* e, void* out) -> herr_t {
+        if (e->desc && *e->desc) static_cast<std::vector<std::string>*>(out)->push_back(e->desc);
         return 0;
       },
-      &reason);
+      &messages);
   H5Eclear2(H5E_DEFAULT);
-  return reason.empty() ? "HDF5 error" : reason;
+  for (const auto& m : messages) {
+    if (m.find("errno") != std::string::npos) return m;
+  }
+  return messages.empty() ? "HDF5 error" : messages.front();
+}
+
+/// Reserves the bytes [from, from + bytes) of the file open as `fd` (a no-op where the file
+/// already has them): 0, or the error (ENOSPC: disk full, EFBIG: file size limit). A file
+/// system that cannot reserve counts as success.
+int reserve(int fd, long long from, long long bytes) {
+  const int err = ::posix_fallocate(fd, static_cast<off_t>(from), static_cast<off_t>(bytes));
+  return err == EOPNOTSUPP || err == EINVAL ? 0 : err;
 }
 
 std::string timeText(double t) {
@@ -75,9 +91,22 @@ Hdf5RowFile::~Hdf5RowFile() {
 void Hdf5RowFile::close() {
   QuietHdf5Errors quiet;
   bool ok = true;
+  haddr_t end = 0;  // HDF5's end of allocated space, once all is written
   if (dataset_ >= 0) ok = H5Dclose(dataset_) >= 0 && ok;
-  if (file_ >= 0) ok = H5Fclose(file_) >= 0 && ok;
+  if (file_ >= 0) {
+    ok = H5Fflush(file_, H5F_SCOPE_LOCAL) >= 0 && H5Fget_eoa(file_, &end) >= 0 && ok;
+    ok = H5Fclose(file_) >= 0 && ok;
+  }
   dataset_ = file_ = -1;
+  // The space reserved past the end (append) is given back.
+  if (reserveFd_ >= 0) {
+    struct stat st {};
+    if (ok && end > 0 && ::fstat(reserveFd_, &st) == 0 && static_cast<haddr_t>(st.st_size) > end) {
+      if (::ftruncate(reserveFd_, static_cast<off_t>(end)) != 0) ok = false;
+    }
+    ::close(reserveFd_);
+    reserveFd_ = -1;
+  }
   if (!ok) throw OutputWriteError("cannot close '" + path_.string() + "': " + hdf5Reason());
 }
 
@@ -86,8 +115,23 @@ void Hdf5RowFile::open(const std::filesystem::path& path, const std::vector<std:
   path_ = path;
   columns_ = columns.size();
   rows_ = 0;
+  // Chunks of about 64 KiB (at least a row); the space reserved before each row: room for
+  // a new chunk and the metadata HDF5 may grow with it (index nodes, object header).
+  const hsize_t chunkRows = std::clamp<hsize_t>(65536 / (8 * std::max<std::size_t>(columns_, 1)), 1, 1024);
+  reserveBytes_ = 2 * static_cast<long long>(chunkRows * 8 * std::max<std::size_t>(columns_, 1)) + 256 * 1024;
+  // The space for the empty file, checked before HDF5 writes it (HDF5 truncates it again).
+  reserveFd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (reserveFd_ < 0) throw OutputWriteError("cannot create '" + path.string() + "': " + std::strerror(errno));
+  if (const int err = reserve(reserveFd_, 0, reserveBytes_)) {
+    ::close(reserveFd_);
+    reserveFd_ = -1;
+    std::filesystem::remove(path);
+    throw OutputWriteError("cannot create '" + path.string() + "': " + std::strerror(err));
+  }
   const auto fail = [&](const std::string& what) {
     const std::string reason = hdf5Reason();
+    ::close(reserveFd_);
+    reserveFd_ = -1;
     if (dataset_ >= 0) H5Dclose(dataset_);
     if (file_ >= 0) H5Fclose(file_);
     dataset_ = file_ = -1;
@@ -117,7 +161,6 @@ void Hdf5RowFile::open(const std::filesystem::path& path, const std::vector<std:
   // /results: rows x columns, extendible in rows, chunks of about 64 KiB (at least a row).
   const hsize_t dims[2] = {0, static_cast<hsize_t>(columns_)};
   const hsize_t maxDims[2] = {H5S_UNLIMITED, static_cast<hsize_t>(columns_)};
-  const hsize_t chunkRows = std::clamp<hsize_t>(65536 / (8 * std::max<hsize_t>(columns_, 1)), 1, 1024);
   const hsize_t chunk[2] = {chunkRows, std::max<hsize_t>(columns_, 1)};
   const Id space{H5Screate_simple(2, dims, maxDims), H5Sclose};
   const Id props{H5Pcreate(H5P_DATASET_CREATE), H5Pclose};
@@ -133,6 +176,14 @@ void Hdf5RowFile::append(const std::vector<double>& row, double t) {
                              std::to_string(columns_) + " columns of '" + path_.string() + "'");
   }
   QuietHdf5Errors quiet;
+  // Past the end of the space HDF5 has allocated (its end of address space; HDF5 cuts the
+  // file back to it when it closes the file).
+  haddr_t end = 0;
+  if (H5Fget_eoa(file_, &end) < 0) end = 0;
+  if (const int err = reserve(reserveFd_, static_cast<long long>(end), reserveBytes_)) {
+    throw OutputWriteError("cannot write '" + path_.string() + "' at t = " + timeText(t) + ": " +
+                           std::strerror(err) + " (" + std::to_string(rows_) + " complete rows kept)");
+  }
   const hsize_t grown[2] = {static_cast<hsize_t>(rows_) + 1, static_cast<hsize_t>(columns_)};
   const hsize_t start[2] = {static_cast<hsize_t>(rows_), 0};
   const hsize_t count[2] = {1, static_cast<hsize_t>(columns_)};

@@ -13,10 +13,18 @@
 
 namespace flexmbd {
 
-/// An HDF5 table written row by row, each row whole or not at all: a failed write (disk
-/// full, file size limit) shrinks /results back to the rows complete before it and throws
-/// OutputWriteError naming the file, the time and HDF5's reason. The file is flushed after
+/// An HDF5 table written row by row, each row whole or not at all, the file flushed after
 /// every row, so a run killed or failing later keeps the rows written.
+///
+/// A full disk or a file size limit: HDF5 1.10 leaves a file whose write failed unreadable
+/// (its metadata then points past the end of the file) and crashes at exit closing it. So
+/// before each row the writer reserves the space HDF5 may need for it (posix_fallocate of
+/// two chunks and 256 KiB past the end of HDF5's allocated space; the file is cut back to
+/// that space when it is closed):
+/// when that fails the row is not written, the file stays as it was (every complete row
+/// readable) and OutputWriteError names the file, the time and the system's reason. A
+/// failure HDF5 meets anyway (a file system without fallocate) is reported the same way,
+/// with HDF5's reason.
 class Hdf5RowFile {
  public:
   Hdf5RowFile() = default;
@@ -40,6 +48,8 @@ class Hdf5RowFile {
   std::int64_t dataset_ = -1;  ///< hid_t of /results
   std::size_t columns_ = 0;
   long rows_ = 0;
+  int reserveFd_ = -1;         ///< the file again, to reserve space before each row
+  long long reserveBytes_ = 0;  ///< bytes reserved past the end of the file
 };
 
 }  // namespace flexmbd

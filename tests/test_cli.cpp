@@ -536,6 +536,32 @@ TEST_F(Cli, Hdf5ResultsOfAFailedRunKeepTheRowsUpToTheFailure) {
   EXPECT_DOUBLE_EQ(h5.rows.back()[0], 0.8);
 }
 
+TEST_F(Cli, Hdf5ResultsOfAFullDiskAreReadableWholeRows) {
+  // A file size limit of 800 KB (ulimit -f, SIGXFSZ ignored) fails the run's 630 KB of rows
+  // plus the space reserved ahead of each row, as a full disk would: the writer stops
+  // before HDF5 writes (which would leave an unreadable file and crash at exit).
+  const fs::path out = dir_ / "out";
+  const fs::path err = dir_ / "stderr.txt";
+  const std::string cmd = "trap '' XFSZ; ulimit -f 800; exec " + shellQuote(FLEXMBD_CLI) + " run " +
+                          shellQuote(kExample) + " --out " + shellQuote(out.string()) +
+                          " --format hdf5 --quiet --t-end 200 2>" + shellQuote(err.string());
+  const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
+  ASSERT_TRUE(rc != -1 && WIFEXITED(rc)) << "no normal exit: " << rc;
+  EXPECT_EQ(WEXITSTATUS(rc), 1);
+  const std::string message = readFile(err);
+  EXPECT_TRUE(IsOneErrorLine(message));
+  EXPECT_NE(message.find("cannot write '" + (out / "results.h5").string() + "' at t = "), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("complete rows kept"), std::string::npos) << message;
+  const Table h5 = readHdf5Table(out / "results.h5");
+  ASSERT_GT(h5.rows.size(), 100u);
+  EXPECT_LT(h5.rows.size(), 1900u);  // 1911 outputs up to t = 200
+  for (std::size_t r = 1; r < h5.rows.size(); ++r) ASSERT_GT(h5.rows[r][0], h5.rows[r - 1][0]) << "row " << r;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  EXPECT_EQ(summary.at("t_reached").get<double>(), h5.rows.back()[0]);
+}
+
 TEST_F(Cli, UnknownFormatExitsWith2AndNoResults) {
   const fs::path out = dir_ / "out";
   const CliResult r = run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --format xlsx");
