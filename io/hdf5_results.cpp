@@ -135,6 +135,8 @@ void Hdf5RowFile::open(const std::filesystem::path& path, const std::vector<std:
     if (dataset_ >= 0) H5Dclose(dataset_);
     if (file_ >= 0) H5Fclose(file_);
     dataset_ = file_ = -1;
+    std::error_code ec;
+    std::filesystem::remove(path_, ec);  // no results file rather than a damaged one
     throw OutputWriteError("cannot " + what + " '" + path_.string() + "': " + reason);
   };
   file_ = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
