@@ -1,9 +1,9 @@
 // flexmbd: the command line.
-//   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--quiet]
+//   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
 //   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
-// kept in DIR/results.csv, DIR/summary.json says "failed"); 2 bad input (command line,
+// kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
 // scene file, model that cannot be set up): one line "flexmbd: error: ..." on stderr,
 // no results.csv.
 #include <cmath>
@@ -40,14 +40,16 @@ constexpr int kExitSolverFailure = 1;
 constexpr int kExitInputError = 2;
 
 const char* const kUsage =
-    "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--vtk] [--quiet]\n"
+    "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A]\n"
+    "                   [--format csv|hdf5] [--vtk] [--quiet]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
     "                          [--corrector newton|modified_newton] [--quiet]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
     "Simulates the planar multibody model described by SCENE.json (see docs/scene-format.md)\n"
-    "and writes DIR/results.csv (one row per output time) and DIR/summary.json.\n"
+    "and writes DIR/results.csv (one row per output time; results.h5 with --format hdf5)\n"
+    "and DIR/summary.json.\n"
     "\n"
     "options of run:\n"
     "  --out DIR    output directory (created if needed; required)\n"
@@ -55,6 +57,8 @@ const char* const kUsage =
     "  --rtol R     relative tolerance, overrides solver.rtol\n"
     "  --atol A     absolute tolerance of positions, overrides solver.atol (and of\n"
     "               velocities too unless the scene sets solver.atol_velocity)\n"
+    "  --format F   results file: csv (default, DIR/results.csv) or hdf5 (DIR/results.h5:\n"
+    "               dataset /results, rows x columns, and /columns, the CSV header names)\n"
     "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView;\n"
     "               bodies, or the nodes and members of a tensegrity scene)\n"
     "  --quiet, -q  no progress display\n"
@@ -82,6 +86,7 @@ struct Options {
   std::optional<double> tEnd, rtol, atol;
   bool quiet = false;
   bool vtk = false;  ///< also write DIR/vtk/bodies_*.vtu and bodies.pvd
+  ResultsFormat format = ResultsFormat::Csv;  ///< --format
 };
 
 
@@ -116,7 +121,7 @@ Options parseCommandLine(int argc, char** argv) {
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
-                          cli::withCommon(cli::kCommonValueOptions, {"--t-end", "--rtol", "--atol"}),
+                          cli::withCommon(cli::kCommonValueOptions, {"--t-end", "--rtol", "--atol", "--format"}),
                           cli::withCommon(cli::kCommonFlags, {{"--vtk", "--vtk"}}), "run: ");
   o.quiet = split.flags.count("--quiet") > 0;
   o.vtk = split.flags.count("--vtk") > 0;
@@ -126,6 +131,12 @@ Options parseCommandLine(int argc, char** argv) {
       o.outDir = value;
     } else if (name == "--t-end") {
       o.tEnd = parseNumberOption(name, value);
+    } else if (name == "--format") {
+      try {
+        o.format = parseResultsFormat(value);
+      } catch (const std::invalid_argument&) {
+        throw UsageError("option --format expects csv or hdf5, got '" + value + "'");
+      }
     } else if (name == "--rtol") {
       o.rtol = parsePositiveOption(name, value);
     } else {
@@ -162,6 +173,11 @@ double cpuSecondsSince(std::clock_t start) {
 
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
+    if (o.format != ResultsFormat::Csv) {
+      printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
+                 "events.csv)");
+      return kExitInputError;
+    }
     return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet, o.vtk});
   }
   const std::filesystem::path outDir(o.outDir);
@@ -193,7 +209,7 @@ int runCommand(const Options& o) {
   std::optional<ResultsWriter> writer;
   std::optional<VtkWriter> vtk;
   try {
-    writer.emplace(outDir, *scene);
+    writer.emplace(outDir, *scene, o.format);
     if (o.vtk) {
       vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system);
       for (const std::string& b : vtk->bodiesNotDrawn()) {

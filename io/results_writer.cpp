@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/system_evaluation.hpp"
+#include "io/hdf5_results.hpp"
 
 namespace flexmbd {
 namespace {
@@ -95,8 +96,21 @@ nlohmann::ordered_json numberOrNull(double x) {
 
 }  // namespace
 
-ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scene)
-    : scene_(scene), path_(dir / "results.csv"), lastTime_(std::numeric_limits<double>::quiet_NaN()) {
+ResultsFormat parseResultsFormat(const std::string& name) {
+  if (name == "csv") return ResultsFormat::Csv;
+  if (name == "hdf5") return ResultsFormat::Hdf5;
+  throw std::invalid_argument("unknown results format '" + name + "' (known formats: csv, hdf5)");
+}
+
+const char* resultsFileName(ResultsFormat format) {
+  return format == ResultsFormat::Hdf5 ? "results.h5" : "results.csv";
+}
+
+ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scene, ResultsFormat format)
+    : scene_(scene),
+      format_(format),
+      path_(dir / resultsFileName(format)),
+      lastTime_(std::numeric_limits<double>::quiet_NaN()) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw std::runtime_error("cannot create output directory '" + dir.string() + "': " + ec.message());
@@ -145,7 +159,7 @@ void RowFile::append(const std::string& row, double t, const char* variable) {
 
 ResultsWriter::~ResultsWriter() {
   if (fd_ >= 0) ::close(fd_);
-}
+}  // h5_ closes results.h5
 
 void ResultsWriter::open() {
   fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
@@ -192,6 +206,17 @@ void ResultsWriter::write(const OutputSample& s) {
                             " in column \"" + columns_[k] + "\" at t = " + tbuf);
     }
   }
+  if (format_ == ResultsFormat::Hdf5) {
+    if (!h5_) {
+      auto file = std::make_unique<Hdf5RowFile>();
+      file->open(path_, columns_);
+      h5_ = std::move(file);
+    }
+    h5_->append(values, s.t);
+    ++rows_;
+    lastTime_ = s.t;
+    return;
+  }
   if (fd_ < 0) open();
   std::string line;
   line.reserve(24 * columns_.size());
@@ -214,7 +239,7 @@ void ResultsWriter::write(const OutputSample& s) {
 void removeStaleResults(const std::filesystem::path& dir) {
   std::error_code ec;
   std::vector<std::filesystem::path> stale;
-  for (const char* name : {"results.csv", "summary.json", "summary.json.tmp"}) stale.push_back(dir / name);
+  for (const char* name : {"results.csv", "results.h5", "summary.json", "summary.json.tmp"}) stale.push_back(dir / name);
   // Frames of an earlier run with --vtk (VtkWriter: bodies_NNNNNN.vtu, bodies.pvd): left
   // there, they would be read as frames of this run's model.
   const std::filesystem::path vtk = dir / "vtk";

@@ -1,9 +1,11 @@
-// Results of a run: DIR/results.csv (one row per output time, written as the run goes)
-// and DIR/summary.json (status and statistics, written at the end).
+// Results of a run: DIR/results.csv, or DIR/results.h5 with --format hdf5 (one row per
+// output time, written as the run goes) and DIR/summary.json (status and statistics,
+// written at the end).
 #pragma once
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,20 +14,33 @@
 
 namespace flexmbd {
 
-/// Writes DIR/results.csv: a header row, then one row per OutputSample, each flushed
-/// so that the rows written survive a failure later in the run. Columns: t; every
+class Hdf5RowFile;
+
+/// The file format of the results table: results.csv (the default) or results.h5
+/// (io/hdf5_results.hpp: /columns, the same names as the CSV header, and /results).
+enum class ResultsFormat { Csv, Hdf5 };
+
+/// "csv" or "hdf5". @throws std::invalid_argument naming the value and the known ones.
+ResultsFormat parseResultsFormat(const std::string& name);
+/// The file name of the results table of `format`: "results.csv" or "results.h5".
+const char* resultsFileName(ResultsFormat format);
+
+/// Writes DIR/results.csv (or DIR/results.h5, see ResultsFormat): a header row, then one
+/// row per OutputSample, each flushed so that the rows written survive a failure later in
+/// the run. Columns: t; every
 /// coordinate "<body>.<coord>" (System::coordinateNames()); every velocity
 /// "<body>.<coord>_dot"; every acceleration "<body>.<coord>_ddot" (OutputSample::a, from
 /// the state at the output time); the reaction outputs (reactionOutputNames: "<joint>.fx",
 /// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs.
 /// Numbers are written with 17 significant digits (they read back exactly).
 /// The file is created at the first sample, so a run that fails before its first
-/// output leaves no results.csv behind.
+/// output leaves no results file behind. In HDF5 the numbers are the doubles themselves.
 class ResultsWriter {
  public:
-  /// Creates `dir` (and parents) and deletes a stale results.csv and summary.json.
-  /// `scene` must outlive the writer. @throws std::runtime_error if dir cannot be made.
-  ResultsWriter(const std::filesystem::path& dir, const Scene& scene);
+  /// Creates `dir` (and parents) and deletes a stale results.csv, results.h5 and
+  /// summary.json. `scene` must outlive the writer. @throws std::runtime_error if dir
+  /// cannot be made.
+  ResultsWriter(const std::filesystem::path& dir, const Scene& scene, ResultsFormat format = ResultsFormat::Csv);
   ~ResultsWriter();
   ResultsWriter(const ResultsWriter&) = delete;
   ResultsWriter& operator=(const ResultsWriter&) = delete;
@@ -46,7 +61,9 @@ class ResultsWriter {
   void open();
 
   const Scene& scene_;
+  ResultsFormat format_;
   std::filesystem::path path_;
+  std::unique_ptr<Hdf5RowFile> h5_;  ///< results.h5, opened at the first row
   std::vector<std::string> columns_;
   int fd_ = -1;                ///< results.csv, opened at the first row
   long long bytes_ = 0;        ///< size of results.csv up to its last complete row
@@ -77,7 +94,7 @@ class RowFile {
   long rows_ = 0;
 };
 
-/// Deletes DIR/results.csv, DIR/summary.json (and its temporary file) and the frames of
+/// Deletes DIR/results.csv, DIR/results.h5, DIR/summary.json (and its temporary file) and the frames of
 /// DIR/vtk (bodies_NNNNNN.vtu, bodies.pvd) if they exist, stale from an earlier run (which
 /// may have been of another model); the directories and any other file are kept.
 void removeStaleResults(const std::filesystem::path& dir);

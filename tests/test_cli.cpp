@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include <hdf5.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
@@ -406,4 +407,178 @@ TEST_F(Cli, VtkSaysOnStderrWhichBodyItCannotDraw) {
   EXPECT_NE(r.err.find("flexmbd: warning: --vtk: body \"loose\" has no points to draw"), std::string::npos) << r.err;
   const std::string vtu = readFile(out / "vtk" / "bodies_000000.vtu");
   EXPECT_NE(vtu.find("<!-- body_names: crank, rod, slider -->"), std::string::npos) << vtu.substr(0, 200);
+}
+
+// ----- issue 12: --format hdf5 ------------------------------------------------------------
+
+namespace {
+
+/// A results table: column names and rows.
+struct Table {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+};
+
+Table readCsvTable(const fs::path& path) {
+  Table t;
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line)) return t;
+  std::istringstream header(line);
+  for (std::string field; std::getline(header, field, ',');) t.columns.push_back(field);
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream fields(line);
+    for (std::string field; std::getline(fields, field, ',');) row.push_back(std::strtod(field.c_str(), nullptr));
+    t.rows.push_back(row);
+  }
+  return t;
+}
+
+/// Reads results.h5 with the HDF5 C API, checking the documented layout on the way:
+/// /columns (1-D, variable-length strings), /results (2-D float64, rows x columns,
+/// extendible in rows).
+Table readHdf5Table(const fs::path& path) {
+  Table t;
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (file < 0) {
+    ADD_FAILURE() << "cannot open " << path;
+    return t;
+  }
+  const hid_t names = H5Dopen2(file, "columns", H5P_DEFAULT);
+  EXPECT_GE(names, 0) << "no /columns";
+  if (names >= 0) {
+    const hid_t space = H5Dget_space(names);
+    EXPECT_EQ(H5Sget_simple_extent_ndims(space), 1);
+    const hssize_t n = H5Sget_simple_extent_npoints(space);
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, H5T_VARIABLE);
+    H5Tset_cset(type, H5T_CSET_UTF8);
+    std::vector<char*> text(static_cast<std::size_t>(n), nullptr);
+    EXPECT_GE(H5Dread(names, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, text.data()), 0);
+    for (char* c : text) t.columns.emplace_back(c ? c : "");
+#if H5_VERSION_GE(1, 12, 0)
+    H5Treclaim(type, space, H5P_DEFAULT, text.data());
+#else
+    H5Dvlen_reclaim(type, space, H5P_DEFAULT, text.data());
+#endif
+    H5Tclose(type);
+    H5Sclose(space);
+    H5Dclose(names);
+  }
+  const hid_t results = H5Dopen2(file, "results", H5P_DEFAULT);
+  EXPECT_GE(results, 0) << "no /results";
+  if (results >= 0) {
+    const hid_t type = H5Dget_type(results);
+    EXPECT_EQ(H5Tget_class(type), H5T_FLOAT);
+    EXPECT_EQ(H5Tget_size(type), 8u);
+    H5Tclose(type);
+    const hid_t space = H5Dget_space(results);
+    hsize_t dims[2] = {0, 0}, maxDims[2] = {0, 0};
+    EXPECT_EQ(H5Sget_simple_extent_ndims(space), 2);
+    H5Sget_simple_extent_dims(space, dims, maxDims);
+    EXPECT_EQ(maxDims[0], H5S_UNLIMITED);  // rows appended as the run goes
+    EXPECT_EQ(dims[1], t.columns.size());
+    std::vector<double> values(dims[0] * dims[1]);
+    if (!values.empty()) {
+      EXPECT_GE(H5Dread(results, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), 0);
+    }
+    for (hsize_t r = 0; r < dims[0]; ++r) {
+      t.rows.emplace_back(values.begin() + static_cast<long>(r * dims[1]),
+                          values.begin() + static_cast<long>((r + 1) * dims[1]));
+    }
+    H5Sclose(space);
+    H5Dclose(results);
+  }
+  H5Fclose(file);
+  return t;
+}
+
+}  // namespace
+
+TEST_F(Cli, Hdf5ResultsHoldTheColumnsAndValuesOfTheCsv) {
+  const fs::path csvOut = dir_ / "csv", h5Out = dir_ / "h5";
+  const std::string args = " --t-end 0.5 --quiet";
+  const CliResult rc = run("run " + shellQuote(kExample) + " --out " + shellQuote(csvOut.string()) + args);
+  const CliResult rh =
+      run("run " + shellQuote(kExample) + " --out " + shellQuote(h5Out.string()) + " --format hdf5" + args);
+  ASSERT_EQ(rc.status, 0) << rc.err;
+  ASSERT_EQ(rh.status, 0) << rh.err;
+  EXPECT_TRUE(rh.err.empty()) << rh.err;
+  EXPECT_NE(rh.out.find((h5Out / "results.h5").string()), std::string::npos) << rh.out;
+  EXPECT_FALSE(fs::exists(h5Out / "results.csv"));
+  EXPECT_EQ(nlohmann::json::parse(readFile(h5Out / "summary.json")).at("status"), "ok");
+  const Table csv = readCsvTable(csvOut / "results.csv");
+  const Table h5 = readHdf5Table(h5Out / "results.h5");
+  EXPECT_EQ(h5.columns, csv.columns);
+  ASSERT_EQ(h5.rows.size(), 6u);  // t = 0, 0.10472, ..., 0.41888 and 0.5
+  ASSERT_EQ(h5.rows.size(), csv.rows.size());
+  // The CSV's 17 significant digits read back exactly: the same doubles.
+  for (std::size_t r = 0; r < h5.rows.size(); ++r) {
+    ASSERT_EQ(h5.rows[r].size(), csv.rows[r].size()) << "row " << r;
+    for (std::size_t c = 0; c < h5.rows[r].size(); ++c) {
+      EXPECT_EQ(h5.rows[r][c], csv.rows[r][c]) << "row " << r << ", column " << csv.columns[c];
+    }
+  }
+  EXPECT_EQ(h5.rows.back()[0], 0.5);
+}
+
+TEST_F(Cli, Hdf5ResultsOfAFailedRunKeepTheRowsUpToTheFailure) {
+  // As LockUpMidRunExitsWith1AndKeepsResultsUpToTheFailure: outputs at 0, 0.05, ..., 0.8.
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_lockup.json") +
+                          " --out " + shellQuote(out.string()) + " --format=hdf5 --quiet");
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("results up to t = 0.8 kept in " + (out / "results.h5").string()), std::string::npos) << r.err;
+  const Table h5 = readHdf5Table(out / "results.h5");
+  ASSERT_EQ(h5.rows.size(), 17u);
+  EXPECT_DOUBLE_EQ(h5.rows.back()[0], 0.8);
+}
+
+TEST_F(Cli, Hdf5ResultsOfAFullDiskAreReadableWholeRows) {
+  // A file size limit of 800 KB (ulimit -f, SIGXFSZ ignored) fails the run's 630 KB of rows
+  // plus the space reserved ahead of each row, as a full disk would: the writer stops
+  // before HDF5 writes (which would leave an unreadable file and crash at exit).
+  const fs::path out = dir_ / "out";
+  const fs::path err = dir_ / "stderr.txt";
+  const std::string cmd = "trap '' XFSZ; ulimit -f 800; exec " + shellQuote(FLEXMBD_CLI) + " run " +
+                          shellQuote(kExample) + " --out " + shellQuote(out.string()) +
+                          " --format hdf5 --quiet --t-end 200 2>" + shellQuote(err.string());
+  const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
+  ASSERT_TRUE(rc != -1 && WIFEXITED(rc)) << "no normal exit: " << rc;
+  EXPECT_EQ(WEXITSTATUS(rc), 1);
+  const std::string message = readFile(err);
+  EXPECT_TRUE(IsOneErrorLine(message));
+  EXPECT_NE(message.find("cannot write '" + (out / "results.h5").string() + "' at t = "), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("complete rows kept"), std::string::npos) << message;
+  const Table h5 = readHdf5Table(out / "results.h5");
+  ASSERT_GT(h5.rows.size(), 100u);
+  EXPECT_LT(h5.rows.size(), 1900u);  // 1911 outputs up to t = 200
+  for (std::size_t r = 1; r < h5.rows.size(); ++r) ASSERT_GT(h5.rows[r][0], h5.rows[r - 1][0]) << "row " << r;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  // The output whose row could not be written (as for results.csv): one step after the last row.
+  EXPECT_NEAR(summary.at("t_reached").get<double>(), h5.rows.back()[0] + 0.10471975511965977, 1e-9);
+}
+
+TEST_F(Cli, UnknownFormatExitsWith2AndNoResults) {
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --format xlsx");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("option --format expects csv or hdf5, got 'xlsx'"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "results.csv"));
+  EXPECT_FALSE(fs::exists(out / "results.h5"));
+  // Only run has --format; a tensegrity scene (results.csv and events.csv) refuses hdf5.
+  const CliResult k = run("kinematics " + shellQuote(kSourceDir + "/examples/kinematics_slider_crank.json") +
+                          " --out " + shellQuote(out.string()) + " --format hdf5");
+  EXPECT_EQ(k.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(k.err));
+  const CliResult t = run("run " + shellQuote(kSourceDir + "/examples/tensegrity_two_masses.json") + " --out " +
+                          shellQuote(out.string()) + " --format hdf5 --quiet");
+  EXPECT_EQ(t.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(t.err));
+  EXPECT_NE(t.err.find("tensegrity"), std::string::npos) << t.err;
 }
