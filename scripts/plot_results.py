@@ -66,7 +66,7 @@ def read_table(path):
 
 
 def close_matches(name, header):
-    found = difflib.get_close_matches(name, header, n=5, cutoff=0.6)
+    found = difflib.get_close_matches(name, header, n=5, cutoff=0.8)
     found += [h for h in header if name and (name in h or h in name) and h not in found and len(h) > 1]
     return found[:5]
 
@@ -140,6 +140,7 @@ def describe(name):
 # Lengths are drawn in the largest of these units below which the data stays under 10.
 SCALES = {"m": [(1e-2, 1e3, "mm"), (1e-5, 1e6, "µm")], "m/s": [(1e-2, 1e3, "mm/s")],
           "m/s²": [(1e-2, 1e3, "mm/s²")]}
+LINE_STYLES = ["-", "--", "-.", ":"]  # one per run: curves that coincide stay visible
 DEGREES = {"rad": "deg", "rad/s": "deg/s", "rad/s²": "deg/s²"}
 
 
@@ -253,8 +254,8 @@ def main(argv):
         for k in range(len(runs)):
             for n in names:
                 label = labels[k] if len(names) == 1 else (n if len(runs) == 1 else f"{labels[k]}: {n}")
-                ax.plot([x * xfactor for x in xdata[k]], [y * yfactor for y in ydata[(k, n)]], "-", lw=1.2,
-                        label=label)
+                ax.plot([x * xfactor for x in xdata[k]], [y * yfactor for y in ydata[(k, n)]],
+                        LINE_STYLES[k % len(LINE_STYLES)], lw=1.2, label=label)
         ax.set_ylabel(axis_label(names, yshown))
         ax.grid(True, alpha=0.3)
         if len(runs) > 1 or len(names) > 1:
