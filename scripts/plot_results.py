@@ -110,7 +110,7 @@ def unit_of(name, kinematics):
         return "s"
     if kinematics:
         if name == "alpha":
-            return "input"
+            return None  # the input parameter, in the unit of the scene's input
         base = name.rpartition(".")[2]
         return {"x": "L", "y": "L", "vx": "L/s", "vy": "L/s", "ax": "L/s²", "ay": "L/s²",
                 "angle": "rad", "omega": "rad/s", "omega_dot": "rad/s²"}.get(base)
@@ -131,6 +131,8 @@ def unit_of(name, kinematics):
 
 
 def describe(name):
+    if name == "alpha":
+        return "alpha (input parameter)"
     coord = name.rpartition(".")[2]
     if re.fullmatch(r"q\d+(_dot|_ddot)?", coord):
         return f"{name} (elastic coordinate)"
@@ -260,6 +262,11 @@ def main(argv):
         ax.grid(True, alpha=0.3)
         if len(runs) > 1 or len(names) > 1:
             ax.legend(fontsize=8, loc="best")
+    if xshown == "deg":  # angle ticks at multiples of 90 or 180 degrees
+        span = max((abs(v) for xs in xdata for v in xs if math.isfinite(v)), default=0.0) * xfactor
+        if span >= 180:
+            from matplotlib.ticker import MultipleLocator
+            axes[-1, 0].xaxis.set_major_locator(MultipleLocator(90 if span <= 1080 else 180))
     axes[-1, 0].set_xlabel(axis_label([xname], xshown) if xname != "t" else f"t [{xshown}]")
     title = a.title
     if title is None:
