@@ -500,3 +500,22 @@ TEST_F(Cli, PlotOfAnUnknownColumnExitsWith2NamingCloseMatches) {
     EXPECT_TRUE(IsOneErrorLine(r.err)) << args;
   }
 }
+
+// The scenes of `make demo` run and hold the columns the demo's table and plot read
+// (scripts/demo_report.py, flexmbd plot): the modal one whole (0.03 s), the nodal one
+// over its first 2 ms (its 3 revolutions take 2 s).
+TEST_F(Cli, DemoScenesRunAndHoldTheColumnsOfTheDemo) {
+  for (const std::string variant : {"modal", "nodal"}) {
+    const fs::path out = dir_ / variant;
+    const CliResult r = run("run " + shellQuote(kSourceDir + "/examples/slider_crank_elastic_demo_" + variant + ".json") +
+                            " --out " + shellQuote(out.string()) + (variant == "nodal" ? " --t-end 0.002" : "") +
+                            " --quiet");
+    ASSERT_EQ(r.status, 0) << variant << ": " << r.err;
+    std::ifstream csv(out / "results.csv");
+    std::string header;
+    std::getline(csv, header);
+    for (const char* col : {"crank.theta", "slider.x", "mid.uy"}) {
+      EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << variant << ": " << col;
+    }
+  }
+}
