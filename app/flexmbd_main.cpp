@@ -1,6 +1,8 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
 //   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
+//   flexmbd summary DIR                              (app/summary_command.cpp)
+//   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -18,6 +20,8 @@
 #include <vector>
 
 #include "app/kinematics_command.hpp"
+#include "app/plot_command.hpp"
+#include "app/summary_command.hpp"
 #include "app/tensegrity_command.hpp"
 #include "app/command_line.hpp"
 #include "core/errors.hpp"
@@ -44,6 +48,9 @@ const char* const kUsage =
     "                   [--format csv|hdf5] [--vtk] [--quiet]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
     "                          [--corrector newton|modified_newton] [--quiet]\n"
+    "       flexmbd summary DIR\n"
+    "       flexmbd plot DIR [DIR ...] [--columns A,B] [--x COLUMN] [--out FILE.png]\n"
+    "                    [--labels L1,L2] [--title TEXT] [--deg]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -71,11 +78,21 @@ const char* const kUsage =
     "override analysis.steps, .tolerance, .corrector of the scene; --quiet, -q as for run\n"
     "(kinematics has no progress display).\n"
     "\n"
+    "summary prints DIR/summary.json of a run (run or kinematics) as a short report.\n"
+    "\n"
+    "plot draws results columns of one or more runs (DIR/results.csv, or kinematics.csv)\n"
+    "into a PNG with /usr/bin/python3 and matplotlib (scripts/plot_results.py; see\n"
+    "docs/results.md): --columns the columns (default: the rigid body coordinates), --x the\n"
+    "column of the horizontal axis (default t, or alpha), --out the PNG (default\n"
+    "DIR/plot.png), --labels one legend label per DIR, --title, --deg angles in degrees.\n"
+    "Units follow from the column names; the path of the PNG is printed.\n"
+    "\n"
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
-    "singular position (results up to there are kept); 2 invalid command line, scene or\n"
-    "model (nothing is integrated).\n";
+    "singular position (results up to there are kept), or plot could not draw (no\n"
+    "matplotlib); 2 invalid command line, scene or model (nothing is integrated), a\n"
+    "missing or malformed summary.json, an unknown results column.\n";
 
 
 struct Options {
@@ -117,7 +134,8 @@ Options parseCommandLine(int argc, char** argv) {
     return o;
   }
   if (args[0] != "run") {
-    throw UsageError("unknown command '" + args[0] + "' (expected 'run', 'kinematics', '--help' or '--version')");
+    throw UsageError("unknown command '" + args[0] +
+                     "' (expected 'run', 'kinematics', 'summary', 'plot', '--help' or '--version')");
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
@@ -285,6 +303,12 @@ int mainImpl(int argc, char** argv) {
     bool help = false;
     for (const auto& a : rest) help = help || a == "--help" || a == "-h";
     if (!help) return runKinematicsCommand(rest);  // same exit statuses 0/1/2
+  }
+  if (argc >= 2 && (std::string(argv[1]) == "summary" || std::string(argv[1]) == "plot")) {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return std::string(argv[1]) == "summary" ? runSummaryCommand(rest) : runPlotCommand(rest);
   }
   Options o;
   try {

@@ -40,6 +40,8 @@ except ImportError:
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from slider_crank_reference import slider_x, slider_dx_da, slider_d2x_da2  # noqa: E402
+
 
 def read(directory):
     path = os.path.join(directory, "kinematics.csv")
@@ -70,14 +72,8 @@ def slider_figure(rows, node, l1, l2, out):
         ax.plot(deg, column(rows, name), "o", ms=3.5, label="flexmbd kinematics")
         if l1 and l2:
             fine = [i * 2 * math.pi / 720 for i in range(721)]
-            exact = []
-            for a in fine:
-                s, c = math.sin(a), math.cos(a)
-                r = math.sqrt(l2 * l2 - l1 * l1 * s * s)
-                exact.append({f"{node}.x": l1 * c + r,                                   # eq. 30
-                              f"{node}.vx": -l1 * s - l1 * l1 * s * c / r,               # eq. 31
-                              f"{node}.ax": -l1 * c - l1 * l1 * (l1 * l1 * s ** 4 + l2 * l2 * math.cos(2 * a))
-                              / r ** 3}[name])                                           # eq. 32
+            formula = {f"{node}.x": slider_x, f"{node}.vx": slider_dx_da, f"{node}.ax": slider_d2x_da2}[name]
+            exact = [formula(l1, l2, a) for a in fine]  # eqs. 30-32 (scripts/slider_crank_reference.py)
             ax.plot([math.degrees(a) for a in fine], exact, "-", lw=1, label="exact, eqs. 30-32")
         ax.set_ylabel(label)
         ax.set_title(title, fontsize=10, loc="left")

@@ -14,6 +14,8 @@ import math
 import os
 import sys
 
+from slider_crank_reference import slider_x  # scripts/slider_crank_reference.py
+
 L1, L2 = 1.0, 2.0  # crank and rod lengths of the example (source document 000)
 EVERY = 5
 
@@ -27,8 +29,7 @@ SUMMARY_KEYS = ["status", "message", "t_reached", "steps", "residual_evals", "ja
 
 
 def exact_slider_x(a):
-    s = L1 * math.sin(a)
-    return L1 * math.cos(a) + math.sqrt(L2 * L2 - s * s)
+    return slider_x(L1, L2, a)
 
 
 def to_float(text):

@@ -582,3 +582,115 @@ TEST_F(Cli, UnknownFormatExitsWith2AndNoResults) {
   EXPECT_TRUE(IsOneErrorLine(t.err));
   EXPECT_NE(t.err.find("tensegrity"), std::string::npos) << t.err;
 }
+
+// ----- flexmbd summary DIR, flexmbd plot DIR (docs/results.md) ---------------------------
+
+TEST_F(Cli, SummaryPrintsARunReadably) {
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --t-end 0.5 --quiet").status,
+            0);
+  CliResult r = run("summary " + shellQuote(out.string()));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  for (const char* text : {"summary of ", "status", " ok", "time reached", "0.5 s of t_end 0.5 s", "steps", "CPU time",
+                           "constraint violation", "position ", "energy", "warnings", "none"}) {
+    EXPECT_NE(r.out.find(text), std::string::npos) << "'" << text << "' missing in:\n" << r.out;
+  }
+  EXPECT_NE(r.out.find("\n"), r.out.rfind("\n")) << "one line only:\n" << r.out;
+  // The summary.json file itself is accepted too.
+  r = run("summary " + shellQuote((out / "summary.json").string()));
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("time reached"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, SummaryOfAMissingOrMalformedSummaryExitsWith2) {
+  CliResult r = run("summary " + shellQuote((dir_ / "nowhere").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+  fs::create_directories(dir_ / "empty");  // a directory without a summary
+  r = run("summary " + shellQuote((dir_ / "empty").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("summary.json"), std::string::npos) << r.err;
+
+  fs::create_directories(dir_ / "bad");
+  for (const char* text : {"{\"status\": \"ok\",\n", "[1, 2]", "{\"steps\": 3}", ""}) {
+    std::ofstream(dir_ / "bad" / "summary.json") << text;
+    r = run("summary " + shellQuote((dir_ / "bad").string()));
+    EXPECT_EQ(r.status, 2) << text;
+    EXPECT_TRUE(IsOneErrorLine(r.err)) << text;
+  }
+  r = run("summary");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+}
+
+namespace {
+
+/// Debian's python3 with matplotlib (scripts/setup.sh installs python3-matplotlib).
+bool haveMatplotlib() { return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0; }
+
+}  // namespace
+
+TEST_F(Cli, PlotWritesAPng) {
+  if (!haveMatplotlib()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib not found (scripts/setup.sh installs it)";
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --t-end 0.5 --quiet").status,
+            0);
+  const fs::path png = dir_ / "figures" / "slider.png";
+  CliResult r = run("plot " + shellQuote(out.string()) + " --columns slider.x,slider.x_dot,O1.fx --x crank.theta --deg" +
+                    " --out " + shellQuote(png.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find(png.string()), std::string::npos) << r.out;
+  const std::string bytes = readFile(png);
+  EXPECT_GT(bytes.size(), 1000u);
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+  // Defaults: the body coordinates against t, into DIR/plot.png; two runs on one axes.
+  r = run("plot " + shellQuote(out.string()) + " " + shellQuote(out.string()) + " --labels a,b");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(readFile(out / "plot.png").substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
+}
+
+TEST_F(Cli, PlotOfAnUnknownColumnExitsWith2NamingCloseMatches) {
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --t-end 0.5 --quiet").status,
+            0);
+  CliResult r = run("plot " + shellQuote(out.string()) + " --columns slider.x,slider.xdot");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("no column 'slider.xdot'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("close matches: slider.x_dot"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out / "plot.png"));
+  r = run("plot " + shellQuote(out.string()) + " --x time");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  EXPECT_NE(r.err.find("'time'"), std::string::npos) << r.err;
+  for (const std::string& args : std::vector<std::string>{"plot", "plot " + shellQuote((dir_ / "nowhere").string()),
+                                  "plot " + shellQuote(out.string()) + " --out x.pdf",
+                                  "plot " + shellQuote(out.string()) + " --frobnicate"}) {
+    r = run(args);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_TRUE(IsOneErrorLine(r.err)) << args;
+  }
+}
+
+// The scenes of `make demo` run and hold the columns the demo's table and plot read
+// (scripts/demo_report.py, flexmbd plot): the modal one whole (0.03 s), the nodal one
+// over its first 2 ms (its 3 revolutions take 2 s).
+TEST_F(Cli, DemoScenesRunAndHoldTheColumnsOfTheDemo) {
+  for (const std::string variant : {"modal", "nodal"}) {
+    const fs::path out = dir_ / variant;
+    const CliResult r = run("run " + shellQuote(kSourceDir + "/examples/slider_crank_elastic_demo_" + variant + ".json") +
+                            " --out " + shellQuote(out.string()) + (variant == "nodal" ? " --t-end 0.002" : "") +
+                            " --quiet");
+    ASSERT_EQ(r.status, 0) << variant << ": " << r.err;
+    std::ifstream csv(out / "results.csv");
+    std::string header;
+    std::getline(csv, header);
+    for (const char* col : {"crank.theta", "slider.x", "mid.uy"}) {
+      EXPECT_NE(("," + header + ",").find(std::string(",") + col + ","), std::string::npos) << variant << ": " << col;
+    }
+  }
+}
