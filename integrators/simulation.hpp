@@ -103,6 +103,9 @@ struct SimulationSummary {
   bool outputFailed = false;     ///< the run stopped because its results could not be written
   /// Singular positions crossed (crossSingular); their steps are counted in `stats` too.
   std::vector<SingularCrossing> singularCrossings;
+  /// "at t = ... from ida to radau5: N error-test failures in the last M steps" when IDA
+  /// rejected nearly every step and Radau IIA took the rest of the run; "" otherwise.
+  std::string integratorSwitch;
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run

@@ -333,6 +333,8 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["singular_crossings"] = crossings;
   j["formulation"] = toString(s.formulation);
   j["integrator"] = toString(s.integrator);
+  j["integrator_switch"] = summary.integratorSwitch.empty() ? nlohmann::ordered_json(nullptr)
+                                                            : nlohmann::ordered_json(summary.integratorSwitch);
   j["linear_solver"] = summary.usedKlu ? "klu" : "dense";
   j["max_order"] = summary.maxOrder;
   j["order_limit"] = summary.orderLimit.empty() ? nlohmann::json() : nlohmann::json(summary.orderLimit);

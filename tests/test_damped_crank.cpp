@@ -73,3 +73,30 @@ TEST(DampedCrank, TwoRevolutionsWithoutAStepRejectedAtEveryStep) {
               r.summary.stats.steps, r.summary.stats.errorTestFailures, r.summary.cpuSeconds, r.summary.maxOrder,
               r.peakDeflection, rr.peakDeflection, rr.summary.stats.steps);
 }
+
+TEST(DampedCrank, HeavierDampingHandsTheRunFromIdaToRadau) {
+  // Rayleigh beta 3e-4 s: IDA still falls into the order-1 trap at order 3 (measured
+  // 460,780 steps with 458,257 error-test failures, 24 s). The run detects it (at least
+  // 80 % of 2,000 or more steps rejected) and Radau IIA takes the rest: measured 9,849
+  // steps, 7,610 failures (nearly all IDA's before the switch), 0.3 s.
+  constexpr double kHeavyBeta = 3e-4;
+  constexpr long kMaxSteps = 50000;  // 5x the measured 9,849; without the switch 460,780
+  Scene s = testmodels::elasticSliderCrank(4, 1.0, 0, 2.0, kRtol, kAtol, kHeavyBeta);
+  const CrankRun r = runCrank(s);
+  ASSERT_TRUE(r.summary.ok) << r.summary.message;
+  EXPECT_NE(r.summary.integratorSwitch.find("from ida to radau5"), std::string::npos) << r.summary.integratorSwitch;
+  EXPECT_LE(r.summary.stats.steps, kMaxSteps);
+  // The motion is the one Radau IIA alone computes at 100x tighter tolerances: peak
+  // midpoint deflection to 1e-4 (tolerance as above).
+  constexpr double kDeflectionAgreement = 1e-4;
+  Scene ref = testmodels::elasticSliderCrank(4, 1.0, 0, 2.0, kRtol / 100, kAtol / 100, kHeavyBeta);
+  ref.solver.integrator = IntegratorKind::Radau5;
+  const CrankRun rr = runCrank(ref);
+  ASSERT_TRUE(rr.summary.ok) << rr.summary.message;
+  EXPECT_TRUE(rr.summary.integratorSwitch.empty());
+  EXPECT_NEAR(r.peakDeflection / rr.peakDeflection, 1.0, kDeflectionAgreement);
+  std::printf("[ measured ] beta 3e-4: %ld steps, %ld error-test failures, %.3f s CPU, %s; peak deflection %.6e m "
+              "(Radau reference %.6e m, %ld steps)\n",
+              r.summary.stats.steps, r.summary.stats.errorTestFailures, r.summary.cpuSeconds,
+              r.summary.integratorSwitch.c_str(), r.peakDeflection, rr.peakDeflection, rr.summary.stats.steps);
+}
