@@ -88,17 +88,16 @@ struct AugmentedLagrangianIntegrator::Impl {
   Impl(const System& s, const AugmentedLagrangianOptions& o)
       : sys(s), opt(o), ggl(s, Formulation::Ggl), index1(s, Formulation::Index1),
         scratch(ggl.makeScratch()), scratch1(index1.makeScratch()),
-        nq(s.numCoordinates()), m(s.numConstraintEquations()), L(ggl.layout()), L1(index1.layout()) {
+        nq(s.numCoordinates()), m(s.numConstraintEquations()), L(ggl.layout()), L1(index1.layout()),
+        lu(nq), eig(m) {  // sized in place: Eigen's sized constructor leaves m_info unset, so no move-assignment
     y = yp = F = VecX::Zero(L.size);
     y1 = yp1 = F1 = VecX::Zero(L1.size);
     J = MatX::Zero(L.size, L.size);
     P = MatX::Zero(nq, nq);
     G = MatX::Zero(m, nq);
-    lu = Eigen::PartialPivLU<MatX>(nq);
     r = dq = w = qN = vN = aN = err = VecX::Zero(nq);
     lamN = g = VecX::Zero(m);
     gram = MatX::Zero(m, m);
-    eig = Eigen::SelfAdjointEigenSolver<MatX>(m);
   }
 
   /// F (GGL, mu = 0) at (q, v, a) with multipliers lam; with the Jacobian dF/dy + cj dF/dy' if asked.
