@@ -25,14 +25,52 @@ class Body {
 
   const std::string& name() const { return name_; }
 
-  /// Number of generalised coordinates n (velocities have the same size).
+  /// Number of generalised coordinates nq.
   virtual int numCoordinates() const = 0;
+  /// Number of velocities nv (default nq: the velocities are the coordinate rates).
+  /// Everything the body returns below is in velocity space (mass matrix nv x nv, forces
+  /// nv) and differentiated with respect to the coordinates (nv x nq), unless stated.
+  virtual int numVelocities() const { return numCoordinates(); }
+
+  // ----- the kinematic equation q' = T(q) v (docs/spatial.md) ---------------------
+  /// True when T = I (planar bodies): the assembly then takes its fast paths.
+  virtual bool velocitiesAreCoordinateRates() const { return true; }
+  /// T(q) (nq x nv), into T (resized). Default: the identity.
+  virtual void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const;
+  /// A left inverse T+(q) (nv x nq, T+ T = I) with ker T+ the directions along which no
+  /// material point moves (a quaternion's length): the derivative of any body-point
+  /// quantity f(q) is f_q = (f_q T) T+ = G T+. Into Tinv (resized). Default: the identity.
+  virtual void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const;
+  /// out += T(q) w.
+  virtual void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
+    (void)q;
+    out += w;
+  }
+  /// K += d(T(q) w)/dq for a fixed w (nq x nq). Default (T = I): nothing.
+  virtual void addCoordinateRateJacobian(const ConstVecRef& q, const ConstVecRef& w, const MatrixSink& K) const {
+    (void)q; (void)w; (void)K;
+  }
+  /// out = q (+) dv: the coordinates after a velocity-space increment dv (Newton
+  /// corrections and projections work in velocity space). Default: q + dv.
+  virtual void applyIncrement(const ConstVecRef& q, const ConstVecRef& dv, Eigen::Ref<VecX> out) const {
+    out = q + dv;
+  }
+  /// The coordinates whose values the velocities `vcols` (ascending, body-local) move,
+  /// ascending: the coordinate support of a point with velocity support vcols.
+  /// Default (T = I): the same indices.
+  virtual std::vector<int> coordinatesOfVelocities(const std::vector<int>& vcols) const { return vcols; }
+  /// Names of the velocities as results columns ("<body>.<name>"). Default: the
+  /// coordinate names with "_dot".
+  virtual std::vector<std::string> velocityNames() const;
   /// Names of the coordinates, as they appear in results files ("x", "y", "theta").
   virtual std::vector<std::string> coordinateNames() const = 0;
   /// The first numFrameCoordinates() coordinates describe the reference (rigid) motion;
   /// the rest are elastic. Consistent initialisation keeps the given elastic values and
   /// moves the frame coordinates (a body is not deformed to assemble the mechanism).
   virtual int numFrameCoordinates() const { return numCoordinates(); }
+  /// The first numFrameVelocities() velocities are the frame's (default: as many as
+  /// frame coordinates, T = I).
+  virtual int numFrameVelocities() const { return numFrameCoordinates(); }
   /// The kind of each coordinate (default: frame coordinates are positions, the others
   /// elastic).
   virtual std::vector<CoordinateKind> coordinateKinds() const {
@@ -40,17 +78,19 @@ class Body {
     for (int i = 0; i < numFrameCoordinates(); ++i) k[i] = CoordinateKind::Position;
     return k;
   }
-  /// Coordinates and velocities given at construction (initial guess).
+  /// The kind of each velocity (default: that of the coordinate it is the rate of).
+  virtual std::vector<CoordinateKind> velocityKinds() const { return coordinateKinds(); }
+  /// Coordinates (nq) and velocities (nv) given at construction (initial guess).
   virtual VecX initialCoordinates() const = 0;
   virtual VecX initialVelocities() const = 0;
 
   /// Total mass (for checks and the Newton-Euler balance).
   virtual double mass() const = 0;
-  /// M += mass matrix M(q) (n x n, symmetric positive definite), structural non-zeros only.
+  /// M += mass matrix M(q) (nv x nv, symmetric positive definite), structural non-zeros only.
   virtual void addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const = 0;
   /// out += M(q) a (the residual's inertia term, without forming M).
   virtual void addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const = 0;
-  /// K += d(M(q) a)/dq for a fixed vector a (n x n).
+  /// K += d(M(q) a)/dq for a fixed vector a (nv x nq).
   virtual void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a,
                                        const MatrixSink& K) const = 0;
   /// Q += internal generalised forces: quadratic velocity forces (and, for flexible
@@ -65,7 +105,7 @@ class Body {
   virtual void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const = 0;
   /// Dense mass matrix (small systems, outputs and tests).
   MatX massMatrix(const ConstVecRef& q) const {
-    MatX M = MatX::Zero(numCoordinates(), numCoordinates());
+    MatX M = MatX::Zero(numVelocities(), numVelocities());
     addMassMatrix(q, M);
     return M;
   }
@@ -96,7 +136,8 @@ class Body {
     pointKinematics(q, point, &cols, withHessians, p);
     return p;
   }
-  /// The body coordinates the kinematics of `point` depend on (ascending). Default: all.
+  /// The body velocities the velocity of `point` depends on (ascending; the coordinates
+  /// are coordinatesOfVelocities of them). Default: all.
   virtual std::vector<int> pointSupport(const Vec2& point) const;
   /// Checks at model build time that `point` is a valid attachment point.
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {

@@ -12,17 +12,23 @@
 
 namespace flexmbd {
 
-/// A body together with its current coordinates (a view, nothing is copied) and the
-/// coordinates a constraint or force uses of it (`cols`, ascending; null: all).
-/// Derivatives are taken with respect to the used coordinates only.
+/// A body together with its current coordinates (a view, nothing is copied) and what a
+/// constraint or force uses of it: the velocities `cols` and the coordinates `qcols`
+/// (body-local, ascending; null: all). Derivatives are taken with respect to the used
+/// velocities (first derivatives, nv_used columns) and the used coordinates (second
+/// derivatives d/dq of first derivatives, nq_used columns); with T = I the two are the same.
 struct BodyState {
-  BodyState(const Body& b, const double* data, const std::vector<int>* used = nullptr)
-      : body(b), q(data, b.numCoordinates()), cols(used) {}
+  BodyState(const Body& b, const double* data, const std::vector<int>* used = nullptr,
+            const std::vector<int>* usedCoordinates = nullptr)
+      : body(b), q(data, b.numCoordinates()), cols(used), qcols(usedCoordinates ? usedCoordinates : used) {}
   const Body& body;
   Eigen::Map<const VecX> q;
   const std::vector<int>* cols;
+  const std::vector<int>* qcols;
+  /// Number of used velocities.
+  int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numVelocities(); }
   /// Number of used coordinates.
-  int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numCoordinates(); }
+  int numUsedCoordinates() const { return qcols ? static_cast<int>(qcols->size()) : body.numCoordinates(); }
   /// Kinematics of a body point over the used coordinates, into `out` (no allocation
   /// once `out` has been filled before).
   void point(const Vec2& p, bool withHessians, PointKinematics& out) const {
@@ -44,9 +50,10 @@ class BodyStates {
   static constexpr int kMaxBodies = 4;
   /// @throws std::logic_error beyond kMaxBodies (System::addConstraint/addForce refuse
   /// such elements first).
-  void add(const Body& b, const double* q, const std::vector<int>* used) {
+  void add(const Body& b, const double* q, const std::vector<int>* used,
+           const std::vector<int>* usedCoordinates = nullptr) {
     if (n_ == kMaxBodies) throw std::logic_error("BodyStates: more than kMaxBodies bodies");
-    states_[n_++].emplace(b, q, used);
+    states_[n_++].emplace(b, q, used, usedCoordinates);
   }
   int size() const { return n_; }
   const BodyState& operator[](int k) const { return *states_[k]; }
@@ -56,13 +63,15 @@ class BodyStates {
   int n_ = 0;
 };
 
-/// Constraint equations g(q, t) = h(q) - f(t) = 0 over the local coordinates
-/// q_local = [used coordinates of body 0; of body 1; ...] of the constraint's bodies.
-/// The caller keeps one per constraint: evaluations into it reuse its memory.
+/// Constraint equations g(q, t) = h(q) - f(t) = 0 of the constraint's bodies. Their
+/// velocity form is G v_local = f'(t), v_local = [used velocities of body 0; of body 1; ...]
+/// (see BodyState). The caller keeps one per constraint: evaluations into it reuse its memory.
 struct ConstraintEvaluation {
   VecX h;               ///< h(q), m
-  MatX G;               ///< dh/dq, m x n_local
-  std::vector<MatX> H;  ///< d2 h_a/dq2, m matrices n_local x n_local (only when asked)
+  MatX G;               ///< velocity Jacobian, m x nv_local (= dh/dq when T = I)
+  /// H_a = d(G_a^T)/dq_local, m matrices nv_local x nq_local (only when asked): the
+  /// derivative of the constraint force direction. With T = I, the Hessian of h_a.
+  std::vector<MatX> H;
   KinematicsWork work;  ///< working memory of evaluate()
 };
 

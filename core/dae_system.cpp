@@ -42,8 +42,9 @@ void addRowsBlock(JacobianSink& J, int row0, int colOffset, const std::vector<in
 struct ConstraintScratch {
   ConstraintEvaluation ev, plus, minus;  ///< at q; at q +- h e_k (index-1 third derivatives)
   VecX f, df, ddf;                       ///< prescribed motion and its derivatives
-  VecX vl, al, Hv;                       ///< local velocities, accelerations, H_a v
-  MatX Hx, vH, dFdq;                     ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq
+  VecX vl, al, Hv, wl;                   ///< local velocities, accelerations, H_a w, (T v) local
+  MatX Hx, vH, dFdq, dFdv;               ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq and d/dv
+  MatX Tl, Til, THx, TGt;                ///< T and T+ over the local columns (T != I only), products
 };
 
 /// Working memory of one force element.
@@ -56,15 +57,60 @@ struct ForceScratch {
 /// DaeSystem's scratch: one per integrator, so that evaluations allocate nothing.
 struct DaeSystemScratch final : DaeScratch {
   std::vector<VecX> bodyForce;  ///< per body, its generalised forces
+  std::vector<MatX> T, Tinv;    ///< per body T(q) and T+(q) (T != I only)
   std::vector<ConstraintScratch> constraints;
   std::vector<ForceScratch> forces;
   VecX qPlus, qMinus;           ///< perturbed coordinates (index-1 Jacobian)
+  VecX DGtmu, w, Tv, TvPlus;    ///< D G^T mu and w = D G^T mu - v (nv); T v (nq)
 };
 
 DaeSystemScratch& scratchOf(DaeScratch& s) {
   auto* d = dynamic_cast<DaeSystemScratch*>(&s);
   if (!d) throw std::logic_error("DaeSystem: the scratch was not made by DaeSystem::makeScratch()");
   return *d;
+}
+
+/// out = T(q) v body by body, into a vector of size nq (no allocation).
+void coordinateRates(const System& sys, const double* q, const double* v, VecX& out) {
+  out.setZero(sys.numCoordinates());
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0) continue;
+    body.addCoordinateRate(Eigen::Map<const VecX>(q + sys.coordinateOffset(bi), nqb),
+                           Eigen::Map<const VecX>(v + sys.velocityOffset(bi), nvb),
+                           out.segment(sys.coordinateOffset(bi), nqb));
+  }
+}
+
+/// Tl (nq_l x nv_l) and Til (nv_l x nq_l): T and T+ of a constraint's bodies restricted to
+/// its used coordinates and velocities, block by body slot (S.T, S.Tinv filled before).
+void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, const DaeSystemScratch& S, MatX& Tl,
+                       MatX& Til) {
+  const BodyStates states = sys.constraintStates(ci, q);
+  int nql = 0, nvl = 0;
+  for (int k = 0; k < states.size(); ++k) {
+    nql += states[k].numUsedCoordinates();
+    nvl += states[k].numUsed();
+  }
+  Tl.setZero(nql, nvl);
+  Til.setZero(nvl, nql);
+  int r = 0, c = 0;
+  for (int k = 0; k < states.size(); ++k) {
+    const BodyState& st = states[k];
+    const int b = sys.constraint(ci).bodies()[k].value;
+    const std::vector<int>& qc = *st.qcols;
+    const std::vector<int>& vc = *st.cols;
+    for (size_t i = 0; i < qc.size(); ++i) {
+      for (size_t j = 0; j < vc.size(); ++j) {
+        Tl(r + i, c + j) = S.T[b](qc[i], vc[j]);
+        Til(c + j, r + i) = S.Tinv[b](vc[j], qc[i]);
+      }
+    }
+    r += static_cast<int>(qc.size());
+    c += static_cast<int>(vc.size());
+  }
 }
 
 }  // namespace
@@ -88,8 +134,8 @@ Formulation parseFormulation(const std::string& name) {
 
 VecX defaultStabilisationMetric(const System& sys) {
   if (!sys.isFinalized()) throw InputError("DaeSystem: the system must be finalized first");
-  VecX D = VecX::Ones(sys.numCoordinates());
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  VecX D = VecX::Ones(sys.numVelocities());
+  const std::vector<CoordinateKind> kinds = sys.velocityKinds();
   for (int k = 0; k < D.size(); ++k) {
     if (kinds[k] == CoordinateKind::Elastic) D[k] = kElasticStabilisationWeight;
   }
@@ -102,24 +148,25 @@ DaeSystem::DaeSystem(const System& sys, Formulation formulation)
 DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric)
     : sys_(sys), formulation_(formulation), metric_(std::move(stabilisationMetric)) {
   if (!sys.isFinalized()) throw InputError("DaeSystem: the system must be finalized first");
-  if (metric_.size() != sys.numCoordinates() || !(metric_.minCoeff() > 0.0) || !metric_.allFinite()) {
-    throw InputError("DaeSystem: the stabilisation metric must have one positive entry per coordinate");
+  if (metric_.size() != sys.numVelocities() || !(metric_.minCoeff() > 0.0) || !metric_.allFinite()) {
+    throw InputError("DaeSystem: the stabilisation metric must have one positive entry per velocity");
   }
   DaeLayout& L = layout_;
   L.nq = sys.numCoordinates();
+  L.nv = sys.numVelocities();
   L.m = sys.numConstraintEquations();
   L.q = 0;
   L.v = L.nq;
-  L.lambda = 2 * L.nq;
-  L.mu = formulation == Formulation::Ggl ? 2 * L.nq + L.m : -1;
-  L.size = 2 * L.nq + (formulation == Formulation::Ggl ? 2 : 1) * L.m;
+  L.lambda = L.nq + L.nv;
+  L.mu = formulation == Formulation::Ggl ? L.nq + L.nv + L.m : -1;
+  L.size = L.nq + L.nv + (formulation == Formulation::Ggl ? 2 : 1) * L.m;
 
   // The pattern is what the assembly writes, recorded once at the initial state.
   std::vector<std::pair<int, int>> entries;
   JacobianSink recorder = JacobianSink::recorder(&entries);
   VecX y, yp;
   const VecX q0 = sys.initialCoordinates();
-  packState(q0, VecX::Zero(L.nq), VecX::Zero(L.nq), VecX::Zero(L.m), y, yp);
+  packState(q0, VecX::Zero(L.nv), VecX::Zero(L.nv), VecX::Zero(L.m), y, yp);
   jacobian(0.0, y.data(), yp.data(), 1.0, recorder);
   pattern_ = SparsePattern(L.size, std::move(entries));
 }
@@ -127,45 +174,58 @@ DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisat
 VecX DaeSystem::differentialIds() const {
   VecX id = VecX::Zero(layout_.size);
   id.segment(layout_.q, layout_.nq).setOnes();
-  if (formulation_ != Formulation::Index3) id.segment(layout_.v, layout_.nq).setOnes();
+  if (formulation_ != Formulation::Index3) id.segment(layout_.v, layout_.nv).setOnes();
   return id;
 }
 
 std::vector<int64_t> DaeSystem::eliminationGroups() const {
   const DaeLayout& L = layout_;
   std::vector<int64_t> groups(L.size, 0);
-  for (int k = 2 * L.nq; k < L.size; ++k) groups[k] = 1;
-  for (int f : sys_.frameCoordinates()) groups[L.q + f] = groups[L.v + f] = 1;
+  for (int k = L.lambda; k < L.size; ++k) groups[k] = 1;
+  for (int f : sys_.frameCoordinates()) groups[L.q + f] = 1;
+  for (int f : sys_.frameVelocities()) groups[L.v + f] = 1;
   return groups;
 }
 
 std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
   const System& sys = sys_;
   auto s = std::make_unique<DaeSystemScratch>();
-  for (int b = 0; b < sys.numBodies(); ++b) s->bodyForce.emplace_back(sys.body(BodyIndex(b)).numCoordinates());
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    s->bodyForce.emplace_back(body.numVelocities());
+    s->T.emplace_back(MatX::Zero(body.numCoordinates(), body.numVelocities()));
+    s->Tinv.emplace_back(MatX::Zero(body.numVelocities(), body.numCoordinates()));
+  }
   s->constraints.resize(sys.numConstraints());
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const int nl = static_cast<int>(sys.constraintColumns(ci).size()), me = sys.constraint(ci).numEquations();
+    const int nql = static_cast<int>(sys.constraintCoordinateColumns(ci).size());
     ConstraintScratch& cs = s->constraints[c];
     cs.vl.resize(nl);
     cs.al.resize(nl);
     cs.Hv.resize(nl);
-    cs.Hx.resize(nl, nl);
-    cs.vH.resize(me, nl);
-    cs.dFdq.resize(me, nl);
+    cs.wl.resize(nql);
+    cs.Hx.resize(nl, nql);
+    cs.vH.resize(me, nql);
+    cs.dFdq.resize(me, nql);
   }
   s->forces.resize(sys.numForces());
   for (int f = 0; f < sys.numForces(); ++f) {
     const int nl = static_cast<int>(sys.forceColumns(ForceIndex(f)).size());
+    const int nql = static_cast<int>(sys.forceCoordinateColumns(ForceIndex(f)).size());
     ForceScratch& fs = s->forces[f];
     fs.vl.resize(nl);
     fs.Q.resize(nl);
-    fs.dQdq.resize(nl, nl);
+    fs.dQdq.resize(nl, nql);
     fs.dQdv.resize(nl, nl);
   }
   s->qPlus.resize(sys.numCoordinates());
   s->qMinus.resize(sys.numCoordinates());
+  s->DGtmu.resize(sys.numVelocities());
+  s->w.resize(sys.numVelocities());
+  s->Tv.resize(sys.numCoordinates());
+  s->TvPlus.resize(sys.numCoordinates());
   return s;
 }
 
@@ -175,32 +235,41 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
   y = VecX::Zero(L.size);
   yp = VecX::Zero(L.size);
   y.segment(L.q, L.nq) = q;
-  y.segment(L.v, L.nq) = v;
+  y.segment(L.v, L.nv) = v;
   y.segment(L.lambda, L.m) = lambda;
-  yp.segment(L.q, L.nq) = v;
-  yp.segment(L.v, L.nq) = a;
+  yp.segment(L.q, L.nq) = sys_.coordinateRates(q, v);
+  yp.segment(L.v, L.nv) = a;
 }
 
 void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
-  ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), qp(yp + L.q, L.nq), vp(yp + L.v, L.nq);
-  Eigen::Map<VecX> Fq(F + L.q, L.nq), Fv(F + L.v, L.nq);
-  Fq = qp - v;
+  const bool identityT = sys.velocitiesAreCoordinateRates();
+  ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), qp(yp + L.q, L.nq), vp(yp + L.v, L.nv);
+  Eigen::Map<VecX> Fq(F + L.q, L.nq), Fv(F + L.v, L.nv);
+  // F_q = q' - T (v - D G^T mu): with T = I written at once, otherwise after the
+  // constraints have accumulated D G^T mu.
+  if (identityT) {
+    Fq = qp - v;
+  } else {
+    Fq = qp;
+    S.DGtmu.setZero();
+  }
   Fv.setZero();
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    const int nb = body.numCoordinates();
-    if (nb == 0) continue;
-    const int off = sys.coordinateOffset(BodyIndex(b));
-    const auto qb = q.segment(off, nb);
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0) continue;
+    const int voff = sys.velocityOffset(bi);
+    const auto qb = q.segment(sys.coordinateOffset(bi), nqb);
     VecX& Qb = S.bodyForce[b];
     Qb.setZero();
-    body.addInternalForces(qb, v.segment(off, nb), Qb);
+    body.addInternalForces(qb, v.segment(voff, nvb), Qb);
     body.addGravityForce(qb, sys.gravity(), Qb);
-    Fv.segment(off, nb) -= Qb;
-    body.addMassTimes(qb, vp.segment(off, nb), Fv.segment(off, nb));
+    Fv.segment(voff, nvb) -= Qb;
+    body.addMassTimes(qb, vp.segment(voff, nvb), Fv.segment(voff, nvb));
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
@@ -212,6 +281,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
     for (size_t k = 0; k < cols.size(); ++k) Fv[cols[k]] -= fs.Q[k];
   }
   const bool needH = formulation_ == Formulation::Index1;
+  if (needH && !identityT) coordinateRates(sys, q.data(), v.data(), S.Tv);
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
@@ -227,9 +297,13 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
     Eigen::Map<VecX> Fc(F + L.lambda + row, me);
     switch (formulation_) {
       case Formulation::Ggl: {
-        // F_q += D G^T mu;  F_g = h - f;  F_gv = G v - f'
+        // F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f'
         const double* mu = y + L.mu + row;
-        for (int k = 0; k < nl; ++k) Fq[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
+        if (identityT) {
+          for (int k = 0; k < nl; ++k) Fq[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
+        } else {
+          for (int k = 0; k < nl; ++k) S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
+        }
         Fc = ev.h - cs.f;
         double* Fcv = F + L.mu + row;
         for (int a = 0; a < me; ++a) Fcv[a] = -cs.df[a];
@@ -243,15 +317,31 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
         Fc = ev.h - cs.f;
         break;
       case Formulation::Index1: {
-        // F_a = G a + v^T H_a v - f''
+        // F_a = G a + v^T H_a T v - f''
         gather(cols, v.data(), cs.vl);
         gather(cols, vp.data(), cs.al);
+        if (identityT) {
+          cs.wl = cs.vl;
+        } else {
+          gather(sys.constraintCoordinateColumns(ci), S.Tv.data(), cs.wl);
+        }
         for (int a = 0; a < me; ++a) {
-          cs.Hv.noalias() = ev.H[a] * cs.vl;
+          cs.Hv.noalias() = ev.H[a] * cs.wl;
           Fc[a] = ev.G.row(a).dot(cs.al) + cs.vl.dot(cs.Hv) - cs.ddf[a];
         }
         break;
       }
+    }
+  }
+  if (!identityT) {
+    S.w = S.DGtmu - v;  // F_q = q' + T (D G^T mu - v)
+    for (int b = 0; b < sys.numBodies(); ++b) {
+      const BodyIndex bi(b);
+      const Body& body = sys.body(bi);
+      const int nqb = body.numCoordinates(), qoff = sys.coordinateOffset(bi);
+      if (nqb == 0) continue;
+      body.addCoordinateRate(q.segment(qoff, nqb), S.w.segment(sys.velocityOffset(bi), body.numVelocities()),
+                             Fq.segment(qoff, nqb));
     }
   }
 }
@@ -261,30 +351,37 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
-  ConstMap q(y + L.q, L.nq), v(y + L.v, L.nq), vp(yp + L.v, L.nq);
-  // F_q = q' - v (+ G^T mu): dF_q/dq' = I, dF_q/dv = -I
-  for (int k = 0; k < L.nq; ++k) {
-    J.add(L.q + k, L.q + k, cj);
-    J.add(L.q + k, L.v + k, -1.0);
-  }
-  // F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body
+  const bool identityT = sys.velocitiesAreCoordinateRates();
+  ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), vp(yp + L.v, L.nv);
+  // F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body; F_q = q' - T w:
+  // cj I and -T (with T = I: -I)
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    const int nb = body.numCoordinates();
-    if (nb == 0) continue;
-    const int off = sys.coordinateOffset(BodyIndex(b));
-    const auto qb = q.segment(off, nb);
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0) continue;
+    const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
+    const auto qb = q.segment(qoff, nqb);
+    for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.q + qoff + k, cj);
+    if (body.velocitiesAreCoordinateRates()) {
+      for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.v + voff + k, -1.0);
+    } else {
+      body.coordinateRateMatrix(qb, S.T[b]);
+      body.coordinateRateInverse(qb, S.Tinv[b]);
+      MatrixSink(J, L.q + qoff, L.v + voff, -1.0).addBlock(0, 0, S.T[b]);
+    }
     // each body writes its structural non-zeros only (sparse for large flexible bodies)
-    const MatrixSink Jq(J, L.v + off, L.q + off), minusJq(J, L.v + off, L.q + off, -1.0);
-    const MatrixSink cjM(J, L.v + off, L.v + off, cj), minusJv(J, L.v + off, L.v + off, -1.0);
-    body.addMassMatrixDerivative(qb, vp.segment(off, nb), Jq);
-    body.addInternalForceJacobians(qb, v.segment(off, nb), minusJq, minusJv);
+    const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);
+    const MatrixSink cjM(J, L.v + voff, L.v + voff, cj), minusJv(J, L.v + voff, L.v + voff, -1.0);
+    body.addMassMatrixDerivative(qb, vp.segment(voff, nvb), Jq);
+    body.addInternalForceJacobians(qb, v.segment(voff, nvb), minusJq, minusJv);
     body.addGravityJacobian(qb, sys.gravity(), minusJq);
     body.addMassMatrix(qb, cjM);
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
     const auto& cols = sys.forceColumns(fi);
+    const auto& qcols = sys.forceCoordinateColumns(fi);
     ForceScratch& fs = S.forces[f];
     gather(cols, v.data(), fs.vl);
     fs.Q.setZero();
@@ -293,75 +390,147 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
     sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, &fs.dQdq, &fs.dQdv, fs.work);
     fs.dQdq *= -1.0;
     fs.dQdv *= -1.0;
-    addBlock(J, L.v, cols, L.q, cols, fs.dQdq);
+    addBlock(J, L.v, cols, L.q, qcols, fs.dQdq);
     addBlock(J, L.v, cols, L.v, cols, fs.dQdv);
+  }
+  if (!identityT) {
+    S.DGtmu.setZero();
+    if (formulation_ == Formulation::Index1) coordinateRates(sys, q.data(), v.data(), S.Tv);
   }
   for (int c = 0; c < sys.numConstraints(); ++c) {
     const ConstraintIndex ci(c);
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
-    const int nl = static_cast<int>(cols.size());
+    const auto& qcols = sys.constraintCoordinateColumns(ci);
+    const int nl = static_cast<int>(cols.size()), nql = static_cast<int>(qcols.size());
     const int row = sys.constraintOffset(ci), me = con.numEquations();
     ConstraintScratch& cs = S.constraints[c];
     const ConstraintEvaluation& ev = cs.ev;
     con.evaluate(sys.constraintStates(ci, q.data()), true, cs.ev);
     gather(cols, v.data(), cs.vl);
+    if (!identityT) localRateMatrices(sys, ci, q.data(), S, cs.Tl, cs.Til);
     // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
     cs.Hx.setZero();
     for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];
-    addBlock(J, L.v, cols, L.q, cols, cs.Hx);
+    addBlock(J, L.v, cols, L.q, qcols, cs.Hx);
     for (int a = 0; a < me; ++a) {
       for (int k = 0; k < nl; ++k) J.add(L.v + cols[k], L.lambda + row + a, ev.G(a, k));
     }
     for (int a = 0; a < me; ++a) cs.vH.row(a).noalias() = cs.vl.transpose() * ev.H[a];  // d(G v)/dq
     switch (formulation_) {
       case Formulation::Ggl: {
-        // F_q += D G^T mu: d/dq = D sum_a mu_a H_a, d/dmu = D G^T
+        // F_q += T D G^T mu: d/dq = T D sum_a mu_a H_a (+ the dT/dq term below), d/dmu = T D G^T
         cs.Hx.setZero();
         for (int a = 0; a < me; ++a) cs.Hx += y[L.mu + row + a] * ev.H[a];
-        for (int j = 0; j < nl; ++j) {
-          for (int i = 0; i < nl; ++i) J.add(L.q + cols[i], L.q + cols[j], metric_[cols[i]] * cs.Hx(i, j));
+        if (identityT) {
+          for (int j = 0; j < nl; ++j) {
+            for (int i = 0; i < nl; ++i) J.add(L.q + cols[i], L.q + cols[j], metric_[cols[i]] * cs.Hx(i, j));
+          }
+          for (int a = 0; a < me; ++a) {
+            for (int k = 0; k < nl; ++k) J.add(L.q + cols[k], L.mu + row + a, metric_[cols[k]] * ev.G(a, k));
+          }
+          addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+        } else {
+          const double* mu = y + L.mu + row;
+          for (int k = 0; k < nl; ++k) {
+            cs.Hx.row(k) *= metric_[cols[k]];
+            S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
+          }
+          cs.THx.noalias() = cs.Tl * cs.Hx;
+          addBlock(J, L.q, qcols, L.q, qcols, cs.THx);
+          cs.TGt.resize(nl, me);
+          for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
+          cs.THx.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
+          for (int a = 0; a < me; ++a) {
+            for (int k = 0; k < nql; ++k) J.add(L.q + qcols[k], L.mu + row + a, cs.THx(k, a));
+          }
+          // F_g = h - f: dh/dq = G T+
+          cs.dFdq.noalias() = ev.G * cs.Til;
+          addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
         }
-        for (int a = 0; a < me; ++a) {
-          for (int k = 0; k < nl; ++k) J.add(L.q + cols[k], L.mu + row + a, metric_[cols[k]] * ev.G(a, k));
-        }
-        addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
-        addRowsBlock(J, L.mu + row, L.q, cols, cs.vH);
+        addRowsBlock(J, L.mu + row, L.q, qcols, cs.vH);
         addRowsBlock(J, L.mu + row, L.v, cols, ev.G);
         break;
       }
       case Formulation::Index3:
-        addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+        if (identityT) {
+          addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+        } else {
+          cs.dFdq.noalias() = ev.G * cs.Til;
+          addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
+        }
         break;
       case Formulation::Index1: {
-        // F_a = G a + v^T H v - f'': d/dq = a^T H_a + d(v^T H_a v)/dq, d/dv = 2 v^T H_a,
-        // d/da = G. The third-derivative term d(v^T H_a v)/dq is the one block taken
-        // by central differences of the analytic Hessians (docs/formulations.md).
+        // F_a = G a + v^T H_a w - f'', w = T v: d/dq = a^T H_a + d(v^T H_a w)/dq,
+        // d/dv = v^T H_a T + (H_a w)^T (2 v^T H_a with T = I), d/da = G. The third-derivative
+        // term d(v^T H_a w)/dq is the one block taken by central differences of the
+        // analytic H_a (and of T) (docs/formulations.md).
         gather(cols, vp.data(), cs.al);
+        if (identityT) {
+          cs.wl = cs.vl;
+        } else {
+          gather(qcols, S.Tv.data(), cs.wl);
+        }
         for (int a = 0; a < me; ++a) cs.dFdq.row(a).noalias() = cs.al.transpose() * ev.H[a];
         S.qPlus = q;
         S.qMinus = q;
-        for (int k = 0; k < nl; ++k) {
-          const int c = cols[k];
-          const double h = 1e-6 * (1.0 + std::abs(q[c]));
-          S.qPlus[c] = q[c] + h;
-          S.qMinus[c] = q[c] - h;
+        for (int k = 0; k < nql; ++k) {
+          const int qc = qcols[k];
+          const double h = 1e-6 * (1.0 + std::abs(q[qc]));
+          S.qPlus[qc] = q[qc] + h;
+          S.qMinus[qc] = q[qc] - h;
           con.evaluate(sys.constraintStates(ci, S.qPlus.data()), true, cs.plus);
           con.evaluate(sys.constraintStates(ci, S.qMinus.data()), true, cs.minus);
-          S.qPlus[c] = S.qMinus[c] = q[c];
           for (int a = 0; a < me; ++a) {
-            cs.Hv.noalias() = cs.plus.H[a] * cs.vl;
-            const double plus = cs.vl.dot(cs.Hv);
-            cs.Hv.noalias() = cs.minus.H[a] * cs.vl;
-            cs.dFdq(a, k) += (plus - cs.vl.dot(cs.Hv)) / (2.0 * h);
+            double plus = 0.0, minus = 0.0;
+            if (identityT) {
+              cs.Hv.noalias() = cs.plus.H[a] * cs.vl;
+              plus = cs.vl.dot(cs.Hv);
+              cs.Hv.noalias() = cs.minus.H[a] * cs.vl;
+              minus = cs.vl.dot(cs.Hv);
+            } else {
+              coordinateRates(sys, S.qPlus.data(), v.data(), S.TvPlus);
+              gather(qcols, S.TvPlus.data(), cs.wl);
+              cs.Hv.noalias() = cs.plus.H[a] * cs.wl;
+              plus = cs.vl.dot(cs.Hv);
+              coordinateRates(sys, S.qMinus.data(), v.data(), S.TvPlus);
+              gather(qcols, S.TvPlus.data(), cs.wl);
+              cs.Hv.noalias() = cs.minus.H[a] * cs.wl;
+              minus = cs.vl.dot(cs.Hv);
+            }
+            cs.dFdq(a, k) += (plus - minus) / (2.0 * h);
           }
+          S.qPlus[qc] = S.qMinus[qc] = q[qc];
         }
-        addRowsBlock(J, L.lambda + row, L.q, cols, cs.dFdq);
-        cs.vH *= 2.0;
-        cs.vH += cj * ev.G;
-        addRowsBlock(J, L.lambda + row, L.v, cols, cs.vH);
+        addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
+        if (identityT) {
+          cs.vH *= 2.0;
+          cs.vH += cj * ev.G;
+          addRowsBlock(J, L.lambda + row, L.v, cols, cs.vH);
+        } else {
+          gather(qcols, S.Tv.data(), cs.wl);
+          cs.dFdv.resize(me, nl);
+          for (int a = 0; a < me; ++a) {
+            cs.Hv.noalias() = ev.H[a] * cs.wl;
+            cs.dFdv.row(a).noalias() = cs.vH.row(a) * cs.Tl + cs.Hv.transpose();
+          }
+          cs.dFdv += cj * ev.G;
+          addRowsBlock(J, L.lambda + row, L.v, cols, cs.dFdv);
+        }
         break;
       }
+    }
+  }
+  if (!identityT) {
+    // F_q = q' + T(q) w, w = D G^T mu - v: the dT/dq term at fixed w
+    S.w = S.DGtmu - v;
+    for (int b = 0; b < sys.numBodies(); ++b) {
+      const BodyIndex bi(b);
+      const Body& body = sys.body(bi);
+      const int nqb = body.numCoordinates(), qoff = sys.coordinateOffset(bi);
+      if (nqb == 0 || body.velocitiesAreCoordinateRates()) continue;
+      body.addCoordinateRateJacobian(q.segment(qoff, nqb), S.w.segment(sys.velocityOffset(bi), body.numVelocities()),
+                                     MatrixSink(J, L.q + qoff, L.q + qoff));
     }
   }
 }

@@ -24,7 +24,8 @@ Formulation parseFormulation(const std::string& name);
 
 /// Where each class of unknowns starts in y (and each class of equations in F).
 struct DaeLayout {
-  int nq = 0;       ///< coordinates (= velocities)
+  int nq = 0;       ///< coordinates
+  int nv = 0;       ///< velocities (= nq when every body has q' = v)
   int m = 0;        ///< constraint equations
   int q = 0;        ///< offset of positions
   int v = 0;        ///< offset of velocities
@@ -42,14 +43,16 @@ inline constexpr double kElasticStabilisationWeight = 1e-6;
 /// D = 1 on frame coordinates, kElasticStabilisationWeight on elastic ones.
 VecX defaultStabilisationMetric(const System& sys);
 
-/// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985):
-///   F_q  = q' - v + G^T mu,  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),  F_gv = G v + g_t.
-/// Index 3 drops mu and F_gv; index 1 replaces F_g by G v' + (G v)_q v + g_tt.
+/// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985), with q' = T(q) v (docs/spatial.md):
+///   F_q  = q' - T(q) (v - D G^T mu),  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),
+///   F_gv = G v + g_t,
+/// G the velocity Jacobian (m x nv). Index 3 drops mu and F_gv; index 1 replaces F_g by
+/// G v' + (G v)_q T v + g_tt. With T = I (planar models), F_q = q' - v + D G^T mu.
 class DaeSystem final : public DaeProblem {
  public:
   /// @throws InputError if the system is not finalized.
   DaeSystem(const System& sys, Formulation formulation);
-  /// GGL with the stabilisation metric D (diagonal, nq, positive): F_q = q' - v + D G^T mu.
+  /// GGL with the stabilisation metric D (diagonal, nv, positive): F_q = q' - T (v - D G^T mu).
   /// The first constructor takes defaultStabilisationMetric(sys).
   DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric);
   const VecX& stabilisationMetric() const { return metric_; }
@@ -87,7 +90,7 @@ class DaeSystem final : public DaeProblem {
   Formulation formulation_;
   DaeLayout layout_;
   SparsePattern pattern_;
-  VecX metric_;  ///< D of the GGL stabilisation (nq)
+  VecX metric_;  ///< D of the GGL stabilisation (nv)
 };
 
 }  // namespace flexmbd

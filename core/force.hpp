@@ -8,8 +8,9 @@
 
 namespace flexmbd {
 
-/// A force element adds generalised forces Q(t, q, v) over the local coordinates of
-/// its bodies, q_local = [used coordinates of body 0; of body 1; ...] (see BodyState).
+/// A force element adds generalised forces Q(t, q, v) over the local velocities of its
+/// bodies, v_local = [used velocities of body 0; of body 1; ...] (see BodyState): Q and
+/// v are nv_local, dQ/dq is nv_local x nq_local, dQ/dv nv_local x nv_local.
 class Force {
  public:
   Force(std::string name, std::vector<BodyIndex> bodies)

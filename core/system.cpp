@@ -229,10 +229,15 @@ void System::finalize() {
     for (const auto& [b, p] : f->attachments()) body(b).checkAttachmentPoint(p, "force '" + f->name() + "'");
   }
   bodyOffset_.clear();
-  nq_ = 0;
+  bodyVelocityOffset_.clear();
+  nq_ = nv_ = 0;
+  coordinateRates_ = true;
   for (const auto& b : bodies_) {
     bodyOffset_.push_back(nq_);
+    bodyVelocityOffset_.push_back(nv_);
     nq_ += b->numCoordinates();
+    nv_ += b->numVelocities();
+    coordinateRates_ = coordinateRates_ && b->velocitiesAreCoordinateRates();
   }
   // Coordinates used of each body: the union of the supports of the attachment points
   // on it (a joint on a node of a large flexible body uses only the frame and that
@@ -254,34 +259,48 @@ void System::finalize() {
         for (int c : body(b).pointSupport(p)) cols.insert(c);
       }
       if (!attached) {
-        for (int k = 0; k < body(bs[slot]).numCoordinates(); ++k) cols.insert(k);
+        for (int k = 0; k < body(bs[slot]).numVelocities(); ++k) cols.insert(k);
       }
       used.emplace_back(cols.begin(), cols.end());
     }
     return used;
   };
-  auto globalColumns = [&](const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used) {
+  auto coordinatesOf = [&](const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used) {
+    std::vector<std::vector<int>> usedQ;
+    for (size_t slot = 0; slot < bs.size(); ++slot) usedQ.push_back(body(bs[slot]).coordinatesOfVelocities(used[slot]));
+    return usedQ;
+  };
+  auto globalColumns = [&](const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
+                           const std::vector<int>& offsets) {
     std::vector<int> cols;
     for (size_t slot = 0; slot < bs.size(); ++slot) {
-      for (int k : used[slot]) cols.push_back(bodyOffset_[bs[slot].value] + k);
+      for (int k : used[slot]) cols.push_back(offsets[bs[slot].value] + k);
     }
     return cols;
   };
   m_ = 0;
   constraintOffset_.clear();
   constraintCols_.clear();
+  constraintQCols_.clear();
   constraintUsed_.clear();
+  constraintUsedQ_.clear();
   for (const auto& c : constraints_) {
     constraintOffset_.push_back(m_);
     m_ += c->numEquations();
     constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), [&](int slot) { return c->coordinatesUsed(slot); }));
-    constraintCols_.push_back(globalColumns(c->bodies(), constraintUsed_.back()));
+    constraintUsedQ_.push_back(coordinatesOf(c->bodies(), constraintUsed_.back()));
+    constraintCols_.push_back(globalColumns(c->bodies(), constraintUsed_.back(), bodyVelocityOffset_));
+    constraintQCols_.push_back(globalColumns(c->bodies(), constraintUsedQ_.back(), bodyOffset_));
   }
   forceCols_.clear();
+  forceQCols_.clear();
   forceUsed_.clear();
+  forceUsedQ_.clear();
   for (const auto& f : forces_) {
     forceUsed_.push_back(usedCoordinates(f->bodies(), f->attachments(), [](int) { return std::nullopt; }));
-    forceCols_.push_back(globalColumns(f->bodies(), forceUsed_.back()));
+    forceUsedQ_.push_back(coordinatesOf(f->bodies(), forceUsed_.back()));
+    forceCols_.push_back(globalColumns(f->bodies(), forceUsed_.back(), bodyVelocityOffset_));
+    forceQCols_.push_back(globalColumns(f->bodies(), forceUsedQ_.back(), bodyOffset_));
   }
   finalized_ = true;
 }
@@ -297,28 +316,52 @@ VecX System::initialCoordinates() const {
 
 VecX System::initialVelocities() const {
   requireFinalized("initialVelocities");
-  VecX v(nq_);
+  VecX v(nv_);
   for (int i = 0; i < numBodies(); ++i) {
-    v.segment(bodyOffset_[i], bodies_[i]->numCoordinates()) = bodies_[i]->initialVelocities();
+    v.segment(bodyVelocityOffset_[i], bodies_[i]->numVelocities()) = bodies_[i]->initialVelocities();
   }
   return v;
 }
 
+VecX System::applyIncrement(const VecX& q, const VecX& dv) const {
+  requireFinalized("applyIncrement");
+  if (coordinateRates_) return q + dv;
+  VecX out(nq_);
+  for (int i = 0; i < numBodies(); ++i) {
+    const int nq = bodies_[i]->numCoordinates(), nv = bodies_[i]->numVelocities();
+    bodies_[i]->applyIncrement(q.segment(bodyOffset_[i], nq), dv.segment(bodyVelocityOffset_[i], nv),
+                               out.segment(bodyOffset_[i], nq));
+  }
+  return out;
+}
+
+VecX System::coordinateRates(const VecX& q, const VecX& v) const {
+  requireFinalized("coordinateRates");
+  if (coordinateRates_) return v;
+  VecX out = VecX::Zero(nq_);
+  for (int i = 0; i < numBodies(); ++i) {
+    const int nq = bodies_[i]->numCoordinates(), nv = bodies_[i]->numVelocities();
+    bodies_[i]->addCoordinateRate(q.segment(bodyOffset_[i], nq), v.segment(bodyVelocityOffset_[i], nv),
+                                  out.segment(bodyOffset_[i], nq));
+  }
+  return out;
+}
+
 BodyStates System::states(const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
-                          const double* q) const {
+                          const std::vector<std::vector<int>>& usedQ, const double* q) const {
   BodyStates out;
   for (size_t slot = 0; slot < bs.size(); ++slot) {
-    out.add(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot]);
+    out.add(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot], &usedQ[slot]);
   }
   return out;
 }
 
 BodyStates System::constraintStates(ConstraintIndex i, const double* q) const {
-  return states(constraint(i).bodies(), constraintUsed_.at(i.value), q);
+  return states(constraint(i).bodies(), constraintUsed_.at(i.value), constraintUsedQ_.at(i.value), q);
 }
 
 BodyStates System::forceStates(ForceIndex i, const double* q) const {
-  return states(force(i).bodies(), forceUsed_.at(i.value), q);
+  return states(force(i).bodies(), forceUsed_.at(i.value), forceUsedQ_.at(i.value), q);
 }
 
 std::string System::describeEquation(int row) const {
@@ -342,10 +385,27 @@ std::vector<int> System::frameCoordinates() const {
   return idx;
 }
 
+std::vector<int> System::frameVelocities() const {
+  requireFinalized("frameVelocities");
+  std::vector<int> idx;
+  for (int b = 0; b < numBodies(); ++b) {
+    for (int k = 0; k < bodies_[b]->numFrameVelocities(); ++k) idx.push_back(bodyVelocityOffset_[b] + k);
+  }
+  return idx;
+}
+
 std::vector<CoordinateKind> System::coordinateKinds() const {
   std::vector<CoordinateKind> kinds;
   for (const auto& b : bodies_) {
     for (CoordinateKind k : b->coordinateKinds()) kinds.push_back(k);
+  }
+  return kinds;
+}
+
+std::vector<CoordinateKind> System::velocityKinds() const {
+  std::vector<CoordinateKind> kinds;
+  for (const auto& b : bodies_) {
+    for (CoordinateKind k : b->velocityKinds()) kinds.push_back(k);
   }
   return kinds;
 }
@@ -372,6 +432,24 @@ std::vector<std::string> System::coordinateNames() const {
   std::vector<std::string> names;
   for (const auto& b : bodies_) {
     for (const auto& c : b->coordinateNames()) names.push_back(b->name() + "." + c);
+  }
+  return names;
+}
+
+std::vector<std::string> System::accelerationNames() const {
+  std::vector<std::string> names = velocityNames();
+  const std::string dot = "_dot";
+  for (auto& n : names) {
+    const bool rate = n.size() > dot.size() && n.compare(n.size() - dot.size(), dot.size(), dot) == 0;
+    n = rate ? n.substr(0, n.size() - dot.size()) + "_ddot" : n + "_dot";
+  }
+  return names;
+}
+
+std::vector<std::string> System::velocityNames() const {
+  std::vector<std::string> names;
+  for (const auto& b : bodies_) {
+    for (const auto& c : b->velocityNames()) names.push_back(b->name() + "." + c);
   }
   return names;
 }

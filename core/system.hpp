@@ -74,32 +74,55 @@ class System {
   ConstraintIndex findConstraint(const std::string& name) const;
 
   // ----- after finalize ----------------------------------------------------------
+  // The coordinate map: body b's coordinates are q[coordinateOffset(b) .. + nq_b) and its
+  // velocities v[velocityOffset(b) .. + nv_b), with q' = T_b(q_b) v_b (Body::coordinateRateMatrix).
   int numCoordinates() const { return nq_; }
+  int numVelocities() const { return nv_; }
   int numConstraintEquations() const { return m_; }
   int coordinateOffset(BodyIndex i) const { return bodyOffset_.at(i.value); }
+  int velocityOffset(BodyIndex i) const { return bodyVelocityOffset_.at(i.value); }
   int constraintOffset(ConstraintIndex i) const { return constraintOffset_.at(i.value); }
-  /// Global coordinate index of each local coordinate of a constraint / force: the
-  /// coordinates it uses of each of its bodies (see Constraint::coordinatesUsed).
+  /// True when every body has q' = v (T = I; planar models): nq == nv and the maps agree.
+  bool velocitiesAreCoordinateRates() const { return coordinateRates_; }
+  /// Global velocity index of each local velocity of a constraint / force (the columns of
+  /// its G, the rows of its Q): what it uses of each of its bodies (Constraint::coordinatesUsed).
   const std::vector<int>& constraintColumns(ConstraintIndex i) const { return constraintCols_.at(i.value); }
   const std::vector<int>& forceColumns(ForceIndex i) const { return forceCols_.at(i.value); }
-  /// Coordinates and velocities given at construction, stacked (nq).
+  /// Global coordinate index of each local coordinate of a constraint / force (the columns
+  /// of its d/dq blocks); equal to the velocity columns when T = I.
+  const std::vector<int>& constraintCoordinateColumns(ConstraintIndex i) const {
+    return constraintQCols_.at(i.value);
+  }
+  const std::vector<int>& forceCoordinateColumns(ForceIndex i) const { return forceQCols_.at(i.value); }
+  /// Coordinates (nq) and velocities (nv) given at construction, stacked.
   VecX initialCoordinates() const;
   VecX initialVelocities() const;
+  /// q (+) dv body by body (Body::applyIncrement): velocity-space corrections of positions.
+  VecX applyIncrement(const VecX& q, const VecX& dv) const;
+  /// T(q) v body by body (nq).
+  VecX coordinateRates(const VecX& q, const VecX& v) const;
   /// Views of a constraint's / force's bodies at the global coordinates q (size nq),
   /// restricted to the coordinates it uses.
   BodyStates constraintStates(ConstraintIndex i, const double* q) const;
   BodyStates forceStates(ForceIndex i, const double* q) const;
   /// "joint 'O2' (revolute, equation 1)": the constraint that owns global equation `row`.
   std::string describeEquation(int row) const;
-  /// Global indices of the frame (reference-motion) coordinates; the others are elastic.
+  /// Global indices of the frame (reference-motion) coordinates / velocities; the others
+  /// are elastic.
   std::vector<int> frameCoordinates() const;
-  /// The kind of every coordinate, in order.
+  std::vector<int> frameVelocities() const;
+  /// The kind of every coordinate / velocity, in order.
   std::vector<CoordinateKind> coordinateKinds() const;
+  std::vector<CoordinateKind> velocityKinds() const;
   /// A length characteristic of the model: the largest distance of a body's initial
   /// position or of an attachment point (body axes) from the origin; 1 if all are zero.
   double characteristicLength() const;
   /// "crank.x", ... for every coordinate, in order.
   std::vector<std::string> coordinateNames() const;
+  /// "crank.x_dot", ... for every velocity, in order (Body::velocityNames).
+  std::vector<std::string> velocityNames() const;
+  /// The accelerations' names: a velocity "x_dot" gives "x_ddot", any other "w" gives "w_dot".
+  std::vector<std::string> accelerationNames() const;
 
  private:
   void requireBuildPhase(const std::string& what) const;
@@ -114,13 +137,14 @@ class System {
   std::vector<std::unique_ptr<Force>> forces_;
   Vec2 gravity_ = Vec2::Zero();
   bool finalized_ = false;
-  int nq_ = 0, m_ = 0;
-  std::vector<int> bodyOffset_, constraintOffset_;
-  std::vector<std::vector<int>> constraintCols_, forceCols_;
-  // per constraint / force, per body slot: the body-local coordinates used
-  std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_;
-  BodyStates states(const std::vector<BodyIndex>& bodies,
-                    const std::vector<std::vector<int>>& used, const double* q) const;
+  int nq_ = 0, nv_ = 0, m_ = 0;
+  bool coordinateRates_ = true;
+  std::vector<int> bodyOffset_, bodyVelocityOffset_, constraintOffset_;
+  std::vector<std::vector<int>> constraintCols_, forceCols_, constraintQCols_, forceQCols_;
+  // per constraint / force, per body slot: the body-local velocities / coordinates used
+  std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_, constraintUsedQ_, forceUsedQ_;
+  BodyStates states(const std::vector<BodyIndex>& bodies, const std::vector<std::vector<int>>& used,
+                    const std::vector<std::vector<int>>& usedQ, const double* q) const;
 };
 
 }  // namespace flexmbd

@@ -28,7 +28,7 @@ void forEachConstraint(const System& sys, const VecX& q, double t, bool withHess
 void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, MatX* G) {
   const int m = sys.numConstraintEquations();
   if (g) g->setZero(m);
-  if (G) G->setZero(m, sys.numCoordinates());
+  if (G) G->setZero(m, sys.numVelocities());
   forEachConstraint(sys, q, t, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
                                           const VecX& f, const VecX&, const VecX&) {
     const int row = sys.constraintOffset(ci), me = con.numEquations();
@@ -51,39 +51,42 @@ VecX velocityConstraintResidual(const System& sys, const VecX& q, const VecX& v,
 
 VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, double t) {
   VecX out(sys.numConstraintEquations());
+  const VecX Tv = sys.coordinateRates(q, v);  // q'
   forEachConstraint(sys, q, t, true, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
                                          const VecX&, const VecX&, const VecX& ddf) {
-    const VecX vl = gather(sys.constraintColumns(ci), v);
+    const VecX vl = gather(sys.constraintColumns(ci), v), wl = gather(sys.constraintCoordinateColumns(ci), Tv);
     const int row = sys.constraintOffset(ci);
-    for (int a = 0; a < con.numEquations(); ++a) out[row + a] = ddf[a] - vl.dot(ev.H[a] * vl);
+    for (int a = 0; a < con.numEquations(); ++a) out[row + a] = ddf[a] - vl.dot(ev.H[a] * wl);
   });
   return out;
 }
 
 MatX massMatrix(const System& sys, const VecX& q) {
-  const int n = sys.numCoordinates();
+  const int n = sys.numVelocities();
   MatX M = MatX::Zero(n, n);
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    const int nb = body.numCoordinates();
-    if (nb == 0) continue;
-    const int off = sys.coordinateOffset(BodyIndex(b));
-    M.block(off, off, nb, nb) = body.massMatrix(q.segment(off, nb));
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0) continue;
+    const int voff = sys.velocityOffset(bi);
+    M.block(voff, voff, nvb, nvb) = body.massMatrix(q.segment(sys.coordinateOffset(bi), nqb));
   }
   return M;
 }
 
 VecX generalizedForces(const System& sys, double t, const VecX& q, const VecX& v) {
-  VecX Q = VecX::Zero(sys.numCoordinates());
+  VecX Q = VecX::Zero(sys.numVelocities());
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    const int nb = body.numCoordinates();
-    if (nb == 0) continue;
-    const int off = sys.coordinateOffset(BodyIndex(b));
-    VecX Qb = VecX::Zero(nb);
-    body.addInternalForces(q.segment(off, nb), v.segment(off, nb), Qb);
-    body.addGravityForce(q.segment(off, nb), sys.gravity(), Qb);
-    Q.segment(off, nb) += Qb;
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0) continue;
+    const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
+    VecX Qb = VecX::Zero(nvb);
+    body.addInternalForces(q.segment(qoff, nqb), v.segment(voff, nvb), Qb);
+    body.addGravityForce(q.segment(qoff, nqb), sys.gravity(), Qb);
+    Q.segment(voff, nvb) += Qb;
   }
   for (int f = 0; f < sys.numForces(); ++f) {
     const ForceIndex fi(f);
@@ -99,9 +102,11 @@ VecX generalizedForces(const System& sys, double t, const VecX& q, const VecX& v
 double kineticEnergy(const System& sys, const VecX& q, const VecX& v) {
   VecX Mv = VecX::Zero(v.size());
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    const int off = sys.coordinateOffset(BodyIndex(b)), nb = body.numCoordinates();
-    body.addMassTimes(q.segment(off, nb), v.segment(off, nb), Mv.segment(off, nb));
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int voff = sys.velocityOffset(bi), nvb = body.numVelocities();
+    body.addMassTimes(q.segment(sys.coordinateOffset(bi), body.numCoordinates()), v.segment(voff, nvb),
+                      Mv.segment(voff, nvb));
   }
   return 0.5 * v.dot(Mv);
 }

@@ -61,6 +61,16 @@ double wrms(const VecX& x, const VecX& w) {
   return std::sqrt((x.array() / w.array()).square().mean());
 }
 
+/// The trapezoidal rule here updates q with v directly (q' = v): bodies with other
+/// velocities (spatial rotations) are refused with a clear message.
+void requireCoordinateRates(const System& sys) {
+  if (!sys.isFinalized()) throw InputError("ali3p: the system must be finalized first");
+  if (!sys.velocitiesAreCoordinateRates()) {
+    throw InputError("solver.integrator: \"ali3p\" needs velocities that are coordinate rates (planar models); "
+                     "this model has bodies with rotation parameters (use \"ida\" or \"radau5\")");
+  }
+}
+
 }  // namespace
 
 struct AugmentedLagrangianIntegrator::Impl {
@@ -226,7 +236,7 @@ struct AugmentedLagrangianIntegrator::Impl {
 AugmentedLagrangianIntegrator::AugmentedLagrangianIntegrator(const System& sys, double t0, const VecX& q0,
                                                              const VecX& v0, const VecX& a0, const VecX& lambda0,
                                                              const AugmentedLagrangianOptions& options)
-    : impl_(std::make_unique<Impl>(sys, options)) {
+    : impl_((requireCoordinateRates(sys), std::make_unique<Impl>(sys, options))) {
   Impl& s = *impl_;
   const int nq = s.nq;
   if (q0.size() != nq || v0.size() != nq || a0.size() != nq || lambda0.size() != s.m) {

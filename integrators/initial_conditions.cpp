@@ -78,7 +78,9 @@ namespace {
 /// beside the others makes [M G^T; G 0] numerically singular).
 std::string massDiagonalReport(const System& sys, const MatX& M) {
   if (M.rows() == 0) return "";
-  const std::vector<std::string> names = sys.coordinateNames();
+  // the mass matrix is in velocity space: named by coordinate where velocities are coordinate rates
+  const std::vector<std::string> names =
+      sys.velocitiesAreCoordinateRates() ? sys.coordinateNames() : sys.velocityNames();
   Eigen::Index lo = 0, hi = 0;
   const VecX d = M.diagonal().cwiseAbs();
   d.minCoeff(&lo);
@@ -129,7 +131,7 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
 }
 
 ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0, const VecX& v0) {
-  const int nq = sys.numCoordinates(), m = sys.numConstraintEquations();
+  const int nv = sys.numVelocities(), m = sys.numConstraintEquations();
   ConsistentState s;
   s.q = q0;
   VecX g;
@@ -140,17 +142,17 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
   // Elastic coordinates keep their given values when the frame coordinates alone can
   // satisfy the constraints (a body is not deformed, nor set vibrating, to assemble the
   // mechanism); otherwise every coordinate takes part.
-  std::vector<int> cols = sys.frameCoordinates();
+  std::vector<int> cols = sys.frameVelocities();
   const auto restrictCols = [&](const MatX& A) {
     MatX B(A.rows(), cols.size());
     for (size_t k = 0; k < cols.size(); ++k) B.col(k) = A.col(cols[k]);
     return B;
   };
-  if (static_cast<int>(cols.size()) < nq && dependentRows(restrictCols(G)).size() > 0) {
-    cols.resize(nq);
-    for (int k = 0; k < nq; ++k) cols[k] = k;
+  if (static_cast<int>(cols.size()) < nv && dependentRows(restrictCols(G)).size() > 0) {
+    cols.resize(nv);
+    for (int k = 0; k < nv; ++k) cols[k] = k;
   }
-  // 1. Newton with minimum-norm corrections: dq = -G^+ g.
+  // 1. Newton with minimum-norm corrections in velocity space: dv = -G^+ g, q <- q (+) dv.
   const double scale = 1.0 + s.q.lpNorm<Eigen::Infinity>();
   const double tol = 1e-13 * scale;
   int it = 0;
@@ -158,7 +160,13 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     const Eigen::CompleteOrthogonalDecomposition<MatX> cod(restrictCols(G));
     const VecX dq = -cod.solve(g);
     if (!dq.allFinite()) break;
-    for (size_t k = 0; k < cols.size(); ++k) s.q[cols[k]] += dq[k];
+    if (sys.velocitiesAreCoordinateRates()) {
+      for (size_t k = 0; k < cols.size(); ++k) s.q[cols[k]] += dq[k];
+    } else {
+      VecX dv = VecX::Zero(nv);
+      for (size_t k = 0; k < cols.size(); ++k) dv[cols[k]] = dq[k];
+      s.q = sys.applyIncrement(s.q, dv);
+    }
     evaluateConstraints(sys, s.q, t0, &g, &G);
   }
   s.positionIterations = it;
@@ -182,7 +190,7 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
   // 2. Velocities: min (v - v0)^T M (v - v0) subject to G v = f'(t0), over the same
   //    coordinates as the positions (elastic velocities kept at their given values).
   const MatX M = massMatrix(sys, s.q);
-  const VecX df = -velocityConstraintResidual(sys, s.q, VecX::Zero(nq), t0);  // = f'(t0)
+  const VecX df = -velocityConstraintResidual(sys, s.q, VecX::Zero(nv), t0);  // = f'(t0)
   s.v = v0;
   {
     MatX Mr(cols.size(), cols.size());

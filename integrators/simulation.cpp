@@ -135,9 +135,9 @@ struct SingularityDiagnosis {
 SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample& last, double tFail,
                                           double startRatio) {
   const int m = sys.numConstraintEquations();
-  if (m == 0 || last.q.size() == 0 || m > sys.numCoordinates()) return {};
+  if (m == 0 || last.q.size() == 0 || m > sys.numVelocities()) return {};
   const double dt = tFail - last.t;
-  VecX q = last.q + dt * last.v + 0.5 * dt * dt * last.a;
+  VecX q = sys.applyIncrement(last.q, dt * last.v + 0.5 * dt * dt * last.a);
   VecX g;
   MatX G;
   evaluateConstraints(sys, q, tFail, &g, &G);
@@ -146,9 +146,10 @@ SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample&
     if (!dq.allFinite() || dq.norm() > 0.1 * (1.0 + q.norm())) break;  // diverging: keep the last q
     VecX gn;
     MatX Gn;
-    evaluateConstraints(sys, q + dq, tFail, &gn, &Gn);
+    const VecX qn = sys.applyIncrement(q, dq);
+    evaluateConstraints(sys, qn, tFail, &gn, &Gn);
     if (!gn.allFinite() || gn.norm() >= g.norm()) break;
-    q += dq;
+    q = qn;
     g = gn;
     G = Gn;
   }
@@ -383,13 +384,13 @@ VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
   const double angle = settings.atolAngle.value_or(position);
   const double elastic = settings.atolElastic.value_or(position);
   const double velocityRatio = settings.atolVelocity.value_or(position) / position;
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  const auto ofKind = [&](CoordinateKind kind) {
+    return kind == CoordinateKind::Position ? position : kind == CoordinateKind::Angle ? angle : elastic;
+  };
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds(), vkinds = sys.velocityKinds();
   VecX atol = VecX::Constant(L.size, kAtolMultiplier);
-  for (int k = 0; k < L.nq; ++k) {
-    const double a = kinds[k] == CoordinateKind::Position ? position : kinds[k] == CoordinateKind::Angle ? angle : elastic;
-    atol[L.q + k] = a;
-    atol[L.v + k] = a * velocityRatio;
-  }
+  for (int k = 0; k < L.nq; ++k) atol[L.q + k] = ofKind(kinds[k]);
+  for (int k = 0; k < L.nv; ++k) atol[L.v + k] = ofKind(vkinds[k]) * velocityRatio;
   return atol;
 }
 
@@ -424,7 +425,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     }
   }
   const bool conservative = isConservative(sys);
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds(), vkinds = sys.velocityKinds();
   double maxSpeed = 0.0;  // velocity scale of the warnings: translational, angular rates times size
   OutputSample last;  // the last output, for the diagnosis of a failure
   double largestCoordinate = 0.0;  // largest |position or elastic coordinate| output so far
@@ -447,8 +448,8 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     // Accelerations and multipliers recomputed from the state (q, v): as accurate as the
     // state itself, unlike the interpolated y' (docs/formulations.md).
     computeAccelerations(sys, t, s.q, s.v, s.a, s.lambda);
-    for (int k = 0; k < L.nq; ++k) {
-      maxSpeed = std::max(maxSpeed, std::fabs(s.v[k]) * (kinds[k] == CoordinateKind::Angle ? modelSize : 1.0));
+    for (int k = 0; k < L.nv; ++k) {
+      maxSpeed = std::max(maxSpeed, std::fabs(s.v[k]) * (vkinds[k] == CoordinateKind::Angle ? modelSize : 1.0));
     }
     if (L.m > 0) {
       VecX g;
@@ -471,7 +472,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     last = std::move(s);
   };
   try {
-    emit(t0, y0.segment(L.q, L.nq), y0.segment(L.v, L.nq));
+    emit(t0, y0.segment(L.q, L.nq), y0.segment(L.v, L.nv));
   } catch (const NonFiniteResult& e) {
     // Nothing was integrated: the scene's own values overflow (masses, speeds, loads).
     throw InputError(std::string("the initial state has ") + e.what() +
@@ -592,7 +593,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
       OutputSample s;
       s.t = failure.time();
       s.q = yf.segment(L.q, L.nq);
-      s.v = yf.segment(L.v, L.nq);
+      s.v = yf.segment(L.v, L.nv);
       try {
         computeAccelerations(sys, s.t, s.q, s.v, s.a, s.lambda);
         if (s.q.allFinite() && s.v.allFinite() && s.a.allFinite() && s.lambda.allFinite()) return s;
@@ -608,7 +609,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
       try {
         for (; k <= nOut; ++k) {
           const double t = integrator->advance(outputTime(k), tEnd);
-          emit(t, integrator->y().segment(L.q, L.nq), integrator->y().segment(L.v, L.nq));
+          emit(t, integrator->y().segment(L.q, L.nq), integrator->y().segment(L.v, L.nv));
           progress.update(t, totalSteps());
           regularStep = integrator->stats().lastStepSize;
           // IDA rejecting nearly every step (the order-1 trap of heavily damped elastic

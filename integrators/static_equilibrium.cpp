@@ -19,6 +19,10 @@ constexpr int kQuickConvergenceIterations = 4;
 
 StaticEquilibrium solveStaticEquilibrium(const System& sys, double t, const VecX& q0,
                                          const StaticEquilibriumOptions& options) {
+  if (sys.isFinalized() && !sys.velocitiesAreCoordinateRates()) {
+    throw InputError("static equilibrium: supported for planar models only so far (this model has bodies with "
+                     "rotation parameters)");
+  }
   const DaeSystem dae(sys, Formulation::Index3);  // y = [q, v, lambda]; F = [q'-v, M v'-Q+G^T l, g]
   const DaeLayout& L = dae.layout();
   const int nq = L.nq, m = L.m, n = nq + m;

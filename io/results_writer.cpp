@@ -119,10 +119,10 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
 
   const System& sys = scene.system;
   columns_.push_back("t");
-  const auto coords = sys.coordinateNames();
+  const auto coords = sys.coordinateNames(), velocities = sys.velocityNames(), accelerations = sys.accelerationNames();
   columns_.insert(columns_.end(), coords.begin(), coords.end());
-  for (const auto& c : coords) columns_.push_back(c + "_dot");
-  for (const auto& c : coords) columns_.push_back(c + "_ddot");
+  columns_.insert(columns_.end(), velocities.begin(), velocities.end());
+  columns_.insert(columns_.end(), accelerations.begin(), accelerations.end());
   const auto reactions = reactionOutputNames(sys);
   columns_.insert(columns_.end(), reactions.begin(), reactions.end());
   for (const auto& o : scene.outputs) {
@@ -176,19 +176,19 @@ void ResultsWriter::open() {
 
 void ResultsWriter::write(const OutputSample& s) {
   const System& sys = scene_.system;
-  const long nq = sys.numCoordinates();
+  const long nq = sys.numCoordinates(), nv = sys.numVelocities();
   const long m = sys.numConstraintEquations();
   if (s.q.size() != nq) throw std::runtime_error(sizeMismatch("q", s.q.size(), nq, s.t));
-  if (s.v.size() != nq) throw std::runtime_error(sizeMismatch("v", s.v.size(), nq, s.t));
-  if (s.a.size() != nq) throw std::runtime_error(sizeMismatch("a", s.a.size(), nq, s.t));
+  if (s.v.size() != nv) throw std::runtime_error(sizeMismatch("v", s.v.size(), nv, s.t));
+  if (s.a.size() != nv) throw std::runtime_error(sizeMismatch("a", s.a.size(), nv, s.t));
   if (s.lambda.size() != m) throw std::runtime_error(sizeMismatch("lambda", s.lambda.size(), m, s.t));
   // The whole row first: a row with a non-finite value is not written (the run stops).
   std::vector<double> values;
   values.reserve(columns_.size());
   values.push_back(s.t);
   for (long k = 0; k < nq; ++k) values.push_back(s.q[k]);
-  for (long k = 0; k < nq; ++k) values.push_back(s.v[k]);
-  for (long k = 0; k < nq; ++k) values.push_back(s.a[k]);
+  for (long k = 0; k < nv; ++k) values.push_back(s.v[k]);
+  for (long k = 0; k < nv; ++k) values.push_back(s.a[k]);
   const VecX reactions = reactionOutputs(sys, s.q, s.lambda);
   for (Eigen::Index k = 0; k < reactions.size(); ++k) values.push_back(reactions[k]);
   for (const auto& o : scene_.outputs) {
