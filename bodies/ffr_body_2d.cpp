@@ -223,7 +223,8 @@ void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   dQdv.addSparse(3, 3, inv_.dff, -1.0);
 }
 
-void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const {
+void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec3& g3, VecX& Q) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
   const int nf = numElastic();
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * q.tail(nf));
@@ -232,7 +233,8 @@ void FfrBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) co
   Q.tail(nf).noalias() += inv_.sBar.transpose() * (A.transpose() * g);
 }
 
-void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const {
+void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec3& g3, const MatrixSink& K) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
   const int nf = numElastic();
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * q.tail(nf));
@@ -242,7 +244,8 @@ void FfrBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const Ma
   K.addColumn(3, 2, nf, [&](int k) { return SASb(k).dot(g); });
 }
 
-double FfrBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
+double FfrBody2d::gravityPotential(const ConstVecRef& q, const Vec3& g3) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
   return -g.dot(inv_.mass * q.head<2>() + rotation(q[2]) * (inv_.firstMoment + inv_.sBar * q.tail(numElastic())));
 }
 
@@ -328,7 +331,9 @@ void FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt, const std
   }
 }
 
-Vec2 FfrBody2d::centreOfMass(const ConstVecRef& q) const {
+Vec3 FfrBody2d::centreOfMass(const ConstVecRef& q) const { return lift(planarCentreOfMass(q)); }
+
+Vec2 FfrBody2d::planarCentreOfMass(const ConstVecRef& q) const {
   return q.head<2>() + rotation(q[2]) * (inv_.firstMoment + inv_.sBar * q.tail(numElastic())) / inv_.mass;
 }
 

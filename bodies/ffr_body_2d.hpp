@@ -55,9 +55,9 @@ class FfrBody2d final : public Body {
   void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
   void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
                                  const MatrixSink& dQdv) const override;
-  void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
-  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const override;
-  double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
+  void addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const override;
+  double gravityPotential(const ConstVecRef& q, const Vec3& g) const override;
   double internalPotential(const ConstVecRef& q) const override;
   bool isDissipative() const override { return inv_.dff.nonZeros() > 0 && inv_.dff.coeffs().cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
@@ -68,7 +68,9 @@ class FfrBody2d final : public Body {
   /// The frame coordinates and the elastic coordinates the node's shape depends on.
   std::vector<int> pointSupport(const Vec2& point) const override;
   void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
-  Vec2 centreOfMass(const ConstVecRef& q) const override;
+  Vec3 centreOfMass(const ConstVecRef& q) const override;
+  /// The centre of mass in the plane.
+  Vec2 planarCentreOfMass(const ConstVecRef& q) const;
   /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
   PointKinematics pointKinematics(const ConstVecRef& q, const FfrPoint& p, bool withHessians = true) const;
 

@@ -19,9 +19,9 @@ class Ground final : public Body {
   void addInternalForces(const ConstVecRef&, const ConstVecRef&, VecX&) const override {}
   void addInternalForceJacobians(const ConstVecRef&, const ConstVecRef&, const MatrixSink&,
                                  const MatrixSink&) const override {}
-  void addGravityForce(const ConstVecRef&, const Vec2&, VecX&) const override {}
-  void addGravityJacobian(const ConstVecRef&, const Vec2&, const MatrixSink&) const override {}
-  double gravityPotential(const ConstVecRef&, const Vec2&) const override { return 0.0; }
+  void addGravityForce(const ConstVecRef&, const Vec3&, VecX&) const override {}
+  void addGravityJacobian(const ConstVecRef&, const Vec3&, const MatrixSink&) const override {}
+  double gravityPotential(const ConstVecRef&, const Vec3&) const override { return 0.0; }
   using Body::pointKinematics;
   void pointKinematics(const ConstVecRef&, const Vec2& point, const std::vector<int>*, bool withHessians,
                        PointKinematics& out) const override {
@@ -29,7 +29,7 @@ class Ground final : public Body {
     out.phi = 0.0;
     out.reset(0, withHessians);
   }
-  Vec2 centreOfMass(const ConstVecRef&) const override { return Vec2::Zero(); }
+  Vec3 centreOfMass(const ConstVecRef&) const override { return Vec3::Zero(); }
 };
 
 }  // namespace flexmbd

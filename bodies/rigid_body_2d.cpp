@@ -72,18 +72,21 @@ void RigidBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVec
   dQdv.addBlock(0, 2, 2.0 * m * ac * v[2]);
 }
 
-void RigidBody2d::addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const {
+void RigidBody2d::addGravityForce(const ConstVecRef& q, const Vec3& g3, VecX& Q) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
   const double m = props_.mass;
   Q.head<2>() += m * g;
   Q[2] += m * perp(rotation(q[2]) * props_.com).dot(g);
 }
 
-void RigidBody2d::addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const {
+void RigidBody2d::addGravityJacobian(const ConstVecRef& q, const Vec3& g3, const MatrixSink& K) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
   K.add(2, 2, -props_.mass * (rotation(q[2]) * props_.com).dot(g));
 }
 
-double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec2& g) const {
-  return -props_.mass * g.dot(centreOfMass(q));
+double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec3& g3) const {
+  const Vec2 g = g3.head<2>();  // the plane carries the z component
+  return -props_.mass * g.dot(planarCentreOfMass(q));
 }
 
 void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
@@ -108,7 +111,9 @@ void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const
   }
 }
 
-Vec2 RigidBody2d::centreOfMass(const ConstVecRef& q) const {
+Vec3 RigidBody2d::centreOfMass(const ConstVecRef& q) const { return lift(planarCentreOfMass(q)); }
+
+Vec2 RigidBody2d::planarCentreOfMass(const ConstVecRef& q) const {
   return q.head<2>() + rotation(q[2]) * props_.com;
 }
 

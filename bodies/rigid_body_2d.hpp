@@ -48,13 +48,15 @@ class RigidBody2d final : public Body {
   void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
   void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
                                  const MatrixSink& dQdv) const override;
-  void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const override;
-  void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const override;
-  double gravityPotential(const ConstVecRef& q, const Vec2& g) const override;
+  void addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const override;
+  double gravityPotential(const ConstVecRef& q, const Vec3& g) const override;
   using Body::pointKinematics;
   void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
                        PointKinematics& out) const override;
-  Vec2 centreOfMass(const ConstVecRef& q) const override;
+  Vec3 centreOfMass(const ConstVecRef& q) const override;
+  /// The centre of mass in the plane.
+  Vec2 planarCentreOfMass(const ConstVecRef& q) const;
 
  private:
   RigidBodyProperties props_;

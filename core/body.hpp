@@ -99,10 +99,11 @@ class Body {
   /// dQdq += d(internal forces)/dq, dQdv += d(internal forces)/dv.
   virtual void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v,
                                          const MatrixSink& dQdq, const MatrixSink& dQdv) const = 0;
-  /// Q += generalised gravity force for the acceleration of gravity g.
-  virtual void addGravityForce(const ConstVecRef& q, const Vec2& g, VecX& Q) const = 0;
+  /// Q += generalised gravity force for the acceleration of gravity g (world axes; planar
+  /// bodies take its x-y components: the plane carries the rest).
+  virtual void addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) const = 0;
   /// K += d(gravity force)/dq.
-  virtual void addGravityJacobian(const ConstVecRef& q, const Vec2& g, const MatrixSink& K) const = 0;
+  virtual void addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const = 0;
   /// Dense mass matrix (small systems, outputs and tests).
   MatX massMatrix(const ConstVecRef& q) const {
     MatX M = MatX::Zero(numVelocities(), numVelocities());
@@ -110,7 +111,7 @@ class Body {
     return M;
   }
   /// Potential energy of gravity (zero at the world origin) and internal (elastic) energy.
-  virtual double gravityPotential(const ConstVecRef& q, const Vec2& g) const = 0;
+  virtual double gravityPotential(const ConstVecRef& q, const Vec3& g) const = 0;
   virtual double internalPotential(const ConstVecRef& q) const { (void)q; return 0.0; }
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
@@ -143,8 +144,8 @@ class Body {
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
     (void)point; (void)user;
   }
-  /// World position of the centre of mass.
-  virtual Vec2 centreOfMass(const ConstVecRef& q) const = 0;
+  /// World position of the centre of mass (planar bodies: z = 0).
+  virtual Vec3 centreOfMass(const ConstVecRef& q) const = 0;
 
  private:
   std::string name_;

@@ -92,10 +92,9 @@ ForceIndex System::addForce(std::unique_ptr<Force> f) {
   return ForceIndex(numForces() - 1);
 }
 
-void System::setGravity(const Vec2& g) {
+void System::setGravity(const Vec3& g) {
   requireBuildPhase("gravity");
-  requireFinite(g.x(), "gravity[0]");
-  requireFinite(g.y(), "gravity[1]");
+  for (int k = 0; k < 3; ++k) requireFinite(g[k], "gravity[" + std::to_string(k) + "]");
   gravity_ = g;
 }
 

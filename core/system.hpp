@@ -29,8 +29,9 @@ class System {
   BodyIndex addBody(std::unique_ptr<Body> body);
   ConstraintIndex addConstraint(std::unique_ptr<Constraint> constraint);
   ForceIndex addForce(std::unique_ptr<Force> force);
-  /// Acceleration of gravity (world axes), default zero.
-  void setGravity(const Vec2& g);
+  /// Acceleration of gravity (world axes), default zero; a planar one lies in the x-y plane.
+  void setGravity(const Vec3& g);
+  void setGravity(const Vec2& g) { setGravity(lift(g)); }
 
   // Convenience builders (the C++ API most users need).
   BodyIndex addRigidBody(const std::string& name, const RigidBodyProperties& props,
@@ -68,7 +69,7 @@ class System {
   const Body& body(BodyIndex i) const { return *bodies_.at(i.value); }
   const Constraint& constraint(ConstraintIndex i) const { return *constraints_.at(i.value); }
   const Force& force(ForceIndex i) const { return *forces_.at(i.value); }
-  const Vec2& gravity() const { return gravity_; }
+  const Vec3& gravity() const { return gravity_; }
   /// @throws InputError listing the known bodies if there is none of that name.
   BodyIndex findBody(const std::string& name) const;
   ConstraintIndex findConstraint(const std::string& name) const;
@@ -135,7 +136,7 @@ class System {
   std::vector<std::unique_ptr<Body>> bodies_;
   std::vector<std::unique_ptr<Constraint>> constraints_;
   std::vector<std::unique_ptr<Force>> forces_;
-  Vec2 gravity_ = Vec2::Zero();
+  Vec3 gravity_ = Vec3::Zero();
   bool finalized_ = false;
   int nq_ = 0, nv_ = 0, m_ = 0;
   bool coordinateRates_ = true;

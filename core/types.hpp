@@ -10,6 +10,9 @@ namespace flexmbd {
 
 using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Mat3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 using VecX = Eigen::VectorXd;
 using MatX = Eigen::MatrixXd;
 using RowVecX = Eigen::RowVectorXd;
@@ -27,6 +30,9 @@ inline Mat2 rotation(double theta) {
 
 /// Counter-clockwise perpendicular S v = (-v_y, v_x); note dA/dtheta = S A.
 inline Vec2 perp(const Vec2& v) { return Vec2(-v.y(), v.x()); }
+
+/// A planar vector in the x-y plane of space.
+inline Vec3 lift(const Vec2& v) { return Vec3(v.x(), v.y(), 0.0); }
 
 /// Planar cross product a x b (a scalar).
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }

@@ -129,7 +129,7 @@ TEST(RigidBody2d, KineticEnergyEqualsComTranslationPlusRotation) {
     const double Tref = 0.5 * p.mass * vcom.squaredNorm() + 0.5 * p.inertia * v[2] * v[2];
     EXPECT_NEAR(T, Tref, kRoundoffTol * std::max(1.0, Tref)) << "sample " << s;
     // centre of mass and point positions
-    const Vec2 com = body.centreOfMass(q);
+    const Vec2 com = body.planarCentreOfMass(q);
     const Vec2 comRef = q.head<2>() + rotate(q[2], p.com);
     EXPECT_NEAR((com - comRef).norm(), 0.0, kRoundoffTol * 10.0) << "sample " << s;
     const Vec2 u = rnd.vec2(-2.0, 2.0);
@@ -138,7 +138,7 @@ TEST(RigidBody2d, KineticEnergyEqualsComTranslationPlusRotation) {
     EXPECT_EQ(pk.phi, q[2]);
     // gravity potential -m g . r_com
     const Vec2 g(0.3, -9.81);
-    EXPECT_NEAR(body.gravityPotential(q, g), -p.mass * g.dot(comRef), kRoundoffTol * 100.0);
+    EXPECT_NEAR(body.gravityPotential(q, lift(g)), -p.mass * g.dot(comRef), kRoundoffTol * 100.0);
   }
 }
 

@@ -30,7 +30,7 @@ struct Model {
 Model makeModel() {
   Model m;
   System& s = m.sys;
-  s.setGravity({0.0, -9.81});
+  s.setGravity(Vec2(0.0, -9.81));
   m.crank = s.addRigidBody("crank", {1.0, 0.1, {0.5, 0.05}}, {{0, 0}, 0.4, {0, 0}, 3.0});
   const Vec2 b(std::cos(0.4), std::sin(0.4));
   const double xs = b.x() + std::sqrt(4.0 - b.y() * b.y());
@@ -91,8 +91,8 @@ TEST(UndrivenSliderCrank, ReactionsSatisfyNewtonEulerForEveryBody) {
     for (int b = 1; b < sys.numBodies(); ++b) {
       const Body& body = sys.body(BodyIndex(b));
       const auto qb = o.q.segment(sys.coordinateOffset(BodyIndex(b)), 3);
-      rc[b] = body.centreOfMass(qb);
-      F[b] += body.mass() * sys.gravity();
+      rc[b] = body.centreOfMass(qb).head<2>();
+      F[b] += body.mass() * sys.gravity().head<2>();
     }
     auto apply = [&](BodyIndex b, const Vec2& f, const Vec2& at, double mz) {
       if (b == kGround) return;

@@ -413,7 +413,7 @@ TEST(FfrBody2d, QuadraticVelocityForcesFollowFromLagrange) {
 
 TEST(FfrBody2d, DerivativesMatchFiniteDifferences) {
   Random rnd(kSeed + 2);
-  const Vec2 g(0.7, -9.81);
+  const Vec3 g(0.7, -9.81, 0.0);
   double worst = 0.0;
   for (const NamedModel& nm : testModels()) {
     const FfrBody2d body("flex", nm.model, FrameState2d{});
@@ -549,7 +549,7 @@ TEST(FfrBody2d, CentreOfMassAndInitialState) {
            (qr.head<2>() + rotation(qr[2]) * (p.position + p.shape * qr.tail(nf)));
     }
   }
-  expectMatrixNear(body.centreOfMass(qr), c / body.mass(), kExactTol, "centre of mass", 1.0);
+  expectMatrixNear(body.planarCentreOfMass(qr), c / body.mass(), kExactTol, "centre of mass", 1.0);
 }
 
 // ----- rigid-body displacements store no strain energy ------------------------------------

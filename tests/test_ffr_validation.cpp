@@ -50,7 +50,7 @@ TEST(FfrStatic, CantileverUnderOwnWeightMatchesRhoAgL4Over8EI) {
   o.reference.type = ReferenceConditions::Type::Clamped;
   auto model = std::make_shared<FfrBeamModel>(BeamMesh2d::straight(L, 8, s), o, "beam");
   System sys;
-  sys.setGravity({0, -9.81});
+  sys.setGravity(Vec2(0, -9.81));
   const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("beam", model, FrameState2d{}));
   sys.addFixedJoint("root", kGround, {0, 0}, b, {0, 0});
   sys.finalize();

@@ -176,7 +176,7 @@ TEST(RigidBodyJacobians, GravityJacobianAndPotential) {
   for (int s = 0; s < kSamples; ++s) {
     const RigidBody2d body("link", randomProperties(rnd), FrameState2d{});
     const VecX q = rnd.frame();
-    const Vec2 g = rnd.vec2(-10.0, 10.0);
+    const Vec3 g = lift(rnd.vec2(-10.0, 10.0));
     auto Q = [&](const VecX& z) {
       VecX out = VecX::Zero(3);
       body.addGravityForce(z, g, out);

@@ -187,7 +187,7 @@ double cantileverTip(int elements, bool stiffening) {
   auto model = std::make_shared<FfrBeamModel>(BeamMesh2d::straight(kBeamLength, elements, s), o, "beam");
   System sys;
   const double g = kLinearTip * 8.0 * s.bendingStiffness() / (s.massPerLength() * std::pow(kBeamLength, 4));
-  sys.setGravity({0, -g});
+  sys.setGravity(Vec2(0, -g));
   const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("beam", model, FrameState2d{}));
   sys.addFixedJoint("root", kGround, {0, 0}, b, {0, 0});
   sys.finalize();

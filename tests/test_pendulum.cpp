@@ -20,7 +20,7 @@ const double kPhi0 = 170.0 * M_PI / 180.0;  // from the downward vertical
 /// theta = phi - pi/2 for the angle phi from the downward vertical.
 System makePendulum(Formulation) {
   System sys;
-  sys.setGravity({0.0, -kGravity});
+  sys.setGravity(Vec2(0.0, -kGravity));
   const BodyIndex b = sys.addRigidBody("bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
   sys.addRevoluteJoint("pivot", kGround, {0, 0}, b, {0, 0});
   sys.finalize();

@@ -456,7 +456,7 @@ TEST(SceneParse, EveryFeature) {
   EXPECT_EQ(sys.numBodies(), 4);
   EXPECT_EQ(sys.numConstraints(), 5);
   EXPECT_EQ(sys.numForces(), 3);
-  EXPECT_EQ(sys.gravity(), Vec2(0, -9.81));
+  EXPECT_EQ(sys.gravity(), Vec3(0, -9.81, 0));
   EXPECT_EQ(s.solver.formulation, Formulation::Index3);
   EXPECT_EQ(s.solver.linearSolver, LinearSolverKind::Dense);
   EXPECT_EQ(s.solver.maxSteps, 100000);
@@ -499,7 +499,7 @@ TEST(SceneParse, DefaultsOfAMinimalScene) {
   EXPECT_EQ(s.name, "");
   EXPECT_EQ(s.system.numCoordinates(), 3);
   EXPECT_EQ(s.system.numConstraints(), 0);
-  EXPECT_EQ(s.system.gravity(), Vec2::Zero());
+  EXPECT_EQ(s.system.gravity(), Vec3::Zero());
   const SolverSettings d;
   EXPECT_EQ(s.solver.formulation, Formulation::Ggl);
   EXPECT_EQ(s.solver.linearSolver, LinearSolverKind::Automatic);

@@ -547,7 +547,7 @@ namespace {
 /// stiffness x sM, gravity x sL.
 System springCrank(double sL, double sM) {
   System s;
-  s.setGravity({0.0, -9.81 * sL});
+  s.setGravity(Vec2(0.0, -9.81 * sL));
   const BodyIndex crank = s.addRigidBody("crank", {1.0 * sM, 0.1 * sM * sL * sL, Vec2(0.5, 0.05) * sL},
                                          {{0, 0}, 0.4, {0, 0}, 3.0});
   const Vec2 b(std::cos(0.4), std::sin(0.4));

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   }
   // Frame at the pivot, centre of mass at (L, 0) in the body: angle = phi - pi/2.
   System sys;
-  sys.setGravity({0.0, -kGravity});
+  sys.setGravity(Vec2(0.0, -kGravity));
   const BodyIndex bob = sys.addRigidBody("bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
   sys.addRevoluteJoint("pivot", kGround, {0, 0}, bob, {0, 0});
   sys.finalize();
