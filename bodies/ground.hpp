@@ -29,6 +29,16 @@ class Ground final : public Body {
     out.phi = 0.0;
     out.reset(0, withHessians);
   }
+  void frameKinematics(const ConstVecRef&, const Vec3& point, const std::vector<int>*, const std::vector<int>*,
+                       FrameKinematics& out) const override {
+    out.r = point;
+    out.A.setIdentity();
+    out.Jr.resize(3, 0);
+    out.Jw.resize(3, 0);
+    out.Tinv.resize(0, 0);
+  }
+  void addFrameCurvature(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+                         const Vec3&, const Vec3&, Eigen::Ref<MatX>) const override {}
   Vec3 centreOfMass(const ConstVecRef&) const override { return Vec3::Zero(); }
 };
 

@@ -2,6 +2,8 @@
 
 #include <numeric>
 
+#include "core/errors.hpp"
+
 namespace flexmbd {
 
 std::vector<int> Body::pointSupport(const Vec2& point) const {
@@ -19,6 +21,16 @@ void Body::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
 void Body::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
   (void)q;
   Tinv.setIdentity(numVelocities(), numCoordinates());
+}
+
+void Body::frameKinematics(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+                           FrameKinematics&) const {
+  throw InputError("body '" + name() + "' is planar: spatial joints and forces need spatial bodies (\"dimension\": 3)");
+}
+
+void Body::addFrameCurvature(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+                             const Vec3&, const Vec3&, Eigen::Ref<MatX>) const {
+  throw InputError("body '" + name() + "' is planar: spatial joints and forces need spatial bodies (\"dimension\": 3)");
 }
 
 std::vector<std::string> Body::velocityNames() const {

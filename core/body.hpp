@@ -144,6 +144,19 @@ class Body {
   virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
     (void)point; (void)user;
   }
+  // ----- spatial kinematics (spatial joints and forces) ---------------------------
+  /// Kinematics of the material frame at the body point `point` (body axes) over the used
+  /// velocities `cols` and coordinates `qcols` (null: all), into `out`. Allocates nothing
+  /// once `out` was filled for as many columns.
+  /// @throws InputError if the body has no spatial kinematics (planar bodies, so far).
+  virtual void frameKinematics(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+                               const std::vector<int>* qcols, FrameKinematics& out) const;
+  /// out += d(Jr^T wr + Jw^T ww)/dq (nv_used x nq_used) for fixed weights wr, ww: the
+  /// curvature of the point's motion that joint Jacobians need.
+  virtual void addFrameCurvature(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+                                 const std::vector<int>* qcols, const Vec3& wr, const Vec3& ww,
+                                 Eigen::Ref<MatX> out) const;
+
   /// World position of the centre of mass (planar bodies: z = 0).
   virtual Vec3 centreOfMass(const ConstVecRef& q) const = 0;
 

@@ -40,6 +40,12 @@ struct BodyState {
     point(p, withHessians, out);
     return out;
   }
+  /// Spatial kinematics of the material frame at a body point, over the used columns.
+  void frame(const Vec3& p, FrameKinematics& out) const { body.frameKinematics(q, p, cols, qcols, out); }
+  /// out += d(Jr^T wr + Jw^T ww)/dq over the used columns.
+  void addCurvature(const Vec3& p, const Vec3& wr, const Vec3& ww, Eigen::Ref<MatX> out) const {
+    body.addFrameCurvature(q, p, cols, qcols, wr, ww, out);
+  }
 };
 
 /// The bodies of one constraint or force element with their coordinates, in the

@@ -368,7 +368,10 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
     } else {
       body.coordinateRateMatrix(qb, S.T[b]);
       body.coordinateRateInverse(qb, S.Tinv[b]);
-      MatrixSink(J, L.q + qoff, L.v + voff, -1.0).addBlock(0, 0, S.T[b]);
+      const MatX& T = S.T[b];
+      for (int j = 0; j < nvb; ++j) {
+        for (int i = 0; i < nqb; ++i) J.add(L.q + qoff + i, L.v + voff + j, -T(i, j));
+      }
     }
     // each body writes its structural non-zeros only (sparse for large flexible bodies)
     const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);

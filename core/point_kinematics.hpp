@@ -35,6 +35,20 @@ struct PointKinematics {
   MatX hessianR(const Vec2& w) const { return w.x() * Hrx + w.y() * Hry; }
 };
 
+/// Spatial kinematics of the material frame at one body point, over the velocities and
+/// coordinates a joint uses (see BodyState): what spatial joints are written in. The
+/// second derivatives are supplied as curvature terms d/dq (Jr^T w_r + Jw^T w_w) for given
+/// weights (Body::addFrameCurvature), never as per-component Hessians.
+struct FrameKinematics {
+  Vec3 r = Vec3::Zero();      ///< world position of the point
+  Mat3 A = Mat3::Identity();  ///< orientation of the material frame at the point (world axes)
+  Mat3X Jr;                   ///< r' = Jr v, 3 x nv_used
+  Mat3X Jw;                   ///< angular velocity (world axes) = Jw v, 3 x nv_used
+  MatX Tinv;                  ///< T+ over the used velocities and coordinates, nv_used x nq_used
+  int numVelocities() const { return static_cast<int>(Jr.cols()); }
+  int numCoordinates() const { return static_cast<int>(Tinv.cols()); }
+};
+
 /// d = r_j - r_i and the material angles at both points, with first and second
 /// derivatives with respect to the local coordinates [q_i; q_j] (n_i + n_j). The same
 /// reuse rule as PointKinematics.
@@ -56,6 +70,9 @@ struct KinematicsWork {
   PointPair pair;          ///< their relative kinematics
   RowVecX row, row2;       ///< 1 x n rows (gradients, products)
   MatX hessian;            ///< an n x n matrix
+  FrameKinematics fi, fj;  ///< spatial joints: the two frames
+  Mat3X J1, J2, Jd;        ///< spatial joints: Jacobians of two vectors and of r_j - r_i (3 x nv)
+  MatX C, Tinv, JT;        ///< spatial joints: a curvature term, T+ (nv x nq), a product
 };
 
 }  // namespace flexmbd

@@ -1,0 +1,291 @@
+// Spatial rigid bodies and joints: every analytic derivative against central finite
+// differences (the kinematic map T, its inverse and derivative, the frame Jacobians and
+// curvature terms, the gyroscopic Jacobian, each joint type's G and H, and the DAE
+// iteration matrix of a spatial model in all three formulations).
+#include <gtest/gtest.h>
+
+#include "bodies/rigid_body_3d.hpp"
+#include "core/dae_system.hpp"
+#include "core/rotation_3d.hpp"
+#include "core/system.hpp"
+#include "joints/spatial_joint.hpp"
+#include "test_support.hpp"
+
+using namespace flexmbd;
+using namespace flexmbd::testsupport;
+
+namespace {
+
+constexpr unsigned kSeed = 4711;
+constexpr int kSamples = 6;
+// Central differences with h = 1e-6 (1 + |x|) on functions with O(1..10) second
+// derivatives: truncation O(h^2) ~ 1e-11, round-off ~ eps |f| / h ~ 1e-10 relative to
+// the O(1..100) entries; 1e-6 leaves a wide margin while a wrong sign or a missing term
+// gives errors of order 1 (checked by dropping terms while writing the code).
+constexpr double kFdRelStep = 1e-6;
+constexpr double kFdTol = 1e-6;
+// Identities evaluated with a few dozen operations on O(1) numbers.
+constexpr double kRoundoffTol = 1e-12;
+
+Mat3 randomRotation(Random& rnd) {
+  Vec4 p = rnd.vector(4, -1.0, 1.0);
+  return quaternionRotation(p);
+}
+
+std::unique_ptr<RigidBody3d> randomBody(Random& rnd, const std::string& name) {
+  RigidBody3dProperties props;
+  props.mass = rnd.uniform(0.5, 3.0);
+  const Vec3 I(rnd.uniform(1.0, 2.0), rnd.uniform(1.0, 2.0), rnd.uniform(1.0, 2.0));
+  const Mat3 R = randomRotation(rnd);
+  props.inertia = R * I.asDiagonal() * R.transpose();
+  props.inertia = 0.5 * (props.inertia + props.inertia.transpose()).eval();
+  FrameState3d init;
+  init.position = rnd.vector(3, -1.0, 1.0);
+  init.orientation = randomRotation(rnd);
+  init.velocity = rnd.vector(3, -1.0, 1.0);
+  init.angularVelocity = rnd.vector(3, -2.0, 2.0);
+  return std::make_unique<RigidBody3d>(name, props, init);
+}
+
+/// A random state with a quaternion of length != 1 (its length is a gauge and must not matter).
+VecX randomCoordinates(Random& rnd) {
+  VecX q(7);
+  q.head<3>() = rnd.vector(3, -1.0, 1.0);
+  q.segment<4>(3) = rnd.vector(4, -1.0, 1.0).normalized() * rnd.uniform(0.8, 1.2);
+  return q;
+}
+
+/// d f(q (+) eps e_k) / d eps at 0 for each velocity direction k (central).
+MatX fdAlongVelocities(const Body& body, const VecX& q, const std::function<VecX(const VecX&)>& f) {
+  const int nv = body.numVelocities();
+  const VecX f0 = f(q);
+  MatX J(f0.size(), nv);
+  for (int k = 0; k < nv; ++k) {
+    VecX dv = VecX::Zero(nv);
+    dv[k] = kFdRelStep;
+    VecX qp(q.size()), qm(q.size());
+    body.applyIncrement(q, dv, qp);
+    body.applyIncrement(q, -dv, qm);
+    J.col(k) = (f(qp) - f(qm)) / (2.0 * kFdRelStep);
+  }
+  return J;
+}
+
+MatX fdJacobian(const std::function<VecX(const VecX&)>& f, const VecX& x) {
+  return testsupport::fdJacobian(f, x, relativeSteps(x, kFdRelStep));
+}
+
+VecX flatten(const Mat3& A) { return Eigen::Map<const VecX>(A.data(), 9); }
+
+}  // namespace
+
+TEST(RigidBody3d, KinematicMapItsInverseAndDerivativeMatchFiniteDifferences) {
+  Random rnd(kSeed);
+  for (int s = 0; s < kSamples; ++s) {
+    const auto bodyPtr = randomBody(rnd, "b");
+    const RigidBody3d& body = *bodyPtr;
+    const VecX q = randomCoordinates(rnd), w = rnd.vector(6, -2.0, 2.0);
+    const std::string at = "sample " + std::to_string(s);
+    MatX T, Ti;
+    body.coordinateRateMatrix(q, T);
+    body.coordinateRateInverse(q, Ti);
+    expectMatrixNear(Ti * T, MatX::Identity(6, 6), kRoundoffTol, "T+ T = I, " + at, 1.0);
+    VecX Tw = VecX::Zero(7);
+    body.addCoordinateRate(q, w, Tw);
+    expectMatrixNear(Tw, T * w, kRoundoffTol, "addCoordinateRate = T w, " + at, 1.0);
+    // T is the derivative of q along the increment q (+) eps e_k (which renormalises p:
+    // checked on a unit quaternion)
+    VecX qu = q;
+    qu.segment<4>(3).normalize();
+    MatX Tu;
+    body.coordinateRateMatrix(qu, Tu);
+    expectMatrixNear(fdAlongVelocities(body, qu, [](const VecX& z) { return z; }), Tu, kFdTol,
+                     "d(q (+) eps e_k)/d eps = T (unit quaternion), " + at, 1.0);
+    MatX K = MatX::Zero(7, 7);
+    body.addCoordinateRateJacobian(q, w, K);
+    expectMatrixNear(K, fdJacobian([&](const VecX& z) { VecX o = VecX::Zero(7); body.addCoordinateRate(z, w, o); return o; }, q),
+                     kFdTol, "d(T w)/dq, " + at, 1.0);
+  }
+}
+
+TEST(RigidBody3d, FrameJacobiansCurvatureAndGyroscopicTermsMatchFiniteDifferences) {
+  Random rnd(kSeed + 1);
+  for (int s = 0; s < kSamples; ++s) {
+    const auto bodyPtr = randomBody(rnd, "b");
+    const RigidBody3d& body = *bodyPtr;
+    const VecX q = randomCoordinates(rnd), v = rnd.vector(6, -2.0, 2.0);
+    const Vec3 u = rnd.vector(3, -1.0, 1.0), wr = rnd.vector(3, -2.0, 2.0), ww = rnd.vector(3, -2.0, 2.0);
+    const std::string at = "sample " + std::to_string(s);
+    FrameKinematics f;
+    body.frameKinematics(q, u, nullptr, nullptr, f);
+    EXPECT_NEAR((f.A - quaternionRotation(q.segment<4>(3))).norm(), 0.0, kRoundoffTol);
+    // Jr: the point's velocity along each velocity direction
+    expectMatrixNear(f.Jr, fdAlongVelocities(body, q, [&](const VecX& z) {
+                       FrameKinematics g;
+                       body.frameKinematics(z, u, nullptr, nullptr, g);
+                       return VecX(g.r);
+                     }), kFdTol, "Jr, " + at, 1.0);
+    // Jw: dA/d eps A^T = (Jw e_k)~
+    const MatX dA = fdAlongVelocities(body, q, [&](const VecX& z) { return flatten(RigidBody3d::rotationOf(z)); });
+    for (int k = 0; k < 6; ++k) {
+      const Mat3 W = Eigen::Map<const Mat3>(dA.col(k).data()) * f.A.transpose();
+      const Vec3 omega(W(2, 1), W(0, 2), W(1, 0));
+      expectMatrixNear(omega, f.Jw.col(k), kFdTol, "Jw column " + std::to_string(k) + ", " + at, 1.0);
+    }
+    // curvature d(Jr^T wr + Jw^T ww)/dq
+    MatX C = MatX::Zero(6, 7);
+    body.addFrameCurvature(q, u, nullptr, nullptr, wr, ww, C);
+    expectMatrixNear(C, fdJacobian([&](const VecX& z) {
+                       FrameKinematics g;
+                       body.frameKinematics(z, u, nullptr, nullptr, g);
+                       return VecX(g.Jr.transpose() * wr + g.Jw.transpose() * ww);
+                     }, q), kFdTol, "curvature, " + at, 1.0);
+    // gyroscopic force and its Jacobian
+    MatX dQdq = MatX::Zero(6, 7), dQdv = MatX::Zero(6, 6);
+    body.addInternalForceJacobians(q, v, dQdq, dQdv);
+    expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { VecX Q = VecX::Zero(6); body.addInternalForces(q, z, Q); return Q; }, v),
+                     kFdTol, "d(gyroscopic)/dv, " + at, 1.0);
+  }
+}
+
+class SpatialJointDerivatives : public ::testing::TestWithParam<SpatialJointType> {};
+
+TEST_P(SpatialJointDerivatives, GAndHMatchFiniteDifferencesBetweenTwoBodiesAndToGround) {
+  Random rnd(kSeed + 10 + static_cast<unsigned>(GetParam()));
+  for (int s = 0; s < kSamples; ++s) {
+    for (const bool toGround : {false, true}) {
+      System sys;
+      const BodyIndex a = sys.addBody(randomBody(rnd, "a"));
+      const BodyIndex b = sys.addBody(randomBody(rnd, "b"));
+      JointFrame fi, fj;
+      fi.point = rnd.vector(3, -1.0, 1.0);
+      fi.axes = randomRotation(rnd);
+      fj.point = rnd.vector(3, -1.0, 1.0);
+      fj.axes = randomRotation(rnd);
+      const ConstraintIndex c = sys.addConstraint(
+          std::make_unique<SpatialJoint>("j", GetParam(), toGround ? kGround : a, fi, b, fj));
+      sys.finalize();
+      VecX q(sys.numCoordinates());
+      for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
+      const Constraint& con = sys.constraint(c);
+      const auto& qcols = sys.constraintCoordinateColumns(c);
+      const auto& vcols = sys.constraintColumns(c);
+      ConstraintEvaluation ev;
+      con.evaluate(sys.constraintStates(c, q.data()), true, ev);
+      const std::string at = std::string(toString(GetParam())) + (toGround ? " to ground" : "") + ", sample " +
+                             std::to_string(s);
+      ASSERT_EQ(ev.G.cols(), static_cast<int>(vcols.size())) << at;
+      // G: the derivative of h along each velocity direction (q (+) eps e_k)
+      const auto hOf = [&](const VecX& z) {
+        ConstraintEvaluation e;
+        con.evaluate(sys.constraintStates(c, z.data()), false, e);
+        return e.h;
+      };
+      MatX Gfd(con.numEquations(), vcols.size());
+      for (size_t k = 0; k < vcols.size(); ++k) {
+        VecX dv = VecX::Zero(sys.numVelocities());
+        dv[vcols[k]] = kFdRelStep;
+        Gfd.col(k) = (hOf(sys.applyIncrement(q, dv)) - hOf(sys.applyIncrement(q, -dv))) / (2.0 * kFdRelStep);
+      }
+      expectMatrixNear(ev.G, Gfd, kFdTol, "G, " + at, 1.0);
+      // H_a = d(G_a^T)/dq over the local coordinates
+      for (int e = 0; e < con.numEquations(); ++e) {
+        const auto GaOf = [&](const VecX& ql) {
+          VecX z = q;
+          for (size_t k = 0; k < qcols.size(); ++k) z[qcols[k]] = ql[k];
+          ConstraintEvaluation x;
+          con.evaluate(sys.constraintStates(c, z.data()), false, x);
+          return VecX(x.G.row(e).transpose());
+        };
+        VecX ql(qcols.size());
+        for (size_t k = 0; k < qcols.size(); ++k) ql[k] = q[qcols[k]];
+        expectMatrixNear(ev.H[e], fdJacobian(GaOf, ql), kFdTol, "H_" + std::to_string(e) + ", " + at, 1.0);
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryType, SpatialJointDerivatives,
+                         ::testing::Values(SpatialJointType::Spherical, SpatialJointType::Revolute,
+                                           SpatialJointType::Prismatic, SpatialJointType::Cylindrical,
+                                           SpatialJointType::Universal, SpatialJointType::Fixed,
+                                           SpatialJointType::Planar),
+                         [](const auto& info) { return std::string(toString(info.param)); });
+
+namespace {
+
+/// A spatial double pendulum with a universal joint and a prismatic-cylindrical pair:
+/// every kind of block of the DAE (T(q), the gyroscopic term, joint curvature).
+System makeSpatialSystem(Random& rnd) {
+  System sys;
+  sys.setGravity(Vec3(0.0, -9.81, 0.0));
+  const BodyIndex a = sys.addBody(randomBody(rnd, "a"));
+  const BodyIndex b = sys.addBody(randomBody(rnd, "b"));
+  const BodyIndex c = sys.addBody(randomBody(rnd, "c"));
+  JointFrame f0, f1, f2, f3;
+  f0.point = Vec3(0.1, 0.2, 0.0);
+  f1.point = Vec3(-0.5, 0.0, 0.1);
+  f1.axes = randomRotation(rnd);
+  f2.point = Vec3(0.5, 0.0, 0.0);
+  f3.axes = randomRotation(rnd);
+  sys.addConstraint(std::make_unique<SpatialJoint>("rev", SpatialJointType::Revolute, kGround, f0, a, f1));
+  sys.addConstraint(std::make_unique<SpatialJoint>("uni", SpatialJointType::Universal, a, f2, b, f3));
+  sys.addConstraint(std::make_unique<SpatialJoint>("cyl", SpatialJointType::Cylindrical, b, f0, c, f1));
+  sys.finalize();
+  return sys;
+}
+
+MatX fdIterationMatrix(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, double cj) {
+  const int n = dae.layout().size;
+  MatX J(n, n);
+  VecX Fp(n), Fm(n);
+  for (int k = 0; k < n; ++k) {
+    VecX yy = y, ypp = yp;
+    const double hy = kFdRelStep * (1.0 + std::abs(y[k]));
+    yy[k] = y[k] + hy;
+    dae.residual(t, yy.data(), yp.data(), Fp.data());
+    yy[k] = y[k] - hy;
+    dae.residual(t, yy.data(), yp.data(), Fm.data());
+    J.col(k) = (Fp - Fm) / (2.0 * hy);
+    const double hp = kFdRelStep * (1.0 + std::abs(yp[k]));
+    ypp[k] = yp[k] + hp;
+    dae.residual(t, y.data(), ypp.data(), Fp.data());
+    ypp[k] = yp[k] - hp;
+    dae.residual(t, y.data(), ypp.data(), Fm.data());
+    J.col(k) += cj * (Fp - Fm) / (2.0 * hp);
+  }
+  return J;
+}
+
+}  // namespace
+
+class SpatialDaeJacobian : public ::testing::TestWithParam<Formulation> {};
+
+TEST_P(SpatialDaeJacobian, IterationMatrixMatchesFiniteDifferencesAndStaysInThePattern) {
+  Random rnd(kSeed + 30 + static_cast<unsigned>(GetParam()));
+  const System sys = makeSpatialSystem(rnd);
+  const DaeSystem dae(sys, GetParam());
+  const DaeLayout& L = dae.layout();
+  ASSERT_EQ(L.nq, 21);
+  ASSERT_EQ(L.nv, 18);
+  for (int s = 0; s < kSamples / 2; ++s) {
+    VecX y = rnd.vector(L.size, -2.0, 2.0), yp = rnd.vector(L.size, -2.0, 2.0);
+    for (int b = 1; b < sys.numBodies(); ++b) {
+      y.segment(L.q + sys.coordinateOffset(BodyIndex(b)), 7) = randomCoordinates(rnd);
+    }
+    const double t = rnd.uniform(0.0, 2.0), cj = 7.3;
+    const std::string at = toString(GetParam()) + ", sample " + std::to_string(s);
+    MatX J = MatX::Zero(L.size, L.size);
+    JacobianSink sink = JacobianSink::dense(J.data(), L.size);
+    dae.jacobian(t, y.data(), yp.data(), cj, sink);
+    expectRowsNear(J, fdIterationMatrix(dae, t, y, yp, cj), kFdTol, "dF/dy + cj dF/dy', " + at);
+    std::vector<std::pair<int, int>> written;
+    JacobianSink recorder = JacobianSink::recorder(&written);
+    dae.jacobian(t, y.data(), yp.data(), cj, recorder);
+    for (const auto& [r, c] : written) EXPECT_GE(dae.pattern().find(r, c), 0) << at << ": (" << r << ", " << c << ")";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllFormulations, SpatialDaeJacobian,
+                         ::testing::Values(Formulation::Ggl, Formulation::Index3, Formulation::Index1),
+                         [](const auto& info) { return toString(info.param); });
