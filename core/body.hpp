@@ -68,9 +68,9 @@ class Body {
   /// the rest are elastic. Consistent initialisation keeps the given elastic values and
   /// moves the frame coordinates (a body is not deformed to assemble the mechanism).
   virtual int numFrameCoordinates() const { return numCoordinates(); }
-  /// The first numFrameVelocities() velocities are the frame's (default: as many as
-  /// frame coordinates, T = I).
-  virtual int numFrameVelocities() const { return numFrameCoordinates(); }
+  /// The first numFrameVelocities() velocities are the frame's (default: all but the
+  /// elastic ones, whose velocities are their rates).
+  virtual int numFrameVelocities() const { return numVelocities() - (numCoordinates() - numFrameCoordinates()); }
   /// The kind of each coordinate (default: frame coordinates are positions, the others
   /// elastic).
   virtual std::vector<CoordinateKind> coordinateKinds() const {
