@@ -11,9 +11,6 @@
 namespace flexmbd {
 namespace {
 
-/// Shortest text that reads back as the same double.
-std::string fmt(double x) { return shortestNumberText(x); }
-
 void requireFiniteVec(const Vec2& v, const std::string& what) {
   if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {
     throw InputError(what + " must be finite numbers, got [" + fmt(v.x()) + ", " + fmt(v.y()) + "]");
