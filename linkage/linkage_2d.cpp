@@ -1,4 +1,4 @@
-#include "elements/linkage_2d.hpp"
+#include "linkage/linkage_2d.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "integrators/kinematic_analysis.hpp"
+#include "linkage/kinematic_analysis.hpp"
 
 #include <algorithm>
 #include <chrono>
