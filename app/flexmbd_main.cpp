@@ -1,6 +1,6 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
-//   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
+//   flexmbd kinematics SCENE.json --out DIR [...]   (linkage/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd --help | --version
@@ -15,20 +15,20 @@
 #include <filesystem>
 #include <iostream>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
-#include "app/kinematics_command.hpp"
+#include "app/command_line.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
-#include "app/tensegrity_command.hpp"
-#include "app/command_line.hpp"
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
+#include "linkage/kinematics_command.hpp"
+#include "tensegrity/tensegrity_command.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -106,13 +106,8 @@ struct Options {
   ResultsFormat format = ResultsFormat::Csv;  ///< --format
 };
 
-
-std::string fmt(double x) {
-  std::ostringstream os;
-  os.precision(6);
-  os << x;
-  return os.str();
-}
+/// Significant digits of times and CPU seconds in messages (fmt, core/number_text.hpp).
+constexpr int kNumberDigits = 6;
 
 Options parseCommandLine(int argc, char** argv) {
   Options o;
@@ -190,7 +185,7 @@ double cpuSecondsSince(std::clock_t start) {
 }
 
 int runCommand(const Options& o) {
-  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
+  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (tensegrity/tensegrity_command.cpp)
     if (o.format != ResultsFormat::Csv) {
       printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
                  "events.csv)");
@@ -212,7 +207,8 @@ int runCommand(const Options& o) {
     SolverSettings& s = scene->solver;
     if (o.tEnd) {
       if (!(*o.tEnd > s.tStart)) {
-        throw InputError("option --t-end must be > t_start (" + fmt(s.tStart) + ") of the scene, got " + fmt(*o.tEnd));
+        throw InputError("option --t-end must be > t_start (" + fmt(s.tStart, kNumberDigits) + ") of the scene, got " +
+                         fmt(*o.tEnd, kNumberDigits));
       }
       s.tEnd = *o.tEnd;
     }
@@ -274,7 +270,7 @@ int runCommand(const Options& o) {
 
   for (const std::string& w : summary.warnings) std::cerr << "flexmbd: warning: " << oneLine(w) << std::endl;
   const std::string kept = writer->rowsWritten() > 0
-                               ? "results up to t = " + fmt(writer->lastTime()) + " kept in " +
+                               ? "results up to t = " + fmt(writer->lastTime(), kNumberDigits) + " kept in " +
                                      writer->resultsPath().string()
                                : "no results were written";
   const int failureStatus = summary.interruptedBySignal ? 128 + summary.interruptedBySignal : kExitSolverFailure;
@@ -292,8 +288,9 @@ int runCommand(const Options& o) {
     printError(what + " (" + kept + ")");
     return failureStatus;
   }
-  std::cout << "flexmbd: ok: t = " << fmt(summary.tReached) << " reached, " << summary.stats.steps << " steps, "
-            << fmt(summary.cpuSeconds) << " s CPU; results in " << writer->resultsPath().string() << std::endl;
+  std::cout << "flexmbd: ok: t = " << fmt(summary.tReached, kNumberDigits) << " reached, " << summary.stats.steps
+            << " steps, " << fmt(summary.cpuSeconds, kNumberDigits) << " s CPU; results in "
+            << writer->resultsPath().string() << std::endl;
   return kExitOk;
 }
 

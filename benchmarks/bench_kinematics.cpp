@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "integrators/kinematic_analysis.hpp"
-#include "io/kinematics_scene.hpp"
+#include "linkage/kinematic_analysis.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 using namespace flexmbd;
 using Clock = std::chrono::steady_clock;

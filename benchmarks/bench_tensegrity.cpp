@@ -1,5 +1,5 @@
 // Benchmark: time per step of method 1 (inextensible cables, one LCP per step, issue 6)
-// against the number of cables, for the LCP solvers behind integrators/lcp_solver.hpp
+// against the number of cables, for the LCP solvers behind tensegrity/lcp_solver.hpp
 // (Siconos lexicographic Lemke and projected Gauss-Seidel).
 //
 // Model: a hanging cable net, k x k nodes (grid spacing 1 in x-y, mass 1 each) with its
@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 using namespace flexmbd;
 using Clock = std::chrono::steady_clock;

@@ -12,6 +12,7 @@
 #include <exception>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "core/errors.hpp"
 
@@ -35,7 +36,9 @@ struct CvodeSolver::Impl {
   N_Vector y = nullptr;
   SUNMatrix A = nullptr;
   SUNLinearSolver LS = nullptr;
-  std::exception_ptr pending;  // exception thrown inside a callback, rethrown by advance()
+  // An exception thrown by the model inside a callback: CVODE is told to stop (an
+  // unrecoverable failure of the callback) and advance() rethrows it with its type.
+  std::exception_ptr pending;
   std::string lastMessage;
 
   ~Impl() {
@@ -122,19 +125,15 @@ double CvodeSolver::advance(double tout) {
   d.pending = nullptr;
   realtype tret = 0.0;
   const int flag = CVode(d.mem, tout, d.y, &tret, CV_NORMAL);
+  // Not a solver failure (an InputError, a ModelError, an assembly bug): it leaves as it was thrown.
+  if (d.pending) std::rethrow_exception(std::exchange(d.pending, nullptr));
   if (flag < 0) {
     realtype h = 0.0, tcur = 0.0;
     CVodeGetLastStep(d.mem, &h);
     CVodeGetCurrentTime(d.mem, &tcur);
     std::ostringstream os;
     os << "CVODE failed at t = " << tcur << " with step size " << h << ": " << flagName(flag);
-    if (d.pending) {
-      try {
-        std::rethrow_exception(d.pending);
-      } catch (const std::exception& e) {
-        os << " (" << e.what() << ")";
-      }
-    } else if (!d.lastMessage.empty()) {
+    if (!d.lastMessage.empty()) {
       os << " (" << d.lastMessage << ")";
     }
     throw SolverError(os.str(), tcur, h);

@@ -33,7 +33,8 @@ class CvodeSolver {
 
   /// Integrates towards tout (never past tout). Returns the time reached: tout, or the
   /// time of a root (then rootsFound() lists the sign changes: +1 rising, -1 falling, 0 none).
-  /// @throws SolverError with CVODE's reason, the time and the last step size.
+  /// @throws SolverError with CVODE's reason, the time and the last step size; an exception
+  /// of the ODE's rhs() or roots() as it was thrown (an InputError stays an InputError).
   double advance(double tout);
   /// Restarts the integration at (t, y) (after a discontinuity of f's derivative).
   void reinit(double t, const VecX& y);

@@ -62,7 +62,11 @@ class DaeIntegrator {
  public:
   virtual ~DaeIntegrator() = default;
   /// Integrates to tout (never past tStop), returns the time reached (= tout).
-  /// @throws SolverError with the reason, the time and the last step size.
+  /// @throws SolverError with the reason, the time and the last step size. An exception
+  /// thrown by the problem's residual or Jacobian is not a solver failure: it leaves with
+  /// its type and message (InputError, ModelError, std::logic_error of an assembly bug),
+  /// so that the caller reports it as what it is. A residual with non-finite entries is
+  /// a recoverable event of the integrator (a smaller step is tried).
   virtual double advance(double tout, double tStop) = 0;
   /// Solution at the time returned by advance().
   virtual const VecX& y() const = 0;

@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <sstream>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "integrators/klu_ordering.hpp"
@@ -39,7 +41,9 @@ struct IdaSolver::Impl {
   SUNLinearSolver LS = nullptr;
   bool sparse = false;
   std::vector<int64_t> kluGroups;  // CAMD constraint set, read by camdOrdering
-  std::exception_ptr pending;  // exception thrown inside a callback, rethrown by advance()
+  // An exception thrown by the model inside a callback: IDA is told to stop (an
+  // unrecoverable failure of the callback) and advance() rethrows it with its type.
+  std::exception_ptr pending;
   std::string lastIdaMessage;  // last message of IDA's error handler
 
   ~Impl() {
@@ -183,19 +187,15 @@ double IdaSolver::advance(double tout, double tStop) {
   d.pending = nullptr;
   const int flag = IDASolve(d.mem, tout, &tret, d.yy, d.yp, IDA_NORMAL);
   const int n = static_cast<int>(y_.size());
+  // Not a solver failure (an InputError, a ModelError, an assembly bug): it leaves as it was thrown.
+  if (d.pending) std::rethrow_exception(std::exchange(d.pending, nullptr));
   if (flag < 0) {
     realtype h = 0.0, tcur = 0.0;
     IDAGetLastStep(d.mem, &h);
     IDAGetCurrentTime(d.mem, &tcur);
     std::ostringstream os;
     os << "IDA failed at t = " << tcur << " with step size " << h << ": " << flagName(flag);
-    if (d.pending) {
-      try {
-        std::rethrow_exception(d.pending);
-      } catch (const std::exception& e) {
-        os << " (" << e.what() << ")";
-      }
-    } else if (!d.lastIdaMessage.empty()) {
+    if (!d.lastIdaMessage.empty()) {
       os << " (" << d.lastIdaMessage << ")";
     }
     // IDASolve returns the solution at its last successful step (tret = tn) on failures

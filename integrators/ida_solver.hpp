@@ -21,7 +21,8 @@ class IdaSolver final : public DaeIntegrator {
   IdaSolver& operator=(const IdaSolver&) = delete;
 
   /// Integrates to tout (never past tStop), returns the time reached (= tout).
-  /// @throws SolverError with IDA's reason, the time and the last step size.
+  /// @throws SolverError with IDA's reason, the time and the last step size; an exception
+  /// of the model's residual or Jacobian as it was thrown (DaeIntegrator::advance).
   double advance(double tout, double tStop) override;
   /// Current solution at the time returned by advance().
   const VecX& y() const override { return y_; }

@@ -715,23 +715,17 @@ struct Radau5Solver::Impl {
       }
       return tout;
     }
-    try {
-      if (h <= 0.0) chooseInitialStep(tout);
-      long steps = 0;
-      while (t < tout) {
-        if (++steps > maxSteps) {
-          std::ostringstream os;
-          os << "more than max_steps = " << maxSteps << " steps on the way to tout = " << tout;
-          fail(os.str(), h);
-        }
-        step(tStop);
+    // An exception of the model's residual or Jacobian (an InputError, a ModelError, an
+    // assembly bug) is not a solver failure: it leaves as it was thrown.
+    if (h <= 0.0) chooseInitialStep(tout);
+    long steps = 0;
+    while (t < tout) {
+      if (++steps > maxSteps) {
+        std::ostringstream os;
+        os << "more than max_steps = " << maxSteps << " steps on the way to tout = " << tout;
+        fail(os.str(), h);
       }
-    } catch (const SolverError&) {
-      throw;
-    } catch (const std::exception& e) {
-      std::ostringstream os;
-      os << "Radau5 failed at t = " << t << " with step size " << h << ": the model evaluation threw: " << e.what();
-      throw SolverError(os.str(), t, h);
+      step(tStop);
     }
     st.currentTime = t;
     st.lastStepSize = hPoly;

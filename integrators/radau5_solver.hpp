@@ -48,7 +48,8 @@ class Radau5Solver final : public DaeIntegrator {
 
   /// Integrates to tout (may step past it, never past tStop), returns tout; y() and yp()
   /// come from the collocation polynomial of the step holding tout.
-  /// @throws SolverError with the reason, the time reached and the last step size.
+  /// @throws SolverError with the reason, the time reached and the last step size; an
+  /// exception of the model's residual or Jacobian as it was thrown (DaeIntegrator::advance).
   double advance(double tout, double tStop) override;
   const VecX& y() const override;
   const VecX& yp() const override;

@@ -32,10 +32,6 @@ constexpr double kMaxInputMagnitude = 1e100;
 
 // ----- formatting ------------------------------------------------------------------
 
-/// Shortest text that reads back as the same double ("-1", "0.1", "1e-08").
-/// Plain decimals from 1e-4 to 1e6 ("-80", not "-8e+01"; core/number_text.hpp).
-inline std::string fmt(double x) { return shortestNumberText(x); }
-
 /// Longest text of a value or name quoted in an error message; longer ones are cut and
 /// end in "...". A message must stay one readable line even for a 100 KB name.
 constexpr std::size_t kMaxQuoted = 60;

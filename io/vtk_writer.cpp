@@ -5,7 +5,7 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
-#include "bodies/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
 namespace {

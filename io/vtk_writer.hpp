@@ -12,7 +12,7 @@
 
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
-#include "integrators/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_output.hpp"
 
 namespace flexmbd {
 

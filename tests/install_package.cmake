@@ -22,9 +22,26 @@ foreach(item config library)
   endif()
 endforeach()
 foreach(file include/flexmbd/core/types.hpp include/flexmbd/io/results_writer.hpp
-             include/flexmbd/integrators/simulation.hpp bin/flexmbd)
+             include/flexmbd/integrators/simulation.hpp include/flexmbd/linkage/kinematic_analysis.hpp
+             include/flexmbd/tensegrity/tensegrity_structure.hpp bin/flexmbd)
   if(NOT EXISTS "${prefix}/${file}")
     message(FATAL_ERROR "install: ${prefix}/${file} missing")
   endif()
+endforeach()
+# Issue 13: every "folder/file.hpp" an installed header includes is installed too (a
+# folder missing from the install rules would break only the outside projects), and the
+# subcommands of the command line (*_command.hpp, not in the library) are not.
+file(GLOB_RECURSE headers RELATIVE "${prefix}/include/flexmbd" "${prefix}/include/flexmbd/*.hpp")
+foreach(header IN LISTS headers)
+  if(header MATCHES "_command\\.hpp$")
+    message(FATAL_ERROR "install: ${header} is a header of the command line, not of the library")
+  endif()
+  file(STRINGS "${prefix}/include/flexmbd/${header}" includes REGEX "^#include \"[a-z_]+/[a-z0-9_]+\\.hpp\"")
+  foreach(line IN LISTS includes)
+    string(REGEX REPLACE "^#include \"([^\"]+)\".*" "\\1" included "${line}")
+    if(NOT EXISTS "${prefix}/include/flexmbd/${included}")
+      message(FATAL_ERROR "install: ${header} includes ${included}, which is not installed")
+    endif()
+  endforeach()
 endforeach()
 message(STATUS "flexmbd installed in ${prefix}: ${config}")

@@ -142,8 +142,8 @@ TEST(DocsKeys, TheComparisonCatchesAKeyMissingFromTheDocsAndAKeyNoReaderAccepts)
 
 TEST(DocsKeys, ReadersTakeTheirAllowedKeysFromTheTable) {
   // A literal list passed to allowOnly would bypass io/scene_keys.hpp (and this test).
-  for (const char* file : {"io/scene.cpp", "io/json_reader.cpp", "io/kinematics_scene.cpp",
-                           "io/tensegrity_scene.cpp"}) {
+  for (const char* file : {"io/scene.cpp", "io/json_reader.cpp", "linkage/kinematics_scene.cpp",
+                           "tensegrity/tensegrity_scene.cpp"}) {
     const std::string src = readText(std::string(FLEXMBD_SOURCE_DIR) + "/" + file);
     ASSERT_FALSE(src.empty()) << file;
     EXPECT_EQ(src.find("allowOnly({"), std::string::npos) << file << " passes a literal key list to allowOnly";

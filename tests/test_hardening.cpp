@@ -9,10 +9,10 @@
 #include <string>
 
 #include "cli_fixture.hpp"
-#include "integrators/kinematic_analysis.hpp"
-#include "io/kinematics_scene.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "linkage/kinematic_analysis.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 namespace fs = std::filesystem;
 

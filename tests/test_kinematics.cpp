@@ -10,9 +10,9 @@
 
 #include "bodies/rigid_body_2d.hpp"
 #include "core/errors.hpp"
-#include "integrators/kinematic_analysis.hpp"
 #include "integrators/simulation.hpp"
-#include "io/kinematics_scene.hpp"
+#include "linkage/kinematic_analysis.hpp"
+#include "linkage/kinematics_scene.hpp"
 #include "tests/four_bar_reference.hpp"
 #include "tests/reference_solutions.hpp"
 

@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "io/kinematics_scene.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "core/errors.hpp"
-#include "elements/link_element_2d.hpp"
-#include "elements/linkage_2d.hpp"
+#include "linkage/link_element_2d.hpp"
+#include "linkage/linkage_2d.hpp"
 #include "tests/four_bar_reference.hpp"
 
 using namespace flexmbd;

@@ -12,8 +12,8 @@
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
-#include "io/kinematics_scene.hpp"
 #include "io/scene.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 namespace flexmbd {
 namespace {

@@ -2,8 +2,8 @@
 // (TimeSteppingSettings::contactConstraints, scene key solver.contact_constraints).
 #include <gtest/gtest.h>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 using namespace flexmbd;
 

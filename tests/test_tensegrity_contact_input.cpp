@@ -12,9 +12,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "elements/segment_closest_points.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
-#include "io/tensegrity_scene.hpp"
+#include "tensegrity/segment_closest_points.hpp"
+#include "tensegrity/tensegrity_scene.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -1,4 +1,4 @@
-// LCP solvers behind integrators/lcp_solver.hpp (Siconos lexicographic Lemke and
+// LCP solvers behind tensegrity/lcp_solver.hpp (Siconos lexicographic Lemke and
 // projected Gauss-Seidel) on a closed-form 2x2 case and on the Delassus LCPs of the
 // tensegrity time-stepper, compared with each other; and the stepper run with both.
 #include <gtest/gtest.h>
@@ -8,9 +8,9 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/lcp_solver.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/lcp_solver.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 using namespace flexmbd;
 

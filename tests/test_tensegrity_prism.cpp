@@ -7,10 +7,10 @@
 #include <iostream>
 #include <vector>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/massless_cable_integrator.hpp"
-#include "integrators/self_equilibrium.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/massless_cable_integrator.hpp"
+#include "tensegrity/self_equilibrium.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 using namespace flexmbd;
 

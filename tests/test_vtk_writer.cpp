@@ -13,7 +13,7 @@
 #include "bodies/ffr_body_2d.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
-#include "bodies/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 #include "tests/ffr_test_models.hpp"
 
 using namespace flexmbd;

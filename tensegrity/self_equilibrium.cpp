@@ -3,7 +3,7 @@
 // file only (the pragma must precede the first inclusion of Eigen).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include "integrators/self_equilibrium.hpp"
+#include "tensegrity/self_equilibrium.hpp"
 
 #include <Eigen/SVD>
 #include <sstream>

@@ -8,8 +8,8 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "elements/linkage_2d.hpp"
-#include "integrators/kinematic_analysis.hpp"
+#include "linkage/kinematic_analysis.hpp"
+#include "linkage/linkage_2d.hpp"
 
 namespace flexmbd {
 

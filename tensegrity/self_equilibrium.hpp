@@ -6,7 +6,7 @@
 // computed with the SVD.
 #pragma once
 
-#include "bodies/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
 

@@ -1,4 +1,4 @@
-#include "integrators/lcp_solver.hpp"
+#include "tensegrity/lcp_solver.hpp"
 
 #include <LCP_Solvers.h>
 #include <LinearComplementarityProblem.h>

@@ -1,4 +1,4 @@
-#include "elements/linkage_2d.hpp"
+#include "linkage/linkage_2d.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -10,9 +10,6 @@
 
 namespace flexmbd {
 namespace {
-
-/// Shortest text that reads back as the same double.
-std::string fmt(double x) { return shortestNumberText(x); }
 
 void requireFiniteVec(const Vec2& v, const std::string& what) {
   if (!std::isfinite(v.x()) || !std::isfinite(v.y())) {

@@ -15,7 +15,7 @@
 
 #include "core/time_law.hpp"
 #include "core/types.hpp"
-#include "elements/bar_element.hpp"
+#include "tensegrity/bar_element.hpp"
 
 namespace flexmbd {
 

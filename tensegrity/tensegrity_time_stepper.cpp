@@ -1,4 +1,4 @@
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -9,8 +9,8 @@
 #include <sstream>
 
 #include "core/errors.hpp"
-#include "elements/segment_closest_points.hpp"
-#include "integrators/member_contact_detector.hpp"
+#include "tensegrity/member_contact_detector.hpp"
+#include "tensegrity/segment_closest_points.hpp"
 
 namespace flexmbd {
 

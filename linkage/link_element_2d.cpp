@@ -1,4 +1,4 @@
-#include "elements/link_element_2d.hpp"
+#include "linkage/link_element_2d.hpp"
 
 #include <cmath>
 

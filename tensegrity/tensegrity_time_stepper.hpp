@@ -15,9 +15,9 @@
 // iterated (Gauss-Newton) until the relative drift is below the projection tolerance.
 #pragma once
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/lcp_solver.hpp"
-#include "integrators/tensegrity_output.hpp"
+#include "tensegrity/lcp_solver.hpp"
+#include "tensegrity/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
 

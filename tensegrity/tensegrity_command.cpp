@@ -1,4 +1,4 @@
-#include "app/tensegrity_command.hpp"
+#include "tensegrity/tensegrity_command.hpp"
 
 #include "app/command_line.hpp"
 
@@ -13,8 +13,8 @@
 
 #include "core/errors.hpp"
 #include "io/results_writer.hpp"
-#include "io/tensegrity_scene.hpp"
 #include "io/vtk_writer.hpp"
+#include "tensegrity/tensegrity_scene.hpp"
 
 namespace flexmbd {
 

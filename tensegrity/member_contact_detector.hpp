@@ -1,13 +1,13 @@
 // Contact between tensegrity members (cylinders of given radius around their axes)
-// during a run: segment-segment closest points (elements/segment_closest_points.hpp)
+// during a run: segment-segment closest points (tensegrity/segment_closest_points.hpp)
 // and a continuous check between two states, with the node positions moving linearly
 // in between, by conservative advancement. Members sharing a node are never checked.
 #pragma once
 
 #include <vector>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
 

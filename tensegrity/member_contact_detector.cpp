@@ -1,9 +1,9 @@
-#include "integrators/member_contact_detector.hpp"
+#include "tensegrity/member_contact_detector.hpp"
 
 #include <algorithm>
 #include <cmath>
 
-#include "elements/segment_closest_points.hpp"
+#include "tensegrity/segment_closest_points.hpp"
 
 namespace flexmbd {
 

@@ -1,4 +1,4 @@
-#include "bodies/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "core/errors.hpp"
-#include "elements/cable_element.hpp"
+#include "tensegrity/cable_element.hpp"
 
 namespace flexmbd {
 

@@ -1,24 +1,21 @@
-#include "integrators/kinematic_analysis.hpp"
+#include "linkage/kinematic_analysis.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <set>
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 
 namespace flexmbd {
 namespace {
 
-std::string fmt(double x, int digits = 10) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, x);
-  return buf;
-}
+/// Significant digits of the numbers in messages (fmt, core/number_text.hpp).
+constexpr int kNumberDigits = 10;
 
 std::string joinQuoted(const std::vector<std::string>& items) {
   std::string out;
@@ -43,22 +40,24 @@ MatX scaledColumns(const MatX& A) {
 
 void KinematicSettings::validate() const {
   auto finite = [](double x, const char* key) {
-    if (!std::isfinite(x)) throw InputError(std::string("kinematics: ") + key + " must be a finite number, got " + fmt(x));
+    if (!std::isfinite(x)) {
+      throw InputError(std::string("kinematics: ") + key + " must be a finite number, got " + fmt(x, kNumberDigits));
+    }
   };
   finite(start, "start");
   finite(end, "end");
   finite(speed, "speed");
   finite(acceleration, "acceleration");
   finite(tolerance, "tolerance");
-  if (end == start) throw InputError("kinematics: end must differ from start, both are " + fmt(start));
+  if (end == start) throw InputError("kinematics: end must differ from start, both are " + fmt(start, kNumberDigits));
   if (steps < 1) throw InputError("kinematics: steps must be >= 1, got " + std::to_string(steps));
-  if (!(tolerance > 0.0)) throw InputError("kinematics: tolerance must be > 0, got " + fmt(tolerance));
+  if (!(tolerance > 0.0)) throw InputError("kinematics: tolerance must be > 0, got " + fmt(tolerance, kNumberDigits));
   if (maxIterations < 1) throw InputError("kinematics: max_iterations must be >= 1, got " + std::to_string(maxIterations));
   if (!(singularTolerance > 0.0 && singularTolerance < 1.0)) {
-    throw InputError("kinematics: singular_tolerance must be in (0, 1), got " + fmt(singularTolerance));
+    throw InputError("kinematics: singular_tolerance must be in (0, 1), got " + fmt(singularTolerance, kNumberDigits));
   }
   if (!(locateTolerance > 0.0) || !std::isfinite(locateTolerance)) {
-    throw InputError("kinematics: locate_tolerance must be > 0, got " + fmt(locateTolerance));
+    throw InputError("kinematics: locate_tolerance must be > 0, got " + fmt(locateTolerance, kNumberDigits));
   }
 }
 
@@ -76,15 +75,16 @@ KinematicAnalysis::KinematicAnalysis(const Linkage2d& linkage, const KinematicSe
     int worst = 0;
     eps.cwiseAbs().maxCoeff(&worst);
     static const char* const kParameter[3] = {"elongation", "rotation at its first node", "rotation at its second node"};
-    throw ModelError("the linkage cannot be assembled at alpha = " + fmt(settings_.start) + ": residual " +
-                     fmt(c.residual, 3) + " after " + std::to_string(c.iterations) + " iterations; largest: link '" +
-                     linkage_.link(LinkIndex(worst / 3)).name + "' (" + kParameter[worst % 3] + ")");
+    throw ModelError("the linkage cannot be assembled at alpha = " + fmt(settings_.start, kNumberDigits) +
+                     ": residual " + fmt(c.residual, 3) + " after " + std::to_string(c.iterations) +
+                     " iterations; largest: link '" + linkage_.link(LinkIndex(worst / 3)).name + "' (" +
+                     kParameter[worst % 3] + ")");
   }
   const TransferFunctions tf = transferFunctions(x0_);
   if (!(tf.rcond >= settings_.singularTolerance)) {
     SingularPosition s;
     describeSingularMode(x0_, s);
-    throw ModelError("the linkage is singular at the start, alpha = " + fmt(settings_.start) +
+    throw ModelError("the linkage is singular at the start, alpha = " + fmt(settings_.start, kNumberDigits) +
                      " (D L1 reciprocal condition " + fmt(tf.rcond, 3) + "; nodes " + joinQuoted(s.nodes) +
                      ", links " + joinQuoted(s.links) + "): a lock, dead or change point, or redundant links");
   }
@@ -187,8 +187,8 @@ KinematicState KinematicAnalysis::solve(double alpha, const VecX& guess) const {
   VecX X = guess;
   const Correction c = correct(alpha, X);
   if (!c.converged) {
-    throw ModelError("kinematics: no position found at alpha = " + fmt(alpha) + " (residual " + fmt(c.residual, 3) +
-                     " after " + std::to_string(c.iterations) + " iterations)");
+    throw ModelError("kinematics: no position found at alpha = " + fmt(alpha, kNumberDigits) + " (residual " +
+                     fmt(c.residual, 3) + " after " + std::to_string(c.iterations) + " iterations)");
   }
   return makeState(0, alpha, X, c);
 }
@@ -280,10 +280,11 @@ std::string firstNonFinite(const KinematicState& s) {
 void stopAtNonFinite(KinematicSummary& summary, const KinematicState& s, const std::string& what,
                      const KinematicState* prev) {
   summary.ok = false;
-  summary.message = "non-finite " + what + " at step " + std::to_string(s.step) + ", alpha = " + fmt(s.alpha) +
+  summary.message = "non-finite " + what + " at step " + std::to_string(s.step) +
+                    ", alpha = " + fmt(s.alpha, kNumberDigits) +
                     " (overflow: are the input speed and acceleration within range?); " +
-                    (prev ? "results kept up to alpha = " + fmt(prev->alpha) + " (step " + std::to_string(prev->step) +
-                                ")"
+                    (prev ? "results kept up to alpha = " + fmt(prev->alpha, kNumberDigits) + " (step " +
+                                std::to_string(prev->step) + ")"
                           : std::string("no results were written"));
 }
 
@@ -330,11 +331,12 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
       summary.ok = false;
       summary.singular = s;
       const double deg = s.alpha * 180.0 / M_PI;
-      summary.message = std::string(s.kind == "lock" ? "the mechanism locks" : "change point") +
-                        " at input alpha = " + fmt(s.alpha) + " (" + fmt(deg, 7) + " deg): D L1 is singular there" +
-                        (s.kind == "lock" ? ", no position exists beyond" : ", two branches cross") + "; nodes " +
-                        joinQuoted(s.nodes) + ", links " + joinQuoted(s.links) + " (a lock, dead or change point);" +
-                        " results kept up to alpha = " + fmt(prev.alpha) + " (step " + std::to_string(prev.step) + ")";
+      summary.message =
+          std::string(s.kind == "lock" ? "the mechanism locks" : "change point") +
+          " at input alpha = " + fmt(s.alpha, kNumberDigits) + " (" + fmt(deg, 7) + " deg): D L1 is singular there" +
+          (s.kind == "lock" ? ", no position exists beyond" : ", two branches cross") + "; nodes " +
+          joinQuoted(s.nodes) + ", links " + joinQuoted(s.links) + " (a lock, dead or change point);" +
+          " results kept up to alpha = " + fmt(prev.alpha, kNumberDigits) + " (step " + std::to_string(prev.step) + ")";
       break;
     }
     KinematicState state = makeState(k, alpha, X, c);
@@ -354,7 +356,8 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
   }
   if (summary.stepsCompleted > 1) summary.meanIterations = static_cast<double>(total) / (summary.stepsCompleted - 1);
   if (summary.ok) {
-    summary.message = "reached alpha = " + fmt(summary.alphaReached) + " in " + std::to_string(settings_.steps) + " steps";
+    summary.message = "reached alpha = " + fmt(summary.alphaReached, kNumberDigits) + " in " +
+                      std::to_string(settings_.steps) + " steps";
   }
   summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return summary;

@@ -11,7 +11,7 @@
 
 #include <Eigen/Core>
 
-#include "elements/linkage_2d.hpp"
+#include "linkage/linkage_2d.hpp"
 
 namespace flexmbd {
 

@@ -1,4 +1,4 @@
-#include "integrators/massless_cable_integrator.hpp"
+#include "tensegrity/massless_cable_integrator.hpp"
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
-#include "integrators/member_contact_detector.hpp"
+#include "tensegrity/member_contact_detector.hpp"
 
 namespace flexmbd {
 

@@ -1,7 +1,7 @@
 // Strict reader of tensegrity scenes (docs/tensegrity.md), in the manner of io/scene.cpp:
 // every object is checked for unknown keys first, every number for type and
 // finiteness, every node name against the nodes defined.
-#include "io/tensegrity_scene.hpp"
+#include "tensegrity/tensegrity_scene.hpp"
 
 #include "io/json_reader.hpp"
 #include "io/scene_keys.hpp"
@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "integrators/self_equilibrium.hpp"
+#include "tensegrity/self_equilibrium.hpp"
 
 namespace flexmbd {
 namespace {

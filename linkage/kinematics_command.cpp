@@ -1,4 +1,4 @@
-#include "app/kinematics_command.hpp"
+#include "linkage/kinematics_command.hpp"
 
 #include "app/command_line.hpp"
 
@@ -14,9 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "integrators/kinematic_analysis.hpp"
-#include "io/kinematics_scene.hpp"
 #include "io/results_writer.hpp"
+#include "linkage/kinematic_analysis.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 namespace flexmbd {
 

@@ -8,9 +8,9 @@
 // there).
 #pragma once
 
-#include "bodies/tensegrity_structure.hpp"
 #include "integrators/cvode_solver.hpp"
-#include "integrators/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_output.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
 

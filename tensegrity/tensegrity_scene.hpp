@@ -8,9 +8,9 @@
 
 #include <nlohmann/json_fwd.hpp>
 
-#include "bodies/tensegrity_structure.hpp"
-#include "integrators/massless_cable_integrator.hpp"
-#include "integrators/tensegrity_time_stepper.hpp"
+#include "tensegrity/massless_cable_integrator.hpp"
+#include "tensegrity/tensegrity_structure.hpp"
+#include "tensegrity/tensegrity_time_stepper.hpp"
 
 namespace flexmbd {
 

@@ -1,13 +1,13 @@
 // A planar linkage assembled from rigid link elements (source document 000): nodes
 // (fixed, free, or sliding along a line), links between them, and the prescribed
-// input coordinates. The model of the kinematic analysis (integrators/kinematic_analysis).
+// input coordinates. The model of the kinematic analysis (linkage/kinematic_analysis).
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "core/types.hpp"
-#include "elements/link_element_2d.hpp"
+#include "linkage/link_element_2d.hpp"
 
 namespace flexmbd {
 

@@ -1,4 +1,4 @@
-#include "elements/segment_closest_points.hpp"
+#include "tensegrity/segment_closest_points.hpp"
 
 #include <algorithm>
 

@@ -1,7 +1,7 @@
 // Strict reader of kinematics scene files (docs/kinematics.md). Same conventions as
 // io/scene.cpp: unknown keys first, then types and ranges; one-line errors
 // "<location>: <what is wrong>, got <what was found>".
-#include "io/kinematics_scene.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 #include "io/json_reader.hpp"
 #include "io/scene_keys.hpp"
