@@ -683,6 +683,10 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     summary.failureTime = tOutput;
     summary.message = std::string(e.what()) + ": the run stops before this output (the rows before it are kept)";
   } catch (const std::exception& e) {
+    // an input error found during the run (exit 2) and an assembly bug keep their type;
+    // a model error at an output state (ModelError, a singular matrix) is a failed run
+    const bool inputError = dynamic_cast<const InputError*>(&e) && !dynamic_cast<const ModelError*>(&e);
+    if (inputError || dynamic_cast<const std::logic_error*>(&e)) throw;
     // post-processing of an output state failed (e.g. a singular mass matrix after the
     // solution blew up, or an output exactly at a singular position of the mechanism,
     // where the augmented matrix for the accelerations is singular): a failure of the

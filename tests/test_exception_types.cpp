@@ -25,6 +25,10 @@
 #include "core/errors.hpp"
 #include "integrators/cvode_solver.hpp"
 #include "integrators/dae_integrator.hpp"
+#include "bodies/rigid_body_2d.hpp"
+#include "core/force.hpp"
+#include "core/system.hpp"
+#include "integrators/simulation.hpp"
 
 using namespace flexmbd;
 
@@ -263,4 +267,48 @@ TEST(ExceptionTypes, ANonFiniteResidualStaysARecoverableSolverEvent) {
   const std::exception_ptr e = integrate(FaultyOde(false, Fault::NanAlways, never));
   ASSERT_TRUE(e) << "cvode";
   EXPECT_TRUE(*typeAndMessage(e).first == typeid(SolverError)) << "cvode: " << typeAndMessage(e).second;
+}
+
+namespace {
+
+/// A load that finds its input bad at t > kTrouble (as a user's force law could), or
+/// throws an assembly bug.
+class FaultyLoad final : public Force {
+ public:
+  FaultyLoad(BodyIndex b, Raise raise) : Force("faulty", {b}), raise_(std::move(raise)) {}
+  std::string typeName() const override { return "faulty"; }
+  bool isConservative() const override { return false; }
+  void addForce(double t, const BodyStates&, const VecX&, VecX& Q, MatX*, MatX*, KinematicsWork&) const override {
+    Q[1] -= 9.81;
+    if (t > kTrouble) raise_();
+  }
+
+ private:
+  Raise raise_;
+};
+
+}  // namespace
+
+TEST(ExceptionTypes, SimulateLetsInputErrorsAndAssemblyBugsThroughButReportsModelErrorsAsAFailedRun) {
+  const auto run = [](Raise raise) {
+    System sys;
+    const BodyIndex b = sys.addRigidBody("b", {1.0, 0.1, {0.0, 0.0}}, {});
+    sys.addForce(std::make_unique<FaultyLoad>(b, std::move(raise)));
+    sys.finalize();
+    SolverSettings st;
+    st.tEnd = kEnd;
+    st.progress = false;
+    return simulate(sys, st, nullptr);
+  };
+  EXPECT_THROW(run([] { throw InputError("load 'faulty': bad table"); }), InputError);
+  try {
+    run([] { throw std::logic_error("assembly bug"); });
+    ADD_FAILURE() << "expected std::logic_error";
+  } catch (const std::logic_error& e) {
+    EXPECT_STREQ(e.what(), "assembly bug");
+  }
+  // a model error (a singular matrix at some state) ends the run as failed, results kept
+  const SimulationSummary s = run([] { throw ModelError("singular"); });
+  EXPECT_FALSE(s.ok);
+  EXPECT_GT(s.tReached, 0.0);
 }
