@@ -108,6 +108,9 @@ class Constraint {
   virtual std::string typeName() const = 0;
   /// Drivers prescribe motion (do work); joints do not.
   virtual bool isDriver() const { return false; }
+  /// The period of h when h is an angle known only modulo it (2 pi for a spatial joint
+  /// angle, from atan2): g = h - f is then taken in (-period/2, period/2]. 0: none.
+  virtual double equationPeriod() const { return 0.0; }
 
   /// h, G and, if withHessians, the Hessians of each equation (H is left as it was
   /// otherwise). Allocates nothing when `out` was filled by this constraint before.

@@ -1,5 +1,7 @@
 #include "core/dae_system.hpp"
 
+#include <cmath>
+
 #include "core/errors.hpp"
 
 namespace flexmbd {
@@ -299,6 +301,9 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
       case Formulation::Ggl: {
         // F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f'
         const double* mu = y + L.mu + row;
+        if (const double period = con.equationPeriod(); period > 0.0) {
+          for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
+        }
         if (identityT) {
           for (int k = 0; k < nl; ++k) Fq[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
         } else {
@@ -314,6 +319,9 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
         break;
       }
       case Formulation::Index3:
+        if (const double period = con.equationPeriod(); period > 0.0) {
+          for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
+        }
         Fc = ev.h - cs.f;
         break;
       case Formulation::Index1: {

@@ -2,6 +2,9 @@
 // quaternion) of a rotation with their kinematic matrices (Nikravesh 1988, ch. 6).
 #pragma once
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include "core/types.hpp"
 
 namespace flexmbd {

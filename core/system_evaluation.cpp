@@ -1,5 +1,7 @@
 #include "core/system_evaluation.hpp"
 
+#include <cmath>
+
 namespace flexmbd {
 namespace {
 
@@ -32,7 +34,13 @@ void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, Ma
   forEachConstraint(sys, q, t, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
                                           const VecX& f, const VecX&, const VecX&) {
     const int row = sys.constraintOffset(ci), me = con.numEquations();
-    if (g) g->segment(row, me) = ev.h - f;
+    if (g) {
+      g->segment(row, me) = ev.h - f;
+      // an angle known modulo a period: the residual on the branch nearest f
+      if (const double period = con.equationPeriod(); period > 0.0) {
+        for (int a = 0; a < me; ++a) (*g)[row + a] = std::remainder((*g)[row + a], period);
+      }
+    }
     if (G) {
       const auto& cols = sys.constraintColumns(ci);
       for (size_t k = 0; k < cols.size(); ++k) G->block(row, cols[k], me, 1) += ev.G.col(k);

@@ -46,15 +46,6 @@ std::vector<Eq> equationsOf(SpatialJointType type) {
   return {};
 }
 
-void checkFrame(const JointFrame& f, const std::string& who) {
-  for (int k = 0; k < 3; ++k) requireFinite(f.point[k], who + ": point[" + std::to_string(k) + "]");
-  const Mat3& C = f.axes;
-  if (!C.allFinite() || !((C.transpose() * C - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-9) ||
-      !(C.determinant() > 0.0)) {
-    throw InputError(who + ": axes: not orthonormal and right-handed (expected a rotation matrix)");
-  }
-}
-
 }  // namespace
 
 SpatialJoint::SpatialJoint(std::string name, SpatialJointType type, BodyIndex bodyI, const JointFrame& frameI,
@@ -63,95 +54,24 @@ SpatialJoint::SpatialJoint(std::string name, SpatialJointType type, BodyIndex bo
       equations_(equationsOf(type)) {
   const std::string who = "joint '" + this->name() + "'";
   if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
-  checkFrame(frameI, who + " frame 0");
-  checkFrame(frameJ, who + " frame 1");
+  checkJointFrame(frameI, who + " frame 0");
+  checkJointFrame(frameJ, who + " frame 1");
 }
 
 void SpatialJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  KinematicsWork& w = out.work;
-  FrameKinematics &fi = w.fi, &fj = w.fj;
-  bodies[0].frame(frameI_.point, fi);
-  bodies[1].frame(frameJ_.point, fj);
-  const int ni = fi.numVelocities(), nj = fj.numVelocities(), n = ni + nj;
-  const int qi = fi.numCoordinates(), qj = fj.numCoordinates(), nq = qi + qj;
-  const int m = numEquations();
-  // d = r_j - r_i and its Jacobian over [v_i; v_j]
-  const Vec3 d = fj.r - fi.r;
-  w.Jd.resize(3, n);
-  w.Jd.leftCols(ni) = -fi.Jr;
-  w.Jd.rightCols(nj) = fj.Jr;
+  FramePair pair(bodies, frameI_, frameJ_, withHessians, out.work);
+  const int m = numEquations(), n = pair.numVelocities(), nq = pair.numCoordinates();
   out.h.resize(m);
   out.G.resize(m, n);
-  if (withHessians) {
-    out.H.resize(m);
-    w.Tinv.setZero(n, nq);  // T+ over the local columns, block-diagonal
-    w.Tinv.topLeftCorner(ni, qi) = fi.Tinv;
-    w.Tinv.bottomRightCorner(nj, qj) = fj.Tinv;
-  }
-  // a frame axis as a world vector u = A c with its Jacobian -u~ Jw (zero on the other body)
-  auto axis = [&](bool onI, int k, Vec3& u, Mat3X& J) {
-    const FrameKinematics& f = onI ? fi : fj;
-    u = f.A * (onI ? frameI_ : frameJ_).axes.col(k);
-    J.setZero(3, n);
-    J.middleCols(onI ? 0 : ni, onI ? ni : nj) = -skew(u) * f.Jw;
-  };
-  // H += d(J_u^T x)/dq at fixed x for an axis u on body i or j:
-  //   the body's curvature with weight (0, u x x), plus Jw^T (-x~) du/dq, du/dq = J_u T+
-  auto axisCurvature = [&](bool onI, const Vec3& u, const Mat3X& Ju, const Vec3& x, MatX& H) {
-    const FrameKinematics& f = onI ? fi : fj;
-    const int r0 = onI ? 0 : ni, c0 = onI ? 0 : qi, nr = onI ? ni : nj, nc = onI ? qi : qj;
-    bodies[onI ? 0 : 1].addCurvature(onI ? frameI_.point : frameJ_.point, Vec3::Zero(), u.cross(x),
-                                     H.block(r0, c0, nr, nc));
-    w.JT.noalias() = Ju * w.Tinv;  // 3 x nq
-    H.middleRows(r0, nr).noalias() -= f.Jw.transpose() * (skew(x) * w.JT);
-  };
-  // H += d(J_d^T x)/dq at fixed x
-  auto gapCurvature = [&](const Vec3& x, MatX& H) {
-    bodies[0].addCurvature(frameI_.point, -x, Vec3::Zero(), H.block(0, 0, ni, qi));
-    bodies[1].addCurvature(frameJ_.point, x, Vec3::Zero(), H.block(ni, qi, nj, qj));
-  };
-  // H += J_a^T (J_b T+) + J_b^T (J_a T+): the product rule's cross terms of h = a . b
-  auto crossTerms = [&](const Mat3X& Ja, const Mat3X& Jb, MatX& H) {
-    w.JT.noalias() = Jb * w.Tinv;
-    H.noalias() += Ja.transpose() * w.JT;
-    w.JT.noalias() = Ja * w.Tinv;
-    H.noalias() += Jb.transpose() * w.JT;
-  };
-  Vec3 u, z;
+  if (withHessians) out.H.resize(m);
   for (int e = 0; e < m; ++e) {
     const Eq& eq = equations_[e];
     MatX* H = withHessians ? &out.H[e] : nullptr;
     if (H) H->setZero(n, nq);
     switch (eq.kind) {
-      case Eq::Gap: {
-        out.h[e] = d[eq.a];
-        out.G.row(e) = w.Jd.row(eq.a);
-        if (H) gapCurvature(Vec3::Unit(eq.a), *H);
-        break;
-      }
-      case Eq::AxisGap: {
-        axis(true, eq.a, u, w.J1);
-        out.h[e] = u.dot(d);
-        out.G.row(e).noalias() = d.transpose() * w.J1 + u.transpose() * w.Jd;
-        if (H) {
-          axisCurvature(true, u, w.J1, d, *H);
-          gapCurvature(u, *H);
-          crossTerms(w.J1, w.Jd, *H);
-        }
-        break;
-      }
-      case Eq::AxisAxis: {
-        axis(true, eq.a, u, w.J1);
-        axis(false, eq.b, z, w.J2);
-        out.h[e] = u.dot(z);
-        out.G.row(e).noalias() = z.transpose() * w.J1 + u.transpose() * w.J2;
-        if (H) {
-          axisCurvature(true, u, w.J1, z, *H);
-          axisCurvature(false, z, w.J2, u, *H);
-          crossTerms(w.J1, w.J2, *H);
-        }
-        break;
-      }
+      case Eq::Gap: pair.gap(eq.a, out.h[e], out.G.row(e), H); break;
+      case Eq::AxisGap: pair.axisGap(eq.a, out.h[e], out.G.row(e), H); break;
+      case Eq::AxisAxis: pair.axisAxis(eq.a, eq.b, out.h[e], out.G.row(e), H); break;
     }
   }
 }

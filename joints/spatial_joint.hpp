@@ -5,14 +5,9 @@
 #include <vector>
 
 #include "core/constraint.hpp"
+#include "joints/frame_pair.hpp"
 
 namespace flexmbd {
-
-/// A frame fixed in a body: origin (body axes) and axes (columns x, y, z in body axes).
-struct JointFrame {
-  Vec3 point = Vec3::Zero();
-  Mat3 axes = Mat3::Identity();
-};
 
 enum class SpatialJointType { Spherical, Revolute, Prismatic, Cylindrical, Universal, Fixed, Planar };
 /// "spherical", "revolute", ...

@@ -8,6 +8,7 @@
 #include "core/dae_system.hpp"
 #include "core/rotation_3d.hpp"
 #include "core/system.hpp"
+#include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 #include "test_support.hpp"
 
@@ -148,10 +149,47 @@ TEST(RigidBody3d, FrameJacobiansCurvatureAndGyroscopicTermsMatchFiniteDifference
   }
 }
 
-class SpatialJointDerivatives : public ::testing::TestWithParam<SpatialJointType> {};
+/// G against central differences of h along the velocity directions (q (+) eps e_k),
+/// and each H_a against central differences of G_a^T over the local coordinates.
+void checkConstraintDerivatives(const System& sys, ConstraintIndex c, const VecX& q, const std::string& at) {
+  const Constraint& con = sys.constraint(c);
+  const auto& qcols = sys.constraintCoordinateColumns(c);
+  const auto& vcols = sys.constraintColumns(c);
+  ConstraintEvaluation ev;
+  con.evaluate(sys.constraintStates(c, q.data()), true, ev);
+  ASSERT_EQ(ev.G.cols(), static_cast<int>(vcols.size())) << at;
+  const auto hOf = [&](const VecX& z) {
+    ConstraintEvaluation e;
+    con.evaluate(sys.constraintStates(c, z.data()), false, e);
+    return e.h;
+  };
+  MatX Gfd(con.numEquations(), vcols.size());
+  for (size_t k = 0; k < vcols.size(); ++k) {
+    VecX dv = VecX::Zero(sys.numVelocities());
+    dv[vcols[k]] = kFdRelStep;
+    Gfd.col(k) = (hOf(sys.applyIncrement(q, dv)) - hOf(sys.applyIncrement(q, -dv))) / (2.0 * kFdRelStep);
+  }
+  expectMatrixNear(ev.G, Gfd, kFdTol, "G, " + at, 1.0);
+  for (int e = 0; e < con.numEquations(); ++e) {
+    const auto GaOf = [&](const VecX& ql) {
+      VecX z = q;
+      for (size_t k = 0; k < qcols.size(); ++k) z[qcols[k]] = ql[k];
+      ConstraintEvaluation x;
+      con.evaluate(sys.constraintStates(c, z.data()), false, x);
+      return VecX(x.G.row(e).transpose());
+    };
+    VecX ql(qcols.size());
+    for (size_t k = 0; k < qcols.size(); ++k) ql[k] = q[qcols[k]];
+    expectMatrixNear(ev.H[e], fdJacobian(GaOf, ql), kFdTol, "H_" + std::to_string(e) + ", " + at, 1.0);
+  }
+}
 
-TEST_P(SpatialJointDerivatives, GAndHMatchFiniteDifferencesBetweenTwoBodiesAndToGround) {
-  Random rnd(kSeed + 10 + static_cast<unsigned>(GetParam()));
+/// Two random spatial bodies and a constraint made by `make` between body a (or the
+/// ground) and body b, checked at random states.
+void checkBetweenRandomBodies(unsigned seed, const std::string& what,
+                              const std::function<std::unique_ptr<Constraint>(BodyIndex, const JointFrame&, BodyIndex,
+                                                                               const JointFrame&)>& make) {
+  Random rnd(seed);
   for (int s = 0; s < kSamples; ++s) {
     for (const bool toGround : {false, true}) {
       System sys;
@@ -162,47 +200,31 @@ TEST_P(SpatialJointDerivatives, GAndHMatchFiniteDifferencesBetweenTwoBodiesAndTo
       fi.axes = randomRotation(rnd);
       fj.point = rnd.vector(3, -1.0, 1.0);
       fj.axes = randomRotation(rnd);
-      const ConstraintIndex c = sys.addConstraint(
-          std::make_unique<SpatialJoint>("j", GetParam(), toGround ? kGround : a, fi, b, fj));
+      const ConstraintIndex c = sys.addConstraint(make(toGround ? kGround : a, fi, b, fj));
       sys.finalize();
       VecX q(sys.numCoordinates());
       for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
-      const Constraint& con = sys.constraint(c);
-      const auto& qcols = sys.constraintCoordinateColumns(c);
-      const auto& vcols = sys.constraintColumns(c);
-      ConstraintEvaluation ev;
-      con.evaluate(sys.constraintStates(c, q.data()), true, ev);
-      const std::string at = std::string(toString(GetParam())) + (toGround ? " to ground" : "") + ", sample " +
-                             std::to_string(s);
-      ASSERT_EQ(ev.G.cols(), static_cast<int>(vcols.size())) << at;
-      // G: the derivative of h along each velocity direction (q (+) eps e_k)
-      const auto hOf = [&](const VecX& z) {
-        ConstraintEvaluation e;
-        con.evaluate(sys.constraintStates(c, z.data()), false, e);
-        return e.h;
-      };
-      MatX Gfd(con.numEquations(), vcols.size());
-      for (size_t k = 0; k < vcols.size(); ++k) {
-        VecX dv = VecX::Zero(sys.numVelocities());
-        dv[vcols[k]] = kFdRelStep;
-        Gfd.col(k) = (hOf(sys.applyIncrement(q, dv)) - hOf(sys.applyIncrement(q, -dv))) / (2.0 * kFdRelStep);
-      }
-      expectMatrixNear(ev.G, Gfd, kFdTol, "G, " + at, 1.0);
-      // H_a = d(G_a^T)/dq over the local coordinates
-      for (int e = 0; e < con.numEquations(); ++e) {
-        const auto GaOf = [&](const VecX& ql) {
-          VecX z = q;
-          for (size_t k = 0; k < qcols.size(); ++k) z[qcols[k]] = ql[k];
-          ConstraintEvaluation x;
-          con.evaluate(sys.constraintStates(c, z.data()), false, x);
-          return VecX(x.G.row(e).transpose());
-        };
-        VecX ql(qcols.size());
-        for (size_t k = 0; k < qcols.size(); ++k) ql[k] = q[qcols[k]];
-        expectMatrixNear(ev.H[e], fdJacobian(GaOf, ql), kFdTol, "H_" + std::to_string(e) + ", " + at, 1.0);
-      }
+      checkConstraintDerivatives(sys, c, q, what + (toGround ? " to ground" : "") + ", sample " + std::to_string(s));
     }
   }
+}
+
+class SpatialJointDerivatives : public ::testing::TestWithParam<SpatialJointType> {};
+
+TEST_P(SpatialJointDerivatives, GAndHMatchFiniteDifferencesBetweenTwoBodiesAndToGround) {
+  checkBetweenRandomBodies(kSeed + 10 + static_cast<unsigned>(GetParam()), toString(GetParam()),
+                           [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+                             return std::make_unique<SpatialJoint>("j", GetParam(), i, fi, j, fj);
+                           });
+}
+
+TEST(SpatialDriverDerivatives, AngleAndDisplacementDriversMatchFiniteDifferences) {
+  checkBetweenRandomBodies(kSeed + 20, "joint angle", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+    return std::make_unique<SpatialJointAngleDriver>("d", i, fi, j, fj, makeConstantLaw(0.0));
+  });
+  checkBetweenRandomBodies(kSeed + 21, "joint displacement", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+    return std::make_unique<SpatialJointDisplacementDriver>("d", i, fi, j, fj, makeConstantLaw(0.0));
+  });
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryType, SpatialJointDerivatives,

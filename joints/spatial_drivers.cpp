@@ -1,0 +1,76 @@
+#include "joints/spatial_drivers.hpp"
+
+#include <cmath>
+
+namespace flexmbd {
+
+FramePairConstraint::FramePairConstraint(std::string name, BodyIndex bodyI, const JointFrame& frameI,
+                                         BodyIndex bodyJ, const JointFrame& frameJ)
+    : Constraint(std::move(name), {bodyI, bodyJ}), frameI_(frameI), frameJ_(frameJ) {
+  const std::string who = "driver '" + this->name() + "'";
+  if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
+  checkJointFrame(frameI, who + " frame 0");
+  checkJointFrame(frameJ, who + " frame 1");
+}
+
+SpatialJointAngleDriver::SpatialJointAngleDriver(std::string name, BodyIndex bodyI, const JointFrame& frameI,
+                                                 BodyIndex bodyJ, const JointFrame& frameJ, TimeLawPtr law)
+    : LawDriver<FramePairConstraint>(std::move(law), std::move(name), bodyI, frameI, bodyJ, frameJ) {}
+
+double SpatialJointAngleDriver::equationPeriod() const { return 2.0 * M_PI; }
+
+void SpatialJointAngleDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  // theta = atan2(s, c), s = y_i . x_j, c = x_i . x_j;  r^2 = s^2 + c^2
+  //   G = (c G_s - s G_c) / r^2
+  //   H = (c H_s - s H_c + G_s^T Gq_c - G_c^T Gq_s) / r^2 - G^T (2 s Gq_s + 2 c Gq_c) / r^2,
+  // with Gq = G T+ the coordinate gradients.
+  KinematicsWork& w = out.work;
+  FramePair pair(bodies, frameI_, frameJ_, withHessians, w);
+  const int n = pair.numVelocities(), nq = pair.numCoordinates();
+  double s = 0.0, c = 0.0;
+  w.row.resize(n);
+  w.row2.resize(n);
+  MatX* Hs = nullptr;
+  MatX* Hc = nullptr;
+  if (withHessians) {
+    out.H.resize(1);
+    w.hessian.setZero(n, nq);
+    out.H[0].setZero(n, nq);
+    Hs = &w.hessian;
+    Hc = &out.H[0];
+  }
+  pair.axisAxis(1, 0, s, w.row, Hs);
+  pair.axisAxis(0, 0, c, w.row2, Hc);
+  const double r2 = s * s + c * c;
+  out.h.setConstant(1, std::atan2(s, c));
+  out.G.resize(1, n);
+  out.G.row(0) = (c * w.row - s * w.row2) / r2;
+  if (!withHessians) return;
+  const Eigen::RowVectorXd gqs = w.row * pair.Tinv(), gqc = w.row2 * pair.Tinv();
+  MatX& H = out.H[0];
+  H = (c * w.hessian - s * H) / r2;  // H held H_c
+  H.noalias() += (w.row.transpose() * gqc - w.row2.transpose() * gqs) / r2;
+  H.noalias() -= out.G.row(0).transpose() * ((2.0 * s) * gqs + (2.0 * c) * gqc) / r2;
+}
+
+SpatialJointDisplacementDriver::SpatialJointDisplacementDriver(std::string name, BodyIndex bodyI,
+                                                               const JointFrame& frameI, BodyIndex bodyJ,
+                                                               const JointFrame& frameJ, TimeLawPtr law)
+    : LawDriver<FramePairConstraint>(std::move(law), std::move(name), bodyI, frameI, bodyJ, frameJ) {}
+
+void SpatialJointDisplacementDriver::evaluate(const BodyStates& bodies, bool withHessians,
+                                              ConstraintEvaluation& out) const {
+  FramePair pair(bodies, frameI_, frameJ_, withHessians, out.work);
+  const int n = pair.numVelocities(), nq = pair.numCoordinates();
+  out.h.resize(1);
+  out.G.resize(1, n);
+  MatX* H = nullptr;
+  if (withHessians) {
+    out.H.resize(1);
+    out.H[0].setZero(n, nq);
+    H = &out.H[0];
+  }
+  pair.axisGap(2, out.h[0], out.G.row(0), H);
+}
+
+}  // namespace flexmbd
