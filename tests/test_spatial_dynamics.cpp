@@ -12,6 +12,7 @@
 
 #include "bodies/rigid_body_2d.hpp"
 #include "bodies/rigid_body_3d.hpp"
+#include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "joints/spatial_drivers.hpp"
@@ -333,4 +334,43 @@ TEST(SpatialSliderCrank, SliderPositionVelocityAndAccelerationMatchTheClosedForm
   RecordProperty("position_error", sci(ex));
   RecordProperty("velocity_error", sci(ev));
   RecordProperty("acceleration_error", sci(ea));
+}
+
+TEST(SpatialRedundancy, FourBarWithParallelRevolutesIsReportedNamingTheDependentJoints) {
+  // A planar four-bar built of spatial bodies and four revolute joints with parallel axes:
+  // 18 velocities, 20 equations, 1 degree of freedom: 3 equations are redundant (the
+  // out-of-plane ones of the last joint). The model error names the dependent equations.
+  System sys;
+  const Vec3 A(0, 0, 0), B(0.5, std::sqrt(3.0) / 2, 0), C(3.016007650436934, 2.4999487505001956, 0), D(3, 0, 0);
+  auto link = [&](const std::string& name, const Vec3& p, const Vec3& q) {
+    FrameState3d s;
+    const Vec3 e = (q - p).normalized();
+    s.orientation << e.x(), -e.y(), 0, e.y(), e.x(), 0, 0, 0, 1;
+    s.position = 0.5 * (p + q);
+    RigidBody3dProperties props;
+    props.inertia = Vec3(0.01, 0.1, 0.1).asDiagonal();
+    return sys.addBody(std::make_unique<RigidBody3d>(name, props, s));
+  };
+  const BodyIndex crank = link("crank", A, B), coupler = link("coupler", B, C), rocker = link("rocker", D, C);
+  auto end = [](double half) {
+    JointFrame f;
+    f.point = Vec3(half, 0, 0);
+    return f;
+  };
+  JointFrame atA, atD;
+  atD.point = D;
+  sys.addConstraint(std::make_unique<SpatialJoint>("A", SpatialJointType::Revolute, kGround, atA, crank, end(-0.5)));
+  sys.addConstraint(std::make_unique<SpatialJoint>("B", SpatialJointType::Revolute, crank, end(0.5), coupler, end(-1.5)));
+  sys.addConstraint(std::make_unique<SpatialJoint>("D", SpatialJointType::Revolute, kGround, atD, rocker, end(-1.25)));
+  sys.addConstraint(std::make_unique<SpatialJoint>("C", SpatialJointType::Revolute, coupler, end(1.5), rocker, end(1.25)));
+  sys.finalize();
+  try {
+    simulate(sys, settings(0.1, 1e-8, 0.01), nullptr);
+    ADD_FAILURE() << "expected a ModelError for the redundant joints";
+  } catch (const ModelError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("redundant"), std::string::npos) << what;
+    EXPECT_NE(what.find("joint 'C'"), std::string::npos) << what;
+    RecordProperty("message", what);
+  }
 }
