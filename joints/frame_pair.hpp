@@ -42,11 +42,14 @@ class FramePair {
   /// World axis a of frame i / j.
   Vec3 axisI(int a) const;
   Vec3 axisJ(int b) const;
+  /// d(d)/dv (3 x nv).
+  const Mat3X& Jd() const { return w_.Jd; }
+  /// H += d(Jd^T x)/dq at fixed x (nv x nq).
+  void gapCurvature(const Vec3& x, MatX& H);
 
  private:
   void axis(bool onI, int k, Vec3& u, Mat3X& J) const;
   void axisCurvature(bool onI, const Vec3& u, const Mat3X& Ju, const Vec3& x, MatX& H);
-  void gapCurvature(const Vec3& x, MatX& H);
   void crossTerms(const Mat3X& Ja, const Mat3X& Jb, MatX& H);
 
   const BodyStates& bodies_;

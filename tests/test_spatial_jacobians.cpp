@@ -8,6 +8,7 @@
 #include "core/dae_system.hpp"
 #include "core/rotation_3d.hpp"
 #include "core/system.hpp"
+#include "forces/spatial_forces.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 #include "test_support.hpp"
@@ -311,3 +312,62 @@ TEST_P(SpatialDaeJacobian, IterationMatrixMatchesFiniteDifferencesAndStaysInTheP
 INSTANTIATE_TEST_SUITE_P(AllFormulations, SpatialDaeJacobian,
                          ::testing::Values(Formulation::Ggl, Formulation::Index3, Formulation::Index1),
                          [](const auto& info) { return toString(info.param); });
+
+TEST(SpatialForceDerivatives, SpringDamperAndAppliedLoadMatchFiniteDifferences) {
+  Random rnd(kSeed + 50);
+  for (int s = 0; s < kSamples; ++s) {
+    for (const bool toGround : {false, true}) {
+      System sys;
+      const BodyIndex a = sys.addBody(randomBody(rnd, "a"));
+      const BodyIndex b = sys.addBody(randomBody(rnd, "b"));
+      const ForceIndex spring = sys.addForce(std::make_unique<SpatialSpringDamper>(
+          "spring", toGround ? kGround : a, Vec3(rnd.vector(3, -1, 1)), b, Vec3(rnd.vector(3, -1, 1)), 50.0, 3.0, 0.4));
+      const ForceIndex load = sys.addForce(std::make_unique<SpatialAppliedLoad>(
+          "load", b, Vec3(rnd.vector(3, -1, 1)),
+          std::array<TimeLawPtr, 6>{makeConstantLaw(1.0), makeHarmonicLaw(2.0, 3.0), nullptr, makeConstantLaw(-0.5),
+                                    nullptr, makeConstantLaw(0.7)}));
+      sys.finalize();
+      VecX q(sys.numCoordinates());
+      for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
+      const VecX vAll = rnd.vector(sys.numVelocities(), -1.0, 1.0);
+      const std::string at = std::string(toGround ? "to ground, " : "") + "sample " + std::to_string(s);
+      for (ForceIndex fi : {spring, load}) {
+        const Force& f = sys.force(fi);
+        const auto& vcols = sys.forceColumns(fi);
+        const auto& qcols = sys.forceCoordinateColumns(fi);
+        VecX vl(vcols.size()), ql(qcols.size());
+        for (size_t k = 0; k < vcols.size(); ++k) vl[k] = vAll[vcols[k]];
+        for (size_t k = 0; k < qcols.size(); ++k) ql[k] = q[qcols[k]];
+        const double t = 0.3;
+        const auto QOf = [&](const VecX& qq, const VecX& vv) {
+          VecX z = q;
+          for (size_t k = 0; k < qcols.size(); ++k) z[qcols[k]] = qq[k];
+          VecX Q = VecX::Zero(vcols.size());
+          f.addForce(t, sys.forceStates(fi, z.data()), vv, Q, nullptr, nullptr);
+          return Q;
+        };
+        VecX Q = VecX::Zero(vcols.size());
+        MatX dQdq = MatX::Zero(vcols.size(), qcols.size()), dQdv = MatX::Zero(vcols.size(), vcols.size());
+        f.addForce(t, sys.forceStates(fi, q.data()), vl, Q, &dQdq, &dQdv);
+        expectMatrixNear(dQdq, fdJacobian([&](const VecX& z) { return QOf(z, vl); }, ql), kFdTol,
+                         f.name() + " dQ/dq, " + at, 1.0);
+        expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return QOf(ql, z); }, vl), kFdTol,
+                         f.name() + " dQ/dv, " + at, 1.0);
+      }
+      // the spring's elastic force is -dV along the velocity directions (no damping: v = 0)
+      const Force& sp = sys.force(spring);
+      const auto& vcols = sys.forceColumns(spring);
+      VecX Q = VecX::Zero(vcols.size());
+      sp.addForce(0.0, sys.forceStates(spring, q.data()), VecX::Zero(vcols.size()), Q, nullptr, nullptr);
+      VecX gradV(vcols.size());
+      for (size_t k = 0; k < vcols.size(); ++k) {
+        VecX dv = VecX::Zero(sys.numVelocities());
+        dv[vcols[k]] = kFdRelStep;
+        const VecX qp = sys.applyIncrement(q, dv), qm = sys.applyIncrement(q, -dv);
+        gradV[k] = (sp.potentialEnergy(sys.forceStates(spring, qp.data())) -
+                    sp.potentialEnergy(sys.forceStates(spring, qm.data()))) / (2.0 * kFdRelStep);
+      }
+      expectMatrixNear(Q, -gradV, kFdTol, "spring force = -dV, " + at, 1.0);
+    }
+  }
+}

@@ -1,0 +1,91 @@
+#include "forces/spatial_forces.hpp"
+
+#include "core/errors.hpp"
+#include "joints/frame_pair.hpp"
+
+namespace flexmbd {
+
+SpatialAppliedLoad::SpatialAppliedLoad(std::string name, BodyIndex body, const Vec3& point,
+                                       std::array<TimeLawPtr, 6> laws)
+    : Force(std::move(name), {body}), point_(point), laws_(std::move(laws)) {
+  for (int k = 0; k < 3; ++k) requireFinite(point[k], "force '" + this->name() + "': point[" + std::to_string(k) + "]");
+  bool any = false;
+  for (const auto& l : laws_) any = any || l != nullptr;
+  if (!any) throw InputError("force '" + this->name() + "': no force or torque law given");
+}
+
+void SpatialAppliedLoad::addForce(double t, const BodyStates& bodies, const VecX&, VecX& Q, MatX* dQdq, MatX*,
+                                  KinematicsWork& w) const {
+  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    if (laws_[k]) F[k] = laws_[k]->evaluate(t).f;
+    if (laws_[3 + k]) M[k] = laws_[3 + k]->evaluate(t).f;
+  }
+  bodies[0].frame(point_, w.fi);
+  Q.noalias() += w.fi.Jr.transpose() * F + w.fi.Jw.transpose() * M;
+  if (dQdq) bodies[0].addCurvature(point_, F, M, *dQdq);
+}
+
+SpatialSpringDamper::SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ,
+                                         const Vec3& pointJ, double stiffness, double damping, double freeLength)
+    : Force(std::move(name), {bodyI, bodyJ}), pointI_(pointI), pointJ_(pointJ), stiffness_(stiffness),
+      damping_(damping), freeLength_(freeLength) {
+  const std::string who = "force '" + this->name() + "'";
+  if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
+  for (int k = 0; k < 3; ++k) {
+    requireFinite(pointI[k], who + ": points[0][" + std::to_string(k) + "]");
+    requireFinite(pointJ[k], who + ": points[1][" + std::to_string(k) + "]");
+  }
+  requireFinite(stiffness, who + ": stiffness");
+  requireFinite(damping, who + ": damping");
+  requireFinite(freeLength, who + ": free_length");
+  if (stiffness < 0.0 || damping < 0.0 || freeLength < 0.0) {
+    throw InputError(who + ": stiffness, damping and free_length must be >= 0");
+  }
+}
+
+double SpatialSpringDamper::length(const BodyStates& bodies) const {
+  KinematicsWork w;
+  JointFrame fi, fj;
+  fi.point = pointI_;
+  fj.point = pointJ_;
+  return FramePair(bodies, fi, fj, false, w).d().norm();
+}
+
+double SpatialSpringDamper::potentialEnergy(const BodyStates& bodies) const {
+  const double s = length(bodies) - freeLength_;
+  return 0.5 * stiffness_ * s * s;
+}
+
+void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                                   KinematicsWork& w) const {
+  JointFrame fi, fj;
+  fi.point = pointI_;
+  fj.point = pointJ_;
+  FramePair pair(bodies, fi, fj, dQdq != nullptr, w);
+  const double l = pair.d().norm();
+  if (!(l > 1e-12)) {
+    throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
+  }
+  // grad l = e^T Jd;  l' = grad l v;  f = k (l - l0) + c l';  Q = -f grad l^T
+  const Vec3 e = pair.d() / l;
+  RowVecX& gradL = w.row;
+  gradL.noalias() = e.transpose() * pair.Jd();
+  const double f = stiffness_ * (l - freeLength_) + damping_ * gradL.dot(v);
+  Q.noalias() -= f * gradL.transpose();
+  if (dQdv) dQdv->noalias() -= damping_ * gradL.transpose() * gradL;
+  if (!dQdq) return;
+  // H_l = d(grad l^T)/dq = C_d(e) + Jd^T (I - e e^T) / l Jd T+;  dl/dq = grad l T+;
+  // dl'/dq = v^T H_l;  dQ/dq = -(grad l^T df/dq + f H_l)
+  MatX& Hl = w.hessian;
+  Hl.setZero(pair.numVelocities(), pair.numCoordinates());
+  pair.gapCurvature(e, Hl);
+  const Mat3 P = (Mat3::Identity() - e * e.transpose()) / l;
+  w.JT.noalias() = pair.Jd() * pair.Tinv();
+  Hl.noalias() += pair.Jd().transpose() * (P * w.JT);
+  RowVecX& dfdq = w.row2;
+  dfdq.noalias() = stiffness_ * (gradL * pair.Tinv()) + damping_ * (v.transpose() * Hl);
+  dQdq->noalias() -= gradL.transpose() * dfdq + f * Hl;
+}
+
+}  // namespace flexmbd

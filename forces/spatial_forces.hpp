@@ -1,0 +1,49 @@
+// Force elements of spatial models: a prescribed force and torque at a body point, and a
+// translational spring-damper between two body points.
+#pragma once
+
+#include "core/force.hpp"
+#include <array>
+
+#include "core/time_law.hpp"
+
+namespace flexmbd {
+
+/// Q = Jr^T F(t) + Jw^T M(t): force F at the body point and torque M, world axes; absent
+/// laws count as zero. dQ/dq is the point's curvature term with weights (F, M).
+class SpatialAppliedLoad final : public Force {
+ public:
+  /// laws: force x, y, z, torque x, y, z (null: zero); at least one given.
+  SpatialAppliedLoad(std::string name, BodyIndex body, const Vec3& point, std::array<TimeLawPtr, 6> laws);
+  std::string typeName() const override { return "applied_load"; }
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  bool isConservative() const override { return false; }
+
+ private:
+  Vec3 point_;
+  std::array<TimeLawPtr, 6> laws_;
+};
+
+/// Tension f = k (l - l0) + c l' along the line of two body points, l = |r_j - r_i|:
+/// Q = -f grad(l)^T (Shabana, Dynamics of Multibody Systems, ch. 7, in velocity form).
+class SpatialSpringDamper final : public Force {
+ public:
+  SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
+                      double stiffness, double damping, double freeLength);
+  std::string typeName() const override { return "spring_damper"; }
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  double potentialEnergy(const BodyStates& bodies) const override;
+  bool isConservative() const override { return damping_ == 0.0; }
+  /// The current length l.
+  double length(const BodyStates& bodies) const;
+
+ private:
+  Vec3 pointI_, pointJ_;
+  double stiffness_, damping_, freeLength_;
+};
+
+}  // namespace flexmbd
