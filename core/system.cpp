@@ -141,6 +141,10 @@ ConstraintIndex System::addBodyCoordinateDriver(const std::string& name, BodyInd
   const auto names = body(b).coordinateNames();
   for (int k = 0; k < static_cast<int>(names.size()); ++k) {
     if (names[k] == coordinate) {
+      if (body(b).coordinatesOfVelocities({k}) != std::vector<int>{k}) {
+        throw InputError("driver '" + name + "': coordinate '" + coordinate + "' of body '" + body(b).name() +
+                         "' is a rotation parameter; drive a joint angle instead");
+      }
       return addConstraint(std::make_unique<BodyCoordinateDriver>(name, b, k, coordinate, std::move(law)));
     }
   }

@@ -602,7 +602,9 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     }
     return last;
   };
-  const bool mayCross = settings.crossSingular && settings.integrator != IntegratorKind::AugmentedLagrangian && L.m > 0;
+  // the crossing runs on ALI3-P, which is planar (q' = v) so far
+  const bool mayCross = settings.crossSingular && settings.integrator != IntegratorKind::AugmentedLagrangian && L.m > 0 &&
+                        sys.velocitiesAreCoordinateRates();
   int restarts = 0;  // consecutive failures just after a crossing
   try {
     while (k <= nOut) {

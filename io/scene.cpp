@@ -6,6 +6,7 @@
 
 #include "io/json_reader.hpp"
 #include "io/scene_keys.hpp"
+#include "io/spatial_scene.hpp"
 
 #include <algorithm>
 #include <array>
@@ -31,18 +32,10 @@
 #include "joints/point_pair.hpp"
 
 namespace flexmbd {
-namespace {
-
-/// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
-/// matrices, 72 MB and some 10 s per factorisation at 1,000 elements.
-constexpr long kMaxElements = 1000;
-/// Most elastic modes of a modal body (the same bound on its coordinates).
-constexpr long kMaxModes = 3000;
+namespace scenereaders {
 
 using nlohmann::json;
 using namespace jsonread;
-
-// ----- name look-ups ---------------------------------------------------------------------
 
 BodyIndex lookupBody(const System& sys, const std::string& name, const ObjectReader& r) {
   std::vector<std::string> known;
@@ -64,6 +57,24 @@ ConstraintIndex lookupJoint(const System& sys, const std::string& name, const Ob
   }
   r.fail("unknown joint " + inQuotes(name) + " (known joints: " + (known.empty() ? "none" : join(known)) + ")");
 }
+
+}  // namespace scenereaders
+
+namespace {
+
+using scenereaders::lookupBody;
+using scenereaders::lookupJoint;
+
+/// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
+/// matrices, 72 MB and some 10 s per factorisation at 1,000 elements.
+constexpr long kMaxElements = 1000;
+/// Most elastic modes of a modal body (the same bound on its coordinates).
+constexpr long kMaxModes = 3000;
+
+using nlohmann::json;
+using namespace jsonread;
+
+// ----- name look-ups ---------------------------------------------------------------------
 
 /// Relative angle phi_j - phi_i of a joint's two points in the initial positions.
 double initialJointAngle(const System& sys, ConstraintIndex joint) {
@@ -387,7 +398,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
 }
 
 OutputRequest parseOutput(const json& j, const std::string& where, const System& sys,
-                          const std::vector<OutputRequest>& earlier) {
+                          const std::vector<OutputRequest>& earlier, bool spatial) {
   ObjectReader r(j, where);
   r.peekName();
   const std::string type = readType(r, "output", {"point", "energy", "deflection"});
@@ -423,6 +434,12 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
   }
   out.bodyName = r.name("body");
   out.body = lookupBody(sys, out.bodyName, r);
+  if (spatial) {
+    if (out.type == OutputRequest::Type::Deflection) r.fail("a deflection output needs a flexible body: planar scenes only so far");
+    out.spatial = true;
+    out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
+    return out;
+  }
   out.point = r.vec2("point", Vec2::Zero());
   if (out.type == OutputRequest::Type::Deflection) {
     const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
@@ -555,6 +572,7 @@ class PathTracker {
 std::vector<std::string> OutputRequest::columnNames() const {
   if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
   if (type == Type::Deflection) return {name + ".ux", name + ".uy", name + ".N", name + ".M"};
+  if (spatial) return {name + ".x", name + ".y", name + ".z", name + ".vx", name + ".vy", name + ".vz"};
   return {name + ".x", name + ".y", name + ".vx", name + ".vy"};
 }
 
@@ -566,6 +584,12 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
   }
   const Body& b = sys.body(body);
   const int off = sys.coordinateOffset(body);
+  if (spatial) {
+    FrameKinematics f;
+    b.frameKinematics(q.segment(off, b.numCoordinates()), point3, nullptr, nullptr, f);
+    const Vec3 vel = f.Jr * v.segment(sys.velocityOffset(body), b.numVelocities());
+    return {f.r.x(), f.r.y(), f.r.z(), vel.x(), vel.y(), vel.z()};
+  }
   if (type == Type::Deflection) {
     const FfrBeamModel& model = *static_cast<const FfrBody2d&>(b).beamModel();
     const VecX qf = q.segment(off + 3, model.numElastic());
@@ -614,28 +638,46 @@ Scene parseScene(const json& j) {
   scene.name = top.string("name", "");
   System& sys = scene.system;
 
+  // "dimension": 2 (planar, the default) or 3 (spatial): which readers the objects go to
+  const bool spatial = top.integer("dimension", 2, 2, 3) == 3;
   if (!top.has("bodies")) top.fail("missing required key \"bodies\"");
   const json& bodies = top.array("bodies");
   if (bodies.empty()) top.fail("key \"bodies\" must list at least one body");
-  for (std::size_t i = 0; i < bodies.size(); ++i) parseBody(bodies[i], "bodies[" + std::to_string(i) + "]", sys);
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::string at = "bodies[" + std::to_string(i) + "]";
+    spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys) : parseBody(bodies[i], at, sys);
+  }
 
   const json& joints = top.array("joints");
-  for (std::size_t i = 0; i < joints.size(); ++i) parseJoint(joints[i], "joints[" + std::to_string(i) + "]", sys);
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const std::string at = "joints[" + std::to_string(i) + "]";
+    spatial ? scenereaders::parseSpatialJoint(joints[i], at, sys) : parseJoint(joints[i], at, sys);
+  }
 
   const json& drivers = top.array("drivers");
   for (std::size_t i = 0; i < drivers.size(); ++i) {
-    parseDriver(drivers[i], "drivers[" + std::to_string(i) + "]", sys);
+    const std::string at = "drivers[" + std::to_string(i) + "]";
+    spatial ? scenereaders::parseSpatialDriver(drivers[i], at, sys) : parseDriver(drivers[i], at, sys);
   }
 
   const json& forces = top.array("forces");
-  for (std::size_t i = 0; i < forces.size(); ++i) parseForce(forces[i], "forces[" + std::to_string(i) + "]", sys);
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    const std::string at = "forces[" + std::to_string(i) + "]";
+    spatial ? scenereaders::parseSpatialForce(forces[i], at, sys) : parseForce(forces[i], at, sys);
+  }
 
-  const Vec2 g = top.vec2("gravity", Vec2::Zero());
-  located("top level", [&] { sys.setGravity(g); });
+  if (spatial) {
+    const Vec3 g = top.has("gravity") ? Vec3(top.vector("gravity", 3)) : Vec3::Zero();
+    located("top level", [&] { sys.setGravity(g); });
+  } else {
+    const Vec2 g = top.vec2("gravity", Vec2::Zero());
+    located("top level", [&] { sys.setGravity(g); });
+  }
 
   const json& outputs = top.array("outputs");
   for (std::size_t i = 0; i < outputs.size(); ++i) {
-    scene.outputs.push_back(parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs));
+    scene.outputs.push_back(
+        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
   }
 
   scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};

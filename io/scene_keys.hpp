@@ -15,7 +15,8 @@ namespace flexmbd::scenekeys {
 using Keys = std::vector<std::string>;
 
 // ----- multibody scenes (flexmbd run) ------------------------------------------------
-inline const Keys kScene = {"name", "gravity", "bodies", "joints", "drivers", "forces", "outputs", "solver"};
+inline const Keys kScene = {"name",   "dimension", "gravity", "bodies", "joints",
+                            "drivers", "forces",   "outputs", "solver"};
 inline const Keys kRigidBody = {"name",  "type",     "mass", "inertia", "com", "position",
                                 "angle", "velocity", "angular_velocity"};
 inline const Keys kFlexibleBody = {"name",     "type",     "position",    "angle",
@@ -53,6 +54,15 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
                              "atol_elastic", "atol_velocity", "t_start",  "t_end",      "output_step",
                              "max_step",     "min_step",      "max_steps", "max_order", "initial_step",
                              "linear_solver", "fd_jacobian", "cross_singular"};
+
+// spatial scenes ("dimension": 3)
+inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "position",
+                                  "orientation", "velocity", "angular_velocity"};
+inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
+inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames"};
+inline const Keys kJointFrame = {"point", "axis", "orientation"};
+inline const Keys kSpatialAppliedLoad = {"name",    "type",     "body",     "point",    "force_x",
+                                         "force_y", "force_z",  "torque_x", "torque_y", "torque_z"};
 
 // ----- kinematics scenes (flexmbd kinematics) ------------------------------------------
 inline const Keys kKinematicsScene = {"name", "nodes", "links", "inputs", "analysis"};
@@ -115,6 +125,18 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"output.point", &kPointOutput},
       {"output.deflection", &kPointOutput},
       {"solver", &kSolver},
+      {"body.rigid.3d", &kRigidBody3d},
+      {"orientation", &kOrientation},
+      {"joint.3d.spherical", &kSpatialJoint},
+      {"joint.3d.revolute", &kSpatialJoint},
+      {"joint.3d.prismatic", &kSpatialJoint},
+      {"joint.3d.cylindrical", &kSpatialJoint},
+      {"joint.3d.universal", &kSpatialJoint},
+      {"joint.3d.fixed", &kSpatialJoint},
+      {"joint.3d.planar", &kSpatialJoint},
+      {"joint.frame", &kJointFrame},
+      {"driver.body_z", &kBodyDriver},
+      {"force.applied_load.3d", &kSpatialAppliedLoad},
       {"kinematics", &kKinematicsScene},
       {"kinematics.node.fixed", &kKinematicsNode},
       {"kinematics.node.free", &kKinematicsNode},

@@ -5,6 +5,8 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "bodies/rigid_body_3d.hpp"
+#include "joints/spatial_joint.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
@@ -177,9 +179,20 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
   for (int f = 0; f < sys.numForces(); ++f) {
     for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p);
   }
+  // spatial bodies: lines from the centre of mass to each joint frame on the body
+  spatialPoints_.resize(sys.numBodies());
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    if (const auto* j = dynamic_cast<const SpatialJoint*>(&sys.constraint(ConstraintIndex(c)))) {
+      spatialPoints_[j->bodies()[0].value].push_back(j->frameI().point);
+      spatialPoints_[j->bodies()[1].value].push_back(j->frameJ().point);
+    }
+  }
+  triad_ = 0.1 * sys.characteristicLength();
   for (int b = 1; b < sys.numBodies(); ++b) {
-    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex(b)));
-    if (rigidPoints_[b].empty() && !(fb && fb->beamModel())) notDrawn_.push_back(sys.body(BodyIndex(b)).name());
+    const Body& body = sys.body(BodyIndex(b));
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&body);
+    const bool spatial = dynamic_cast<const RigidBody3d*>(&body) != nullptr;
+    if (rigidPoints_[b].empty() && !(fb && fb->beamModel()) && !spatial) notDrawn_.push_back(body.name());
   }
 }
 
@@ -194,7 +207,23 @@ void VtkWriter::write(const OutputSample& s) {
     const auto q = s.q.segment(sys_.coordinateOffset(BodyIndex(b)), body.numCoordinates());
     const int cellsBefore = static_cast<int>(g.cells.size());
     const auto* fb = dynamic_cast<const FfrBody2d*>(&body);
-    if (fb && fb->beamModel()) {
+    if (dynamic_cast<const RigidBody3d*>(&body)) {
+      // an oriented body: a triad of its axes at the centre of mass (the cells' order: x, y,
+      // z) and a line to each joint point
+      const Vec3 c = q.head<3>();
+      const Mat3 A = RigidBody3d::rotationOf(q);
+      auto addLine = [&](const Vec3& a, const Vec3& b) {
+        g.cells.push_back({static_cast<int>(g.points.size()), static_cast<int>(g.points.size()) + 1});
+        for (const Vec3& p : {a, b}) {
+          g.points.push_back(p);
+          displacement.push_back(Vec3::Zero());
+          axial.push_back(0.0);
+          moment.push_back(0.0);
+        }
+      };
+      for (int k = 0; k < 3; ++k) addLine(c, c + triad_ * A.col(k));
+      for (const Vec3& p : spatialPoints_[b]) addLine(c, c + A * p);
+    } else if (fb && fb->beamModel()) {
       const FfrBeamModel& m = *fb->beamModel();
       const VecX qf = q.tail(m.numElastic());
       const Mat2 A = rotation(q[2]);

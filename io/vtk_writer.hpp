@@ -60,6 +60,10 @@ class VtkWriter {
   std::vector<std::string> notDrawn_;
   int subdivisions_;
   std::vector<std::vector<Vec2>> rigidPoints_;  // per body: body-frame points of its line
+  // per spatial body: its joint points (body frame), drawn as lines from the centre of
+  // mass, and the length of the axis triad drawn at the centre of mass
+  std::vector<std::vector<Vec3>> spatialPoints_;
+  double triad_ = 0.1;
 };
 
 /// A tensegrity structure: its nodes as points (point data: velocity) and every member

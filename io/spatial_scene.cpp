@@ -1,0 +1,244 @@
+#include "io/spatial_scene.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "bodies/rigid_body_3d.hpp"
+#include "core/errors.hpp"
+#include "core/rotation_3d.hpp"
+#include "forces/spatial_forces.hpp"
+#include "io/scene_keys.hpp"
+#include "joints/spatial_drivers.hpp"
+#include "joints/spatial_joint.hpp"
+
+namespace flexmbd::scenereaders {
+namespace {
+
+using nlohmann::json;
+using namespace jsonread;
+
+Vec3 vec3(const ObjectReader& r, const std::string& key, const Vec3& fallback) {
+  return r.has(key) ? Vec3(r.vector(key, 3)) : fallback;
+}
+
+/// A frame from {"point", "axis" | "orientation"}: "axis" gives the frame's z axis (body
+/// axes), its x axis being the body axis least aligned with it, made orthogonal.
+JointFrame parseJointFrame(const json& j, const std::string& where) {
+  ObjectReader r(j, where);
+  r.allowOnly(scenekeys::kJointFrame, " for a joint frame");
+  JointFrame f;
+  f.point = vec3(r, "point", Vec3::Zero());
+  if (r.has("axis") && r.has("orientation")) r.fail("give either \"axis\" or \"orientation\", not both");
+  if (r.has("axis")) {
+    const Vec3 a = r.vector("axis", 3);
+    if (!(a.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
+    const Vec3 z = a.normalized();
+    Eigen::Index k = 0;
+    z.cwiseAbs().minCoeff(&k);
+    const Vec3 x = (Vec3::Unit(k) - z[k] * z).normalized();
+    f.axes.col(0) = x;
+    f.axes.col(1) = z.cross(x);
+    f.axes.col(2) = z;
+  } else if (r.has("orientation")) {
+    f.axes = parseOrientation(r.object("orientation"), r.where() + ".orientation");
+  }
+  return f;
+}
+
+/// The frames of a spatial joint (for its drivers).
+const SpatialJoint& spatialJoint(const System& sys, ConstraintIndex c, const ObjectReader& r) {
+  const auto* joint = dynamic_cast<const SpatialJoint*>(&sys.constraint(c));
+  if (!joint) r.fail("joint " + inQuotes(sys.constraint(c).name()) + " is not a spatial joint");
+  return *joint;
+}
+
+}  // namespace
+
+Mat3 parseOrientation(const json& j, const std::string& where) {
+  ObjectReader r(j, where);
+  r.allowOnly(scenekeys::kOrientation, " for an orientation");
+  const int forms = (r.has("quaternion") ? 1 : 0) + (r.has("axis") || r.has("angle") ? 1 : 0) + (r.has("matrix") ? 1 : 0);
+  if (forms != 1) {
+    r.fail("give exactly one of \"quaternion\": [e0, e1, e2, e3], \"axis\" with \"angle\", or \"matrix\": [[...], [...], [...]]");
+  }
+  if (r.has("quaternion")) {
+    const Vec4 p = r.vector("quaternion", 4);
+    if (!(p.norm() > 0.0)) r.fail("key \"quaternion\" must be non-zero");
+    return quaternionRotation(p);
+  }
+  if (r.has("matrix")) {
+    const MatX m = r.matrix("matrix");
+    if (m.rows() != 3 || m.cols() != 3) r.fail("key \"matrix\" must be 3 rows of 3 numbers");
+    const Mat3 A = m;
+    if (!((A.transpose() * A - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-9) || !(A.determinant() > 0.0)) {
+      r.fail("key \"matrix\" is not a rotation (expected orthonormal rows, determinant +1, to 1e-9)");
+    }
+    return A;
+  }
+  if (!r.has("axis") || !r.has("angle")) r.fail("an axis-angle orientation needs both \"axis\" and \"angle\"");
+  const Vec3 axis = r.vector("axis", 3);
+  if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
+  return quaternionRotation(quaternionFromAxisAngle(axis, r.number("angle")));
+}
+
+void parseSpatialBody(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants"});
+  if (type != "rigid") {
+    r.fail("a " + type + " body is planar so far; a spatial scene (\"dimension\": 3) takes rigid bodies");
+  }
+  r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");
+  const std::string name = r.name("name");
+  if (name == "ground") {
+    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
+           "in joints, do not define it)");
+  }
+  RigidBody3dProperties props;
+  props.mass = r.positive("mass");
+  const json& inertia = r.required("inertia");
+  if (inertia.is_array() && inertia.size() == 3 && !inertia[0].is_array()) {
+    const Vec3 I = r.vector("inertia", 3);
+    for (int k = 0; k < 3; ++k) r.checkPositive(I[k], "inertia[" + std::to_string(k) + "]");
+    props.inertia = I.asDiagonal();
+  } else {
+    const MatX m = r.matrix("inertia");
+    if (m.rows() != 3 || m.cols() != 3) {
+      r.fail("key \"inertia\" must be 3 principal moments [Ixx, Iyy, Izz] or a 3 x 3 tensor [[...], [...], [...]]");
+    }
+    props.inertia = m;
+  }
+  FrameState3d init;
+  init.position = vec3(r, "position", Vec3::Zero());
+  if (r.has("orientation")) init.orientation = parseOrientation(r.object("orientation"), r.where() + ".orientation");
+  init.velocity = vec3(r, "velocity", Vec3::Zero());
+  init.angularVelocity = vec3(r, "angular_velocity", Vec3::Zero());
+  located(r.where(), [&] { return sys.addBody(std::make_unique<RigidBody3d>(name, props, init)); });
+}
+
+void parseSpatialJoint(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type =
+      readType(r, "joint", {"spherical", "revolute", "prismatic", "cylindrical", "universal", "fixed", "planar"});
+  r.allowOnly(scenekeys::kSpatialJoint, " for a joint in a spatial scene");
+  const std::string name = r.name("name");
+  const auto bodyNames = r.namePair("bodies");
+  const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
+  const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
+  if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a joint connects two different bodies");
+  const json& frames = r.requiredArray("frames");
+  if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
+  const JointFrame fi = parseJointFrame(frames[0], r.where() + ".frames[0]");
+  const JointFrame fj = parseJointFrame(frames[1], r.where() + ".frames[1]");
+  static const std::array<std::pair<const char*, SpatialJointType>, 7> types = {{
+      {"spherical", SpatialJointType::Spherical}, {"revolute", SpatialJointType::Revolute},
+      {"prismatic", SpatialJointType::Prismatic}, {"cylindrical", SpatialJointType::Cylindrical},
+      {"universal", SpatialJointType::Universal}, {"fixed", SpatialJointType::Fixed},
+      {"planar", SpatialJointType::Planar}}};
+  SpatialJointType t = SpatialJointType::Spherical;
+  for (const auto& [n, v] : types) {
+    if (type == n) t = v;
+  }
+  located(r.where(), [&] { return sys.addConstraint(std::make_unique<SpatialJoint>(name, t, bi, fi, bj, fj)); });
+}
+
+void parseSpatialDriver(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type =
+      readType(r, "driver", {"body_x", "body_y", "body_z", "body_angle", "joint_angle", "joint_displacement"});
+  if (type == "body_angle") {
+    r.fail("a body_angle driver is planar; in a spatial scene drive a revolute joint's angle (joint_angle)");
+  }
+  const bool onJoint = type == "joint_angle" || type == "joint_displacement";
+  r.allowOnly(onJoint ? scenekeys::kJointDriver : scenekeys::kBodyDriver, " for a " + type + " driver");
+  const std::string name = r.name("name");
+  if (!onJoint) {
+    const BodyIndex body = lookupBody(sys, r.name("body"), r);
+    TimeLawPtr law = parseTimeLaw(r.object("law"), r.where() + ".law");
+    const std::string coordinate = type.substr(5);
+    located(r.where(), [&] { return sys.addBodyCoordinateDriver(name, body, coordinate, law); });
+    return;
+  }
+  const std::string jointName = r.name("joint");
+  const SpatialJoint& joint = spatialJoint(sys, lookupJoint(sys, jointName, r), r);
+  const SpatialJointType jt = joint.type();
+  const bool angle = type == "joint_angle";
+  const bool fits = jt == SpatialJointType::Cylindrical ||
+                    (angle ? jt == SpatialJointType::Revolute : jt == SpatialJointType::Prismatic);
+  if (!fits) {
+    r.fail("a " + type + " driver needs a " + (angle ? "revolute or cylindrical" : "prismatic or cylindrical") +
+           " joint, but joint " + inQuotes(jointName) + " is " + joint.typeName());
+  }
+  TimeLawPtr law = parseTimeLaw(r.object("law"), r.where() + ".law");
+  const BodyIndex bi = joint.bodies()[0], bj = joint.bodies()[1];
+  located(r.where(), [&] {
+    if (angle) {
+      return sys.addConstraint(
+          std::make_unique<SpatialJointAngleDriver>(name, bi, joint.frameI(), bj, joint.frameJ(), law));
+    }
+    return sys.addConstraint(
+        std::make_unique<SpatialJointDisplacementDriver>(name, bi, joint.frameI(), bj, joint.frameJ(), law));
+  });
+}
+
+void parseSpatialForce(const json& j, const std::string& where, System& sys) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load"});
+  if (type == "rotational_spring_damper") {
+    r.fail("a rotational_spring_damper is planar so far; in a spatial scene use spring_damper or applied_load");
+  }
+  const std::string forA = " for a " + type + " force in a spatial scene";
+  if (type == "spring_damper") {
+    r.allowOnly(scenekeys::kSpringDamper, forA);
+    const std::string name = r.name("name");
+    const auto bodyNames = r.namePair("bodies");
+    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
+    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
+    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a spring connects two different bodies");
+    const json& points = r.requiredArray("points");
+    if (points.size() != 2 || !points[0].is_array() || !points[1].is_array()) {
+      r.fail("key \"points\" must be two points [[xi, yi, zi], [xj, yj, zj]]");
+    }
+    const MatX P = r.matrix("points");
+    if (P.cols() != 3) r.fail("key \"points\" must be two points [[xi, yi, zi], [xj, yj, zj]]");
+    const Vec3 pi = P.row(0).transpose(), pj = P.row(1).transpose();
+    const double stiffness = r.nonNegative("stiffness");
+    const double damping = r.nonNegative("damping", 0.0);
+    double freeLength = 0.0;
+    if (r.has("free_length")) {
+      freeLength = r.nonNegative("free_length");
+    } else {
+      freeLength = located(r.where(), [&] {
+        FrameKinematics a, b;
+        sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi, nullptr, nullptr, a);
+        sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj, nullptr, nullptr, b);
+        return (b.r - a.r).norm();
+      });
+    }
+    located(r.where(), [&] {
+      return sys.addForce(std::make_unique<SpatialSpringDamper>(name, bi, pi, bj, pj, stiffness, damping, freeLength));
+    });
+    return;
+  }
+  r.allowOnly(scenekeys::kSpatialAppliedLoad, forA);
+  const std::string name = r.name("name");
+  const BodyIndex body = lookupBody(sys, r.name("body"), r);
+  const Vec3 point = vec3(r, "point", Vec3::Zero());
+  std::array<TimeLawPtr, 6> laws;
+  static const std::array<const char*, 6> keys = {"force_x", "force_y", "force_z", "torque_x", "torque_y", "torque_z"};
+  bool any = false;
+  for (int k = 0; k < 6; ++k) {
+    if (!r.has(keys[k])) continue;
+    laws[k] = parseTimeLaw(r.object(keys[k]), r.where() + "." + keys[k]);
+    any = true;
+  }
+  if (!any) r.fail("an applied_load needs at least one of the keys \"force_x\" ... \"torque_z\" (each a law object)");
+  located(r.where(), [&] { return sys.addForce(std::make_unique<SpatialAppliedLoad>(name, body, point, laws)); });
+}
+
+}  // namespace flexmbd::scenereaders

@@ -1,0 +1,29 @@
+// Readers of the objects of spatial scenes ("dimension": 3): rigid bodies with
+// orientations, joints as frame pairs, their drivers and the spatial force elements
+// (docs/scene-format.md, "Spatial scenes"). Called by io/scene.cpp.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "core/system.hpp"
+#include "io/json_reader.hpp"
+
+namespace flexmbd::scenereaders {
+
+/// A body / a joint (not a driver) by name. @throws InputError listing the known ones.
+BodyIndex lookupBody(const System& sys, const std::string& name, const jsonread::ObjectReader& r);
+ConstraintIndex lookupJoint(const System& sys, const std::string& name, const jsonread::ObjectReader& r);
+
+/// A rotation from an "orientation" object: {"quaternion": [e0, e1, e2, e3]} (normalised),
+/// {"axis": [x, y, z], "angle": a} (radians) or {"matrix": [[...], [...], [...]]} (rows;
+/// orthonormal, determinant +1). Exactly one form.
+Mat3 parseOrientation(const nlohmann::json& j, const std::string& where);
+
+void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys);
+void parseSpatialJoint(const nlohmann::json& j, const std::string& where, System& sys);
+void parseSpatialDriver(const nlohmann::json& j, const std::string& where, System& sys);
+void parseSpatialForce(const nlohmann::json& j, const std::string& where, System& sys);
+
+}  // namespace flexmbd::scenereaders
