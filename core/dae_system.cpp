@@ -46,7 +46,7 @@ struct ConstraintScratch {
   VecX f, df, ddf;                       ///< prescribed motion and its derivatives
   VecX vl, al, Hv, wl;                   ///< local velocities, accelerations, H_a w, (T v) local
   MatX Hx, vH, dFdq, dFdv;               ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq and d/dv
-  MatX Tl, Til, THx, TGt;                ///< T and T+ over the local columns (T != I only), products
+  MatX Tl, Til, THx, TGt, TDG;           ///< T and T+ over the local columns (T != I only), products
 };
 
 /// Working memory of one force element.
@@ -451,9 +451,9 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
           addBlock(J, L.q, qcols, L.q, qcols, cs.THx);
           cs.TGt.resize(nl, me);
           for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
-          cs.THx.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
+          cs.TDG.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
           for (int a = 0; a < me; ++a) {
-            for (int k = 0; k < nql; ++k) J.add(L.q + qcols[k], L.mu + row + a, cs.THx(k, a));
+            for (int k = 0; k < nql; ++k) J.add(L.q + qcols[k], L.mu + row + a, cs.TDG(k, a));
           }
           // F_g = h - f: dh/dq = G T+
           cs.dFdq.noalias() = ev.G * cs.Til;
@@ -523,7 +523,8 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
           cs.dFdv.resize(me, nl);
           for (int a = 0; a < me; ++a) {
             cs.Hv.noalias() = ev.H[a] * cs.wl;
-            cs.dFdv.row(a).noalias() = cs.vH.row(a) * cs.Tl + cs.Hv.transpose();
+            cs.dFdv.row(a).noalias() = cs.vH.row(a) * cs.Tl;
+            cs.dFdv.row(a) += cs.Hv.transpose();
           }
           cs.dFdv += cj * ev.G;
           addRowsBlock(J, L.lambda + row, L.v, cols, cs.dFdv);

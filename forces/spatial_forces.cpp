@@ -22,7 +22,8 @@ void SpatialAppliedLoad::addForce(double t, const BodyStates& bodies, const VecX
     if (laws_[3 + k]) M[k] = laws_[3 + k]->evaluate(t).f;
   }
   bodies[0].frame(point_, w.fi);
-  Q.noalias() += w.fi.Jr.transpose() * F + w.fi.Jw.transpose() * M;
+  Q.noalias() += w.fi.Jr.transpose() * F;
+  Q.noalias() += w.fi.Jw.transpose() * M;
   if (dQdq) bodies[0].addCurvature(point_, F, M, *dQdq);
 }
 
@@ -73,7 +74,10 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
   gradL.noalias() = e.transpose() * pair.Jd();
   const double f = stiffness_ * (l - freeLength_) + damping_ * gradL.dot(v);
   Q.noalias() -= f * gradL.transpose();
-  if (dQdv) dQdv->noalias() -= damping_ * gradL.transpose() * gradL;
+  if (dQdv) {
+    w.row3 = damping_ * gradL;
+    dQdv->noalias() -= gradL.transpose() * w.row3;
+  }
   if (!dQdq) return;
   // H_l = d(grad l^T)/dq = C_d(e) + Jd^T (I - e e^T) / l Jd T+;  dl/dq = grad l T+;
   // dl'/dq = v^T H_l;  dQ/dq = -(grad l^T df/dq + f H_l)
@@ -82,10 +86,15 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
   pair.gapCurvature(e, Hl);
   const Mat3 P = (Mat3::Identity() - e * e.transpose()) / l;
   w.JT.noalias() = pair.Jd() * pair.Tinv();
-  Hl.noalias() += pair.Jd().transpose() * (P * w.JT);
+  w.JT2.noalias() = P * w.JT;
+  Hl.noalias() += pair.Jd().transpose() * w.JT2;
   RowVecX& dfdq = w.row2;
-  dfdq.noalias() = stiffness_ * (gradL * pair.Tinv()) + damping_ * (v.transpose() * Hl);
-  dQdq->noalias() -= gradL.transpose() * dfdq + f * Hl;
+  dfdq.noalias() = gradL * pair.Tinv();
+  dfdq *= stiffness_;
+  w.row4.noalias() = v.transpose() * Hl;
+  dfdq += damping_ * w.row4;
+  dQdq->noalias() -= gradL.transpose() * dfdq;
+  *dQdq -= f * Hl;
 }
 
 }  // namespace flexmbd

@@ -44,7 +44,8 @@ void FramePair::axis(bool onI, int k, Vec3& u, Mat3X& J) const {
   const FrameKinematics& f = onI ? w_.fi : w_.fj;
   u = onI ? axisI(k) : axisJ(k);
   J.setZero(3, ni_ + nj_);
-  J.middleCols(onI ? 0 : ni_, onI ? ni_ : nj_) = -skew(u) * f.Jw;
+  const Mat3 minusU = -skew(u);
+  J.middleCols(onI ? 0 : ni_, onI ? ni_ : nj_).noalias() = minusU * f.Jw;
 }
 
 // H += d(J_u^T x)/dq at fixed x for an axis u on body i or j: the body's curvature with
@@ -55,7 +56,9 @@ void FramePair::axisCurvature(bool onI, const Vec3& u, const Mat3X& Ju, const Ve
   bodies_[onI ? 0 : 1].addCurvature(onI ? frameI_.point : frameJ_.point, Vec3::Zero(), u.cross(x),
                                     H.block(r0, c0, nr, nc));
   w_.JT.noalias() = Ju * w_.Tinv;  // 3 x nq
-  H.middleRows(r0, nr).noalias() -= f.Jw.transpose() * (skew(x) * w_.JT);
+  const Mat3 X = skew(x);
+  w_.JT2.noalias() = X * w_.JT;
+  H.middleRows(r0, nr).noalias() -= f.Jw.transpose() * w_.JT2;
 }
 
 // H += d(J_d^T x)/dq at fixed x

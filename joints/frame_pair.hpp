@@ -71,7 +71,8 @@ void FramePair::axisGap(int a, double& h, Row&& G, MatX* H) {
   Vec3 u;
   axis(true, a, u, w_.J1);
   h = u.dot(d_);
-  G.noalias() = d_.transpose() * w_.J1 + u.transpose() * w_.Jd;
+  G.noalias() = d_.transpose() * w_.J1;
+  G.noalias() += u.transpose() * w_.Jd;
   if (!H) return;
   axisCurvature(true, u, w_.J1, d_, *H);
   gapCurvature(u, *H);
@@ -84,7 +85,8 @@ void FramePair::axisAxis(int a, int b, double& h, Row&& G, MatX* H) {
   axis(true, a, u, w_.J1);
   axis(false, b, z, w_.J2);
   h = u.dot(z);
-  G.noalias() = z.transpose() * w_.J1 + u.transpose() * w_.J2;
+  G.noalias() = z.transpose() * w_.J1;
+  G.noalias() += u.transpose() * w_.J2;
   if (!H) return;
   axisCurvature(true, u, w_.J1, z, *H);
   axisCurvature(false, z, w_.J2, u, *H);

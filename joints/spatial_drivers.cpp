@@ -46,11 +46,18 @@ void SpatialJointAngleDriver::evaluate(const BodyStates& bodies, bool withHessia
   out.G.resize(1, n);
   out.G.row(0) = (c * w.row - s * w.row2) / r2;
   if (!withHessians) return;
-  const Eigen::RowVectorXd gqs = w.row * pair.Tinv(), gqc = w.row2 * pair.Tinv();
+  RowVecX &gqs = w.row3, &gqc = w.row4, &k = w.row5, &g = w.row6;
+  gqs.noalias() = w.row * pair.Tinv();
+  gqc.noalias() = w.row2 * pair.Tinv();
+  k = (2.0 * s / r2) * gqs + (2.0 * c / r2) * gqc;
+  g = out.G.row(0);
   MatX& H = out.H[0];
   H = (c * w.hessian - s * H) / r2;  // H held H_c
-  H.noalias() += (w.row.transpose() * gqc - w.row2.transpose() * gqs) / r2;
-  H.noalias() -= out.G.row(0).transpose() * ((2.0 * s) * gqs + (2.0 * c) * gqc) / r2;
+  H.noalias() -= g.transpose() * k;
+  gqs /= r2;
+  gqc /= r2;
+  H.noalias() += w.row.transpose() * gqc;
+  H.noalias() -= w.row2.transpose() * gqs;
 }
 
 SpatialJointDisplacementDriver::SpatialJointDisplacementDriver(std::string name, BodyIndex bodyI,

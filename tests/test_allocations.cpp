@@ -1,7 +1,7 @@
 // The integrator's hot path allocates nothing: after a first call (which may size the
 // scratch), a residual and a Jacobian of DaeSystem make zero heap allocations, for
-// rigid, nodal-flexible, modal-flexible and given-invariants models and for every
-// joint, driver and force type, in every formulation.
+// rigid, nodal-flexible, modal-flexible and given-invariants models, spatial rigid models,
+// and for every planar and spatial joint, driver and force type, in every formulation.
 //
 // The global allocation functions of the process are replaced (malloc and friends;
 // operator new and Eigen's aligned allocation go through malloc) and count while a
@@ -14,7 +14,11 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bodies/rigid_body_3d.hpp"
 #include "core/dae_system.hpp"
+#include "forces/spatial_forces.hpp"
+#include "joints/spatial_drivers.hpp"
+#include "joints/spatial_joint.hpp"
 #include "core/time_law.hpp"
 #include "ffr_test_models.hpp"
 #include "io/scene.hpp"
@@ -97,10 +101,10 @@ long allocationsIn(Fn&& fn) {
 /// so that every term of the residual and the Jacobian is evaluated.
 void genericState(const DaeSystem& dae, VecX& y, VecX& yp) {
   const System& sys = dae.system();
-  const int nq = sys.numCoordinates();
+  const int nv = sys.numVelocities();
   const VecX q = sys.initialCoordinates();
-  VecX v(nq), a(nq), lambda(sys.numConstraintEquations());
-  for (int k = 0; k < nq; ++k) {
+  VecX v(nv), a(nv), lambda(sys.numConstraintEquations());
+  for (int k = 0; k < nv; ++k) {
     v[k] = 0.3 + 0.01 * k;
     a[k] = -0.2 + 0.02 * k;
   }
@@ -186,6 +190,46 @@ TEST(Allocations, EveryJointDriverAndForceType) {
   sys.setGravity(Vec2(0.0, -9.81));
   sys.finalize();
   expectAllocationFree(sys, "every component type");
+}
+
+TEST(Allocations, SpatialSliderCrank) {
+  const Scene s = loadExample("spatial_slider_crank.json");
+  expectAllocationFree(s.system, "spatial slider crank");
+}
+
+TEST(Allocations, EverySpatialJointDriverAndForceType) {
+  // Not a meaningful mechanism: every spatial component type once, at a generic state.
+  System sys;
+  RigidBody3dProperties p;
+  p.mass = 2.0;
+  p.inertia = Vec3(0.1, 0.2, 0.25).asDiagonal();
+  std::vector<BodyIndex> b;
+  for (int k = 0; k < 8; ++k) {
+    FrameState3d s;
+    s.position = Vec3(k, 0.1 * k, -0.05 * k);
+    s.orientation = quaternionRotation(Vec4(1.0, 0.1 * k, -0.05, 0.02 * k));
+    b.push_back(sys.addBody(std::make_unique<RigidBody3d>("b" + std::to_string(k), p, s)));
+  }
+  JointFrame f0, f1;
+  f1.point = Vec3(0.3, -0.1, 0.2);
+  f1.axes = quaternionRotation(Vec4(0.9, 0.1, 0.3, -0.2));
+  using T = SpatialJointType;
+  const T types[] = {T::Spherical, T::Revolute, T::Prismatic, T::Cylindrical, T::Universal, T::Fixed, T::Planar};
+  for (int k = 0; k < 7; ++k) {
+    sys.addConstraint(std::make_unique<SpatialJoint>("j" + std::to_string(k), types[k], k == 0 ? kGround : b[k - 1],
+                                                     f0, b[k], f1));
+  }
+  sys.addConstraint(std::make_unique<SpatialJointAngleDriver>("angle", b[0], f0, b[1], f1, makeHarmonicLaw(0.2, 3.0)));
+  sys.addConstraint(
+      std::make_unique<SpatialJointDisplacementDriver>("slide", b[1], f0, b[2], f1, makeConstantSpeedLaw(0.1, 0.5)));
+  sys.addBodyCoordinateDriver("z", b[7], "z", makeConstantLaw(0.0));
+  sys.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), b[3], f1.point, 100.0, 2.0, 0.5));
+  sys.addForce(std::make_unique<SpatialAppliedLoad>(
+      "load", b[4], f1.point,
+      std::array<TimeLawPtr, 6>{makeConstantLaw(1.0), nullptr, makeHarmonicLaw(2.0, 1.0), nullptr, makeConstantLaw(0.3), nullptr}));
+  sys.setGravity(Vec3(0.0, 0.0, -9.81));
+  sys.finalize();
+  expectAllocationFree(sys, "every spatial component type");
 }
 
 }  // namespace
