@@ -15,6 +15,7 @@
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
+#include "io/scene.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 
@@ -373,4 +374,75 @@ TEST(SpatialRedundancy, FourBarWithParallelRevolutesIsReportedNamingTheDependent
     EXPECT_NE(what.find("joint 'C'"), std::string::npos) << what;
     RecordProperty("message", what);
   }
+}
+
+TEST(SpatialInPlane, SliderCrankGivesThePlanarPositionsAndDrivingTorque) {
+  // examples/slider_crank_rigid.json (crank 1, rod 2, driven at 1 rad/s from the dead
+  // centre) rebuilt of spatial bodies in the x-y plane: revolute bearing, spherical crank
+  // pin, universal joint at the slider, prismatic rail (non-redundant in space). Both at
+  // rtol 1e-10: slider position and motor torque agree to the integration error (~1e-9;
+  // bounds 1e-7 m and 1e-6 relative to the largest torque).
+  Scene planar = loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json");
+  planar.solver.rtol = 1e-10;
+  planar.solver.atol = 1e-12;
+  planar.solver.progress = false;
+  System sys;
+  auto body = [&](const std::string& name, double m, double Izz, const Vec3& com) {
+    RigidBody3dProperties p;
+    p.mass = m;
+    p.inertia = Vec3(0.6 * Izz, 0.6 * Izz, Izz).asDiagonal();
+    FrameState3d s;
+    s.position = com;
+    return sys.addBody(std::make_unique<RigidBody3d>(name, p, s));
+  };
+  const BodyIndex crank = body("crank", 1.0, 0.1, Vec3(0.5, 0, 0));
+  const BodyIndex rod = body("rod", 1.0, 0.4, Vec3(2.0, 0, 0));
+  const BodyIndex slider = body("slider", 0.5, 0.01, Vec3(3.0, 0, 0));
+  JointFrame origin, crankAxis, crankPin, rodStart, rodEnd, sliderCross, rail, railOnSlider;
+  crankAxis.point = Vec3(-0.5, 0, 0);
+  crankPin.point = Vec3(0.5, 0, 0);
+  rodStart.point = Vec3(-1.0, 0, 0);
+  rodEnd.point = Vec3(1.0, 0, 0);
+  sliderCross.axes << 0, -1, 0, 1, 0, 0, 0, 0, 1;  // x along world y
+  rodEnd.axes.col(0) = Vec3::UnitY();
+  rodEnd.axes.col(1) = Vec3::UnitZ();  // the cross: y along rod axis z = x_rod x y_world
+  rodEnd.axes.col(2) = Vec3::UnitX();
+  rail.axes.col(0) = Vec3::UnitY();
+  rail.axes.col(1) = Vec3::UnitZ();
+  rail.axes.col(2) = Vec3::UnitX();
+  railOnSlider.axes = rail.axes;
+  const ConstraintIndex bearing = sys.addConstraint(
+      std::make_unique<SpatialJoint>("O1", SpatialJointType::Revolute, kGround, origin, crank, crankAxis));
+  sys.addConstraint(std::make_unique<SpatialJoint>("O2", SpatialJointType::Spherical, crank, crankPin, rod, rodStart));
+  sys.addConstraint(std::make_unique<SpatialJoint>("O3", SpatialJointType::Universal, slider, sliderCross, rod, rodEnd));
+  sys.addConstraint(std::make_unique<SpatialJoint>("P", SpatialJointType::Prismatic, kGround, rail, slider, railOnSlider));
+  const ConstraintIndex motor = sys.addConstraint(std::make_unique<SpatialJointAngleDriver>(
+      "motor", kGround, origin, crank, crankAxis, makeConstantSpeedLaw(1.0, 0.0)));
+  (void)bearing;
+  sys.finalize();
+  std::vector<double> xp, tp, xs, ts;
+  const int xPlanar = planar.system.coordinateOffset(planar.system.findBody("slider"));
+  const int motorPlanar = planar.system.constraintOffset(planar.system.findConstraint("motor"));
+  ASSERT_TRUE(simulate(planar.system, planar.solver, [&](const OutputSample& o) {
+                xp.push_back(o.q[xPlanar]);
+                tp.push_back(-o.lambda[motorPlanar]);
+              }).ok);
+  SolverSettings st = planar.solver;
+  const int xSpatial = sys.coordinateOffset(slider), motorSpatial = sys.constraintOffset(motor);
+  const SimulationSummary s = simulate(sys, st, [&](const OutputSample& o) {
+    xs.push_back(o.q[xSpatial]);
+    ts.push_back(-o.lambda[motorSpatial]);
+  });
+  ASSERT_TRUE(s.ok) << s.message;
+  ASSERT_EQ(xp.size(), xs.size());
+  double ex = 0.0, et = 0.0, tmax = 0.0;
+  for (size_t k = 0; k < xp.size(); ++k) {
+    ex = std::max(ex, std::abs(xp[k] - xs[k]));
+    et = std::max(et, std::abs(tp[k] - ts[k]));
+    tmax = std::max(tmax, std::abs(tp[k]));
+  }
+  EXPECT_LE(ex, 1e-7);
+  EXPECT_LE(et, 1e-6 * tmax);
+  RecordProperty("position_difference", sci(ex));
+  RecordProperty("torque_difference_relative", sci(et / tmax));
 }
