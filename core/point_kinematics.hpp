@@ -73,7 +73,7 @@ struct KinematicsWork {
   FrameKinematics fi, fj;  ///< spatial joints: the two frames
   Mat3X J1, J2, Jd;        ///< spatial joints: Jacobians of two vectors and of r_j - r_i (3 x nv)
   MatX C, Tinv, JT, JT2;   ///< spatial joints: a curvature term, T+ (nv x nq), products
-  RowVecX row3, row4, row5, row6;  ///< more 1 x n rows
+  RowVecX row3, row4, row5, row6, row7;  ///< more 1 x n rows
 };
 
 }  // namespace flexmbd

@@ -2,6 +2,9 @@
 
 #include "core/errors.hpp"
 #include "joints/frame_pair.hpp"
+#include "joints/spatial_drivers.hpp"
+
+#include <cmath>
 
 namespace flexmbd {
 
@@ -95,6 +98,51 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
   dfdq += damping_ * w.row4;
   dQdq->noalias() -= gradL.transpose() * dfdq;
   *dQdq -= f * Hl;
+}
+
+SpatialRotationalSpringDamper::SpatialRotationalSpringDamper(std::string name, BodyIndex bodyI,
+                                                             const JointFrame& frameI, BodyIndex bodyJ,
+                                                             const JointFrame& frameJ, double stiffness,
+                                                             double damping, double freeAngle)
+    : Force(std::move(name), {bodyI, bodyJ}), frameI_(frameI), frameJ_(frameJ), stiffness_(stiffness),
+      damping_(damping), freeAngle_(freeAngle) {
+  const std::string who = "force '" + this->name() + "'";
+  requireFinite(stiffness, who + ": stiffness");
+  requireFinite(damping, who + ": damping");
+  requireFinite(freeAngle, who + ": free_angle");
+  if (stiffness < 0.0 || damping < 0.0) throw InputError(who + ": stiffness and damping must be >= 0");
+}
+
+double SpatialRotationalSpringDamper::potentialEnergy(const BodyStates& bodies) const {
+  KinematicsWork w;
+  double theta = 0.0;
+  evaluateJointAngle(bodies, frameI_, frameJ_, w, theta, w.row7, nullptr);
+  const double a = std::remainder(theta - freeAngle_, 2.0 * M_PI);
+  return 0.5 * stiffness_ * a * a;
+}
+
+void SpatialRotationalSpringDamper::addForce(double, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq,
+                                             MatX* dQdv, KinematicsWork& w) const {
+  // tau = -k a - c theta', theta' = grad v;  Q = tau grad^T;
+  // dQ/dq = tau H + grad^T dtau/dq, dtau/dq = -k grad T+ - c v^T H;  dQ/dv = -c grad^T grad
+  double theta = 0.0;
+  RowVecX& grad = w.row7;
+  MatX& H = w.C;
+  evaluateJointAngle(bodies, frameI_, frameJ_, w, theta, grad, dQdq ? &H : nullptr);
+  const double a = std::remainder(theta - freeAngle_, 2.0 * M_PI);
+  const double tau = -stiffness_ * a - damping_ * grad.dot(v);
+  Q.noalias() += tau * grad.transpose();
+  if (dQdv) {
+    w.row6 = damping_ * grad;  // (rows sized nv; row3, row4 are nq-long: not reused across sizes)
+    dQdv->noalias() -= grad.transpose() * w.row6;
+  }
+  if (!dQdq) return;
+  w.row3.noalias() = grad * w.Tinv;
+  w.row3 *= -stiffness_;
+  w.row4.noalias() = v.transpose() * H;
+  w.row3 -= damping_ * w.row4;
+  *dQdq += tau * H;
+  dQdq->noalias() += grad.transpose() * w.row3;
 }
 
 }  // namespace flexmbd

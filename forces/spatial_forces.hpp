@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/time_law.hpp"
+#include "joints/frame_pair.hpp"
 
 namespace flexmbd {
 
@@ -44,6 +45,25 @@ class SpatialSpringDamper final : public Force {
  private:
   Vec3 pointI_, pointJ_;
   double stiffness_, damping_, freeLength_;
+};
+
+/// Torque -k (theta - theta0) - c theta' about a spatial revolute or cylindrical joint's
+/// axis, theta the joint angle of SpatialJointAngleDriver (frame j's x axis from frame i's,
+/// about frame i's z axis), taken within half a turn of theta0: Q = tau grad(theta)^T.
+class SpatialRotationalSpringDamper final : public Force {
+ public:
+  SpatialRotationalSpringDamper(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
+                                const JointFrame& frameJ, double stiffness, double damping, double freeAngle);
+  std::string typeName() const override { return "rotational_spring_damper"; }
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  double potentialEnergy(const BodyStates& bodies) const override;
+  bool isConservative() const override { return damping_ == 0.0; }
+
+ private:
+  JointFrame frameI_, frameJ_;
+  double stiffness_, damping_, freeAngle_;
 };
 
 }  // namespace flexmbd

@@ -189,10 +189,41 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
   r.peekName();
   const std::string type = readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load"});
-  if (type == "rotational_spring_damper") {
-    r.fail("a rotational_spring_damper is planar so far; in a spatial scene use spring_damper or applied_load");
-  }
   const std::string forA = " for a " + type + " force in a spatial scene";
+  if (type == "rotational_spring_damper") {
+    r.allowOnly(scenekeys::kRotationalSpringDamper, forA);
+    const std::string name = r.name("name");
+    const std::string jointName = r.name("joint");
+    const SpatialJoint& joint = spatialJoint(sys, lookupJoint(sys, jointName, r), r);
+    if (joint.type() != SpatialJointType::Revolute && joint.type() != SpatialJointType::Cylindrical) {
+      r.fail("a rotational_spring_damper needs a revolute or cylindrical joint, but joint " + inQuotes(jointName) +
+             " is " + joint.typeName());
+    }
+    const double stiffness = r.nonNegative("stiffness");
+    const double damping = r.nonNegative("damping", 0.0);
+    const BodyIndex bi = joint.bodies()[0], bj = joint.bodies()[1];
+    double freeAngle = 0.0;
+    if (r.has("free_angle")) {
+      freeAngle = r.number("free_angle");
+    } else {
+      // the joint angle in the initial positions
+      freeAngle = located(r.where(), [&] {
+        const VecX qi = sys.body(bi).initialCoordinates(), qj = sys.body(bj).initialCoordinates();
+        BodyStates states;
+        states.add(sys.body(bi), qi.data(), nullptr);
+        states.add(sys.body(bj), qj.data(), nullptr);
+        KinematicsWork w;
+        double theta = 0.0;
+        evaluateJointAngle(states, joint.frameI(), joint.frameJ(), w, theta, w.row7, nullptr);
+        return theta;
+      });
+    }
+    located(r.where(), [&] {
+      return sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(name, bi, joint.frameI(), bj, joint.frameJ(),
+                                                                          stiffness, damping, freeAngle));
+    });
+    return;
+  }
   if (type == "spring_damper") {
     r.allowOnly(scenekeys::kSpringDamper, forA);
     const std::string name = r.name("name");

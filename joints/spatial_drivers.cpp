@@ -19,45 +19,45 @@ SpatialJointAngleDriver::SpatialJointAngleDriver(std::string name, BodyIndex bod
 
 double SpatialJointAngleDriver::equationPeriod() const { return 2.0 * M_PI; }
 
-void SpatialJointAngleDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+void evaluateJointAngle(const BodyStates& bodies, const JointFrame& frameI, const JointFrame& frameJ,
+                        KinematicsWork& w, double& theta, RowVecX& grad, MatX* H) {
   // theta = atan2(s, c), s = y_i . x_j, c = x_i . x_j;  r^2 = s^2 + c^2
-  //   G = (c G_s - s G_c) / r^2
-  //   H = (c H_s - s H_c + G_s^T Gq_c - G_c^T Gq_s) / r^2 - G^T (2 s Gq_s + 2 c Gq_c) / r^2,
+  //   grad = (c G_s - s G_c) / r^2
+  //   H = (c H_s - s H_c + G_s^T Gq_c - G_c^T Gq_s) / r^2 - grad^T (2 s Gq_s + 2 c Gq_c) / r^2,
   // with Gq = G T+ the coordinate gradients.
-  KinematicsWork& w = out.work;
-  FramePair pair(bodies, frameI_, frameJ_, withHessians, w);
+  FramePair pair(bodies, frameI, frameJ, H != nullptr, w);
   const int n = pair.numVelocities(), nq = pair.numCoordinates();
   double s = 0.0, c = 0.0;
   w.row.resize(n);
   w.row2.resize(n);
-  MatX* Hs = nullptr;
-  MatX* Hc = nullptr;
-  if (withHessians) {
-    out.H.resize(1);
+  if (H) {
     w.hessian.setZero(n, nq);
-    out.H[0].setZero(n, nq);
-    Hs = &w.hessian;
-    Hc = &out.H[0];
+    H->setZero(n, nq);
   }
-  pair.axisAxis(1, 0, s, w.row, Hs);
-  pair.axisAxis(0, 0, c, w.row2, Hc);
+  pair.axisAxis(1, 0, s, w.row, H ? &w.hessian : nullptr);
+  pair.axisAxis(0, 0, c, w.row2, H);
   const double r2 = s * s + c * c;
-  out.h.setConstant(1, std::atan2(s, c));
-  out.G.resize(1, n);
-  out.G.row(0) = (c * w.row - s * w.row2) / r2;
-  if (!withHessians) return;
-  RowVecX &gqs = w.row3, &gqc = w.row4, &k = w.row5, &g = w.row6;
+  theta = std::atan2(s, c);
+  grad = (c * w.row - s * w.row2) / r2;
+  if (!H) return;
+  RowVecX &gqs = w.row3, &gqc = w.row4, &k = w.row5;
   gqs.noalias() = w.row * pair.Tinv();
   gqc.noalias() = w.row2 * pair.Tinv();
   k = (2.0 * s / r2) * gqs + (2.0 * c / r2) * gqc;
-  g = out.G.row(0);
-  MatX& H = out.H[0];
-  H = (c * w.hessian - s * H) / r2;  // H held H_c
-  H.noalias() -= g.transpose() * k;
+  *H = (c * w.hessian - s * *H) / r2;  // H held H_c
+  H->noalias() -= grad.transpose() * k;
   gqs /= r2;
   gqc /= r2;
-  H.noalias() += w.row.transpose() * gqc;
-  H.noalias() -= w.row2.transpose() * gqs;
+  H->noalias() += w.row.transpose() * gqc;
+  H->noalias() -= w.row2.transpose() * gqs;
+}
+
+void SpatialJointAngleDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
+  double theta = 0.0;
+  if (withHessians) out.H.resize(1);
+  evaluateJointAngle(bodies, frameI_, frameJ_, out.work, theta, out.work.row6, withHessians ? &out.H[0] : nullptr);
+  out.h.setConstant(1, theta);
+  out.G = out.work.row6;
 }
 
 SpatialJointDisplacementDriver::SpatialJointDisplacementDriver(std::string name, BodyIndex bodyI,

@@ -7,6 +7,12 @@
 
 namespace flexmbd {
 
+/// theta = atan2(y_i . x_j, x_i . x_j), the rotation of frame j about frame i's z axis,
+/// with its gradient (1 x nv) and, if H is given, H = d(grad^T)/dq (nv x nq), using
+/// `work` (its rows row..row6 and hessian; grad and H must be other storage).
+void evaluateJointAngle(const BodyStates& bodies, const JointFrame& frameI, const JointFrame& frameJ,
+                        KinematicsWork& work, double& theta, RowVecX& grad, MatX* H);
+
 /// Base of drivers between two body frames.
 class FramePairConstraint : public Constraint {
  public:

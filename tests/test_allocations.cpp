@@ -224,6 +224,7 @@ TEST(Allocations, EverySpatialJointDriverAndForceType) {
       std::make_unique<SpatialJointDisplacementDriver>("slide", b[1], f0, b[2], f1, makeConstantSpeedLaw(0.1, 0.5)));
   sys.addBodyCoordinateDriver("z", b[7], "z", makeConstantLaw(0.0));
   sys.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), b[3], f1.point, 100.0, 2.0, 0.5));
+  sys.addForce(std::make_unique<SpatialRotationalSpringDamper>("torsion", b[0], f0, b[1], f1, 10.0, 0.5, 0.1));
   sys.addForce(std::make_unique<SpatialAppliedLoad>(
       "load", b[4], f1.point,
       std::array<TimeLawPtr, 6>{makeConstantLaw(1.0), nullptr, makeHarmonicLaw(2.0, 1.0), nullptr, makeConstantLaw(0.3), nullptr}));

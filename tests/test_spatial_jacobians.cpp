@@ -313,7 +313,7 @@ INSTANTIATE_TEST_SUITE_P(AllFormulations, SpatialDaeJacobian,
                          ::testing::Values(Formulation::Ggl, Formulation::Index3, Formulation::Index1),
                          [](const auto& info) { return toString(info.param); });
 
-TEST(SpatialForceDerivatives, SpringDamperAndAppliedLoadMatchFiniteDifferences) {
+TEST(SpatialForceDerivatives, SpringDampersAndAppliedLoadMatchFiniteDifferences) {
   Random rnd(kSeed + 50);
   for (int s = 0; s < kSamples; ++s) {
     for (const bool toGround : {false, true}) {
@@ -326,12 +326,18 @@ TEST(SpatialForceDerivatives, SpringDamperAndAppliedLoadMatchFiniteDifferences) 
           "load", b, Vec3(rnd.vector(3, -1, 1)),
           std::array<TimeLawPtr, 6>{makeConstantLaw(1.0), makeHarmonicLaw(2.0, 3.0), nullptr, makeConstantLaw(-0.5),
                                     nullptr, makeConstantLaw(0.7)}));
+      JointFrame fi, fj;
+      fi.point = rnd.vector(3, -1.0, 1.0);
+      fi.axes = randomRotation(rnd);
+      fj.axes = randomRotation(rnd);
+      const ForceIndex torsion = sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(
+          "torsion", toGround ? kGround : a, fi, b, fj, 30.0, 1.5, 0.2));
       sys.finalize();
       VecX q(sys.numCoordinates());
       for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
       const VecX vAll = rnd.vector(sys.numVelocities(), -1.0, 1.0);
       const std::string at = std::string(toGround ? "to ground, " : "") + "sample " + std::to_string(s);
-      for (ForceIndex fi : {spring, load}) {
+      for (ForceIndex fi : {spring, load, torsion}) {
         const Force& f = sys.force(fi);
         const auto& vcols = sys.forceColumns(fi);
         const auto& qcols = sys.forceCoordinateColumns(fi);
@@ -354,20 +360,22 @@ TEST(SpatialForceDerivatives, SpringDamperAndAppliedLoadMatchFiniteDifferences) 
         expectMatrixNear(dQdv, fdJacobian([&](const VecX& z) { return QOf(ql, z); }, vl), kFdTol,
                          f.name() + " dQ/dv, " + at, 1.0);
       }
-      // the spring's elastic force is -dV along the velocity directions (no damping: v = 0)
-      const Force& sp = sys.force(spring);
-      const auto& vcols = sys.forceColumns(spring);
-      VecX Q = VecX::Zero(vcols.size());
-      sp.addForce(0.0, sys.forceStates(spring, q.data()), VecX::Zero(vcols.size()), Q, nullptr, nullptr);
-      VecX gradV(vcols.size());
-      for (size_t k = 0; k < vcols.size(); ++k) {
-        VecX dv = VecX::Zero(sys.numVelocities());
-        dv[vcols[k]] = kFdRelStep;
-        const VecX qp = sys.applyIncrement(q, dv), qm = sys.applyIncrement(q, -dv);
-        gradV[k] = (sp.potentialEnergy(sys.forceStates(spring, qp.data())) -
-                    sp.potentialEnergy(sys.forceStates(spring, qm.data()))) / (2.0 * kFdRelStep);
+      // the springs' elastic forces are -dV along the velocity directions (v = 0: no damping)
+      for (ForceIndex fi : {spring, torsion}) {
+        const Force& sp = sys.force(fi);
+        const auto& vcols = sys.forceColumns(fi);
+        VecX Q = VecX::Zero(vcols.size());
+        sp.addForce(0.0, sys.forceStates(fi, q.data()), VecX::Zero(vcols.size()), Q, nullptr, nullptr);
+        VecX gradV(vcols.size());
+        for (size_t k = 0; k < vcols.size(); ++k) {
+          VecX dv = VecX::Zero(sys.numVelocities());
+          dv[vcols[k]] = kFdRelStep;
+          const VecX qp = sys.applyIncrement(q, dv), qm = sys.applyIncrement(q, -dv);
+          gradV[k] = (sp.potentialEnergy(sys.forceStates(fi, qp.data())) -
+                      sp.potentialEnergy(sys.forceStates(fi, qm.data()))) / (2.0 * kFdRelStep);
+        }
+        expectMatrixNear(Q, -gradV, kFdTol, sp.name() + " force = -dV, " + at, 1.0);
       }
-      expectMatrixNear(Q, -gradV, kFdTol, "spring force = -dV, " + at, 1.0);
     }
   }
 }
