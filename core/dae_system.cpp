@@ -3,17 +3,13 @@
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
 
 namespace flexmbd {
 namespace {
 
 using ConstMap = Eigen::Map<const VecX>;
 
-/// out[k] = x[cols[k]]
-void gather(const std::vector<int>& cols, const double* x, VecX& out) {
-  out.resize(static_cast<Eigen::Index>(cols.size()));
-  for (size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
-}
 
 /// (column k of G) . x
 double columnDot(const MatX& G, int k, const double* x) {

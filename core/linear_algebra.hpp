@@ -7,6 +7,13 @@
 
 namespace flexmbd {
 
+/// out[k] = x[cols[k]]: the entries of a global vector a component uses (resizes out;
+/// allocates only when it grows).
+inline void gather(const std::vector<int>& cols, const double* x, VecX& out) {
+  out.resize(static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
+}
+
 /// Indices of the rows of A that are linearly dependent on earlier rows (modified
 /// Gram-Schmidt in row order; a row whose remainder is below rankTolerance times its
 /// own norm is dependent). Reports the later of two conflicting rows, so errors can

@@ -1,13 +1,15 @@
 #include "core/system_evaluation.hpp"
 
+#include "core/linear_algebra.hpp"
+
 #include <cmath>
 
 namespace flexmbd {
 namespace {
 
 VecX gather(const std::vector<int>& cols, const VecX& x) {
-  VecX out(cols.size());
-  for (size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
+  VecX out;
+  flexmbd::gather(cols, x.data(), out);
   return out;
 }
 
