@@ -145,4 +145,82 @@ void SpatialRotationalSpringDamper::addForce(double, const BodyStates& bodies, c
   dQdq->noalias() += grad.transpose() * w.row3;
 }
 
+SpatialBushing::SpatialBushing(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
+                               const JointFrame& frameJ, const std::array<double, 6>& stiffness,
+                               const std::array<double, 6>& damping)
+    : Force(std::move(name), {bodyI, bodyJ}), frameI_(frameI), frameJ_(frameJ), stiffness_(stiffness),
+      damping_(damping) {
+  const std::string who = "force '" + this->name() + "'";
+  if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
+  checkJointFrame(frameI, who + " frame 0");
+  checkJointFrame(frameJ, who + " frame 1");
+  for (int k = 0; k < 6; ++k) {
+    requireFinite(stiffness[k], who + ": stiffness[" + std::to_string(k) + "]");
+    requireFinite(damping[k], who + ": damping[" + std::to_string(k) + "]");
+    if (stiffness[k] < 0.0 || damping[k] < 0.0) throw InputError(who + ": stiffness and damping must be >= 0");
+  }
+}
+
+bool SpatialBushing::isConservative() const {
+  for (double c : damping_) {
+    if (c != 0.0) return false;
+  }
+  return true;
+}
+
+double SpatialBushing::measure(int k, FramePair& pair, KinematicsWork& w, RowVecX& grad, MatX* H) const {
+  if (k < 3) {
+    double c = 0.0;
+    pair.axisGap(k, c, grad, H);
+    return c;
+  }
+  // rotation about axis a of frame i: (x_b^i . x_c^j - x_c^i . x_b^j) / 2, (a, b, c) cyclic
+  const int a = k - 3, b = (a + 1) % 3, c = (a + 2) % 3;
+  double s1 = 0.0, s2 = 0.0;
+  pair.axisAxis(b, c, s1, grad, H);
+  if (H) *H *= -1.0;  // accumulate -H of the second term, then flip back
+  pair.axisAxis(c, b, s2, w.row5, H);
+  if (H) *H *= -0.5;
+  grad = 0.5 * (grad - w.row5);
+  return 0.5 * (s1 - s2);
+}
+
+double SpatialBushing::potentialEnergy(const BodyStates& bodies) const {
+  KinematicsWork w;
+  FramePair pair(bodies, frameI_, frameJ_, false, w);
+  double V = 0.0;
+  for (int k = 0; k < 6; ++k) {
+    const double c = measure(k, pair, w, w.row7, nullptr);
+    V += 0.5 * stiffness_[k] * c * c;
+  }
+  return V;
+}
+
+void SpatialBushing::addForce(double, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                              KinematicsWork& w) const {
+  // per measure: f = K c + C c', c' = grad v;  Q -= f grad^T;  dQ/dv -= C grad^T grad;
+  // dQ/dq -= f H + grad^T (K grad T+ + C v^T H)
+  FramePair pair(bodies, frameI_, frameJ_, dQdq != nullptr, w);
+  RowVecX& grad = w.row7;
+  MatX& H = w.C;
+  for (int k = 0; k < 6; ++k) {
+    if (stiffness_[k] == 0.0 && damping_[k] == 0.0) continue;
+    if (dQdq) H.setZero(pair.numVelocities(), pair.numCoordinates());
+    const double c = measure(k, pair, w, grad, dQdq ? &H : nullptr);
+    const double f = stiffness_[k] * c + damping_[k] * grad.dot(v);
+    Q.noalias() -= f * grad.transpose();
+    if (dQdv) {
+      w.row6 = damping_[k] * grad;
+      dQdv->noalias() -= grad.transpose() * w.row6;
+    }
+    if (!dQdq) continue;
+    w.row3.noalias() = grad * pair.Tinv();
+    w.row3 *= stiffness_[k];
+    w.row4.noalias() = v.transpose() * H;
+    w.row3 += damping_[k] * w.row4;
+    *dQdq -= f * H;
+    dQdq->noalias() -= grad.transpose() * w.row3;
+  }
+}
+
 }  // namespace flexmbd

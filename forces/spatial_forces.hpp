@@ -66,4 +66,28 @@ class SpatialRotationalSpringDamper final : public Force {
   double stiffness_, damping_, freeAngle_;
 };
 
+/// Six-component bushing between frame i (body i) and frame j (body j): the measures
+///   c = (x_i . d, y_i . d, z_i . d,                         (d = r_j - r_i: translations in frame i)
+///        (y_i . z_j - z_i . y_j) / 2, (z_i . x_j - x_i . z_j) / 2, (x_i . y_j - y_i . x_j) / 2)
+/// (the last three: the relative rotation about x_i, y_i, z_i, exact to second order in
+/// the angles) with generalised force Q = -sum_k (K_k c_k + C_k c_k') grad(c_k)^T. For the
+/// small relative motions of an elastic mount; its energy is 1/2 sum_k K_k c_k^2.
+class SpatialBushing final : public Force {
+ public:
+  SpatialBushing(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
+                 const JointFrame& frameJ, const std::array<double, 6>& stiffness, const std::array<double, 6>& damping);
+  std::string typeName() const override { return "bushing"; }
+  void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+                KinematicsWork& work) const override;
+  using Force::addForce;
+  double potentialEnergy(const BodyStates& bodies) const override;
+  bool isConservative() const override;
+
+ private:
+  /// c_k with its gradient into `grad` and, if H, its d(grad^T)/dq into *H (work rows used).
+  double measure(int k, FramePair& pair, KinematicsWork& w, RowVecX& grad, MatX* H) const;
+  JointFrame frameI_, frameJ_;
+  std::array<double, 6> stiffness_, damping_;
+};
+
 }  // namespace flexmbd

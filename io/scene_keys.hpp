@@ -61,6 +61,7 @@ inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia",
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames"};
 inline const Keys kJointFrame = {"point", "axis", "orientation"};
+inline const Keys kBushing = {"name", "type", "bodies", "frames", "stiffness", "damping"};
 inline const Keys kSpatialAppliedLoad = {"name",    "type",     "body",     "point",    "force_x",
                                          "force_y", "force_z",  "torque_x", "torque_y", "torque_z"};
 
@@ -137,6 +138,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"joint.frame", &kJointFrame},
       {"driver.body_z", &kBodyDriver},
       {"force.applied_load.3d", &kSpatialAppliedLoad},
+      {"force.bushing", &kBushing},
       {"kinematics", &kKinematicsScene},
       {"kinematics.node.fixed", &kKinematicsNode},
       {"kinematics.node.free", &kKinematicsNode},

@@ -188,8 +188,30 @@ void parseSpatialDriver(const json& j, const std::string& where, System& sys) {
 void parseSpatialForce(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
   r.peekName();
-  const std::string type = readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load"});
+  const std::string type =
+      readType(r, "force", {"spring_damper", "rotational_spring_damper", "applied_load", "bushing"});
   const std::string forA = " for a " + type + " force in a spatial scene";
+  if (type == "bushing") {
+    r.allowOnly(scenekeys::kBushing, forA);
+    const std::string name = r.name("name");
+    const auto bodyNames = r.namePair("bodies");
+    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
+    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
+    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a bushing connects two different bodies");
+    const json& frames = r.requiredArray("frames");
+    if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
+    const JointFrame fi = parseJointFrame(frames[0], r.where() + ".frames[0]");
+    const JointFrame fj = parseJointFrame(frames[1], r.where() + ".frames[1]");
+    std::array<double, 6> k{}, c{};
+    const VecX kv = r.vector("stiffness", 6);
+    const VecX cv = r.has("damping") ? r.vector("damping", 6) : VecX::Zero(6);
+    for (int a = 0; a < 6; ++a) {
+      k[a] = r.checkNonNegative(kv[a], "stiffness[" + std::to_string(a) + "]");
+      c[a] = r.checkNonNegative(cv[a], "damping[" + std::to_string(a) + "]");
+    }
+    located(r.where(), [&] { return sys.addForce(std::make_unique<SpatialBushing>(name, bi, fi, bj, fj, k, c)); });
+    return;
+  }
   if (type == "rotational_spring_damper") {
     r.allowOnly(scenekeys::kRotationalSpringDamper, forA);
     const std::string name = r.name("name");

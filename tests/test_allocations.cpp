@@ -225,6 +225,8 @@ TEST(Allocations, EverySpatialJointDriverAndForceType) {
   sys.addBodyCoordinateDriver("z", b[7], "z", makeConstantLaw(0.0));
   sys.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), b[3], f1.point, 100.0, 2.0, 0.5));
   sys.addForce(std::make_unique<SpatialRotationalSpringDamper>("torsion", b[0], f0, b[1], f1, 10.0, 0.5, 0.1));
+  sys.addForce(std::make_unique<SpatialBushing>("bushing", b[5], f1, b[6], f0, std::array<double, 6>{1, 2, 3, 4, 5, 6},
+                                                std::array<double, 6>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
   sys.addForce(std::make_unique<SpatialAppliedLoad>(
       "load", b[4], f1.point,
       std::array<TimeLawPtr, 6>{makeConstantLaw(1.0), nullptr, makeHarmonicLaw(2.0, 1.0), nullptr, makeConstantLaw(0.3), nullptr}));

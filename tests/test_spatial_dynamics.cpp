@@ -16,6 +16,7 @@
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
+#include "forces/spatial_forces.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 
@@ -487,4 +488,36 @@ TEST(HeavyTop, NutationStaysBetweenTheClosedFormBounds) {
   RecordProperty("theta1", sci(theta1));
   RecordProperty("max_tilt_error", sci(std::abs(hi - theta1)));
   RecordProperty("min_tilt_error", sci(std::abs(lo - theta0)));
+}
+
+TEST(SpatialBushing, MountedBodyOscillatesAtTheClosedFormFrequencies) {
+  // A body on a bushing to the ground, no gravity: along z the mount is a linear spring,
+  // z(t) = (v0 / w) sin(w t), w = sqrt(kz / m); about z a torsion spring of measure
+  // sin(theta) (to second order theta), so for a 1e-4 rad amplitude
+  // theta(t) = (w0 / W) sin(W t), W = sqrt(krz / Izz), to ~1e-8 relative.
+  constexpr double m = 2.0, Izz = 0.05, kz = 800.0, krz = 20.0, v0 = 0.01, w0 = 1e-3;
+  System sys;
+  RigidBody3dProperties p;
+  p.mass = m;
+  p.inertia = Vec3(0.04, 0.045, Izz).asDiagonal();
+  FrameState3d s0;
+  s0.velocity = Vec3(0.0, 0.0, v0);
+  s0.angularVelocity = Vec3(0.0, 0.0, w0);
+  const BodyIndex b = sys.addBody(std::make_unique<RigidBody3d>("mass", p, s0));
+  sys.addForce(std::make_unique<SpatialBushing>("mount", kGround, JointFrame{}, b, JointFrame{},
+                                                std::array<double, 6>{500.0, 600.0, kz, 30.0, 40.0, krz},
+                                                std::array<double, 6>{}));
+  sys.finalize();
+  const double w = std::sqrt(kz / m), W = std::sqrt(krz / Izz);
+  double ez = 0.0, et = 0.0;
+  const SimulationSummary s = simulate(sys, settings(1.0, 1e-10, 0.005), [&](const OutputSample& o) {
+    ez = std::max(ez, std::abs(o.q[2] - v0 / w * std::sin(w * o.t)));
+    const Mat3 A = RigidBody3d::rotationOf(o.q.segment(sys.coordinateOffset(b), 7));
+    et = std::max(et, std::abs(std::atan2(A(1, 0), A(0, 0)) - w0 / W * std::sin(W * o.t)));
+  });
+  ASSERT_TRUE(s.ok) << s.message;
+  EXPECT_LE(ez, 1e-6 * v0 / w);
+  EXPECT_LE(et, 1e-6 * w0 / W);
+  RecordProperty("z_error_relative", sci(ez / (v0 / w)));
+  RecordProperty("angle_error_relative", sci(et / (w0 / W)));
 }

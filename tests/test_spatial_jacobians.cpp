@@ -313,7 +313,7 @@ INSTANTIATE_TEST_SUITE_P(AllFormulations, SpatialDaeJacobian,
                          ::testing::Values(Formulation::Ggl, Formulation::Index3, Formulation::Index1),
                          [](const auto& info) { return toString(info.param); });
 
-TEST(SpatialForceDerivatives, SpringDampersAndAppliedLoadMatchFiniteDifferences) {
+TEST(SpatialForceDerivatives, SpringDampersBushingAndAppliedLoadMatchFiniteDifferences) {
   Random rnd(kSeed + 50);
   for (int s = 0; s < kSamples; ++s) {
     for (const bool toGround : {false, true}) {
@@ -332,12 +332,15 @@ TEST(SpatialForceDerivatives, SpringDampersAndAppliedLoadMatchFiniteDifferences)
       fj.axes = randomRotation(rnd);
       const ForceIndex torsion = sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(
           "torsion", toGround ? kGround : a, fi, b, fj, 30.0, 1.5, 0.2));
+      const ForceIndex bushing = sys.addForce(std::make_unique<SpatialBushing>(
+          "bushing", toGround ? kGround : a, fj, b, fi, std::array<double, 6>{10, 20, 30, 4, 5, 6},
+          std::array<double, 6>{0.1, 0.2, 0.3, 0.04, 0.05, 0.06}));
       sys.finalize();
       VecX q(sys.numCoordinates());
       for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
       const VecX vAll = rnd.vector(sys.numVelocities(), -1.0, 1.0);
       const std::string at = std::string(toGround ? "to ground, " : "") + "sample " + std::to_string(s);
-      for (ForceIndex fi : {spring, load, torsion}) {
+      for (ForceIndex fi : {spring, load, torsion, bushing}) {
         const Force& f = sys.force(fi);
         const auto& vcols = sys.forceColumns(fi);
         const auto& qcols = sys.forceCoordinateColumns(fi);
@@ -361,7 +364,7 @@ TEST(SpatialForceDerivatives, SpringDampersAndAppliedLoadMatchFiniteDifferences)
                          f.name() + " dQ/dv, " + at, 1.0);
       }
       // the springs' elastic forces are -dV along the velocity directions (v = 0: no damping)
-      for (ForceIndex fi : {spring, torsion}) {
+      for (ForceIndex fi : {spring, torsion, bushing}) {
         const Force& sp = sys.force(fi);
         const auto& vcols = sys.forceColumns(fi);
         VecX Q = VecX::Zero(vcols.size());
