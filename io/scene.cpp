@@ -592,11 +592,9 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
     return {f.r.x(), f.r.y(), f.r.z(), vel.x(), vel.y(), vel.z()};
   }
   if (type == Type::Deflection) {
-    const FfrBeamModel& model = *static_cast<const FfrBody2d&>(b).beamModel();
-    const VecX qf = q.segment(off + 3, model.numElastic());
-    const Vec2 u = model.materialPoint(element, xi).shape * qf;
-    const Vec2 f = model.sectionForces(qf, element, xi);
-    return {u.x(), u.y(), f.x(), f.y()};
+    const FfrBody2d::BeamDeflection d =
+        static_cast<const FfrBody2d&>(b).beamDeflection(q.segment(off, b.numCoordinates()), element, xi);
+    return {d.displacement.x(), d.displacement.y(), d.sectionForces.x(), d.sectionForces.y()};
   }
   const int n = b.numCoordinates();
   const PointKinematics pk = b.pointKinematics(q.segment(off, n), point, false);
