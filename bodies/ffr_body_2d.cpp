@@ -337,4 +337,23 @@ Vec2 FfrBody2d::planarCentreOfMass(const ConstVecRef& q) const {
   return q.head<2>() + rotation(q[2]) * (inv_.firstMoment + inv_.sBar * q.tail(numElastic())) / inv_.mass;
 }
 
+FfrBody2d::BeamDeflection FfrBody2d::beamDeflection(const ConstVecRef& q, int element, double xi) const {
+  if (!model_) {
+    throw InputError("body '" + name() + "': not made from a beam mesh; its deflection and section forces are unknown");
+  }
+  const VecX qf = q.tail(model_->numElastic());
+  const FfrPoint p = model_->materialPoint(element, xi);
+  BeamDeflection d;
+  d.displacement = p.shape * qf;
+  d.sectionForces = model_->sectionForces(qf, element, xi);
+  const Mat2 A = rotation(q[2]);
+  d.position = q.head<2>() + A * (p.position + d.displacement);
+  d.worldDisplacement = A * d.displacement;
+  return d;
+}
+
+Vec2 FfrBody2d::worldElasticDisplacement(const ConstVecRef& q, const FfrPoint& p) const {
+  return rotation(q[2]) * (p.shape * q.tail(numElastic()));
+}
+
 }  // namespace flexmbd

@@ -74,6 +74,22 @@ class FfrBody2d final : public Body {
   /// Kinematics of any FfrPoint (e.g. a point inside an element, for outputs).
   PointKinematics pointKinematics(const ConstVecRef& q, const FfrPoint& p, bool withHessians = true) const;
 
+  // ----- outputs, from the body's own coordinates q (numCoordinates(): x, y, theta, q_f) --
+  /// The deformation at a point of the generating beam mesh's axis.
+  struct BeamDeflection {
+    Vec2 displacement = Vec2::Zero();       ///< elastic displacement u = N q_f, body axes (ux, uy)
+    Vec2 sectionForces = Vec2::Zero();      ///< axial force N, bending moment M
+    Vec2 position = Vec2::Zero();           ///< deformed position, world axes: R + A (u0 + u)
+    Vec2 worldDisplacement = Vec2::Zero();  ///< A u
+  };
+  /// At `xi` in [0, 1] along element `element` of beamModel() (FfrBeamModel::locate finds
+  /// them for a point of the undeformed axis).
+  /// @throws InputError naming the body if it was not made from a beam mesh.
+  BeamDeflection beamDeflection(const ConstVecRef& q, int element, double xi) const;
+  /// Elastic displacement N q_f of a point of the invariants (e.g. invariants().points[k]),
+  /// world axes: A(theta) N q_f.
+  Vec2 worldElasticDisplacement(const ConstVecRef& q, const FfrPoint& p) const;
+
  private:
   int findPoint(const Vec2& point) const;
   /// Mass matrix blocks: frame-frame (3 x 3) and column k of frame-elastic (3 x nf).

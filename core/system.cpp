@@ -6,17 +6,8 @@
 #include <optional>
 #include <set>
 
-
-#include "bodies/ground.hpp"
-#include "bodies/rigid_body_2d.hpp"
 #include "core/errors.hpp"
-#include "forces/applied_load.hpp"
-#include "forces/rotational_spring_damper.hpp"
-#include "forces/spring_damper.hpp"
-#include "joints/drivers.hpp"
-#include "joints/fixed_joint.hpp"
-#include "joints/prismatic_joint.hpp"
-#include "joints/revolute_joint.hpp"
+#include "core/ground.hpp"
 
 namespace flexmbd {
 
@@ -96,111 +87,6 @@ void System::setGravity(const Vec3& g) {
   requireBuildPhase("gravity");
   for (int k = 0; k < 3; ++k) requireFinite(g[k], "gravity[" + std::to_string(k) + "]");
   gravity_ = g;
-}
-
-BodyIndex System::addRigidBody(const std::string& name, const RigidBodyProperties& props,
-                               const FrameState2d& initial) {
-  return addBody(std::make_unique<RigidBody2d>(name, props, initial));
-}
-
-double System::initialRelativeAngle(BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
-                                    const Vec2& pointJ) const {
-  const VecX qi = body(bodyI).initialCoordinates();
-  const VecX qj = body(bodyJ).initialCoordinates();
-  return body(bodyJ).pointKinematics(qj, pointJ, false).phi - body(bodyI).pointKinematics(qi, pointI, false).phi;
-}
-
-ConstraintIndex System::addRevoluteJoint(const std::string& name, BodyIndex bodyI,
-                                         const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ) {
-  checkBody(bodyI, "joint '" + name + "'");
-  checkBody(bodyJ, "joint '" + name + "'");
-  return addConstraint(std::make_unique<RevoluteJoint>(name, bodyI, pointI, bodyJ, pointJ));
-}
-
-ConstraintIndex System::addPrismaticJoint(const std::string& name, BodyIndex bodyI,
-                                          const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ,
-                                          const Vec2& axis) {
-  checkBody(bodyI, "joint '" + name + "'");
-  checkBody(bodyJ, "joint '" + name + "'");
-  const double phi0 = initialRelativeAngle(bodyI, pointI, bodyJ, pointJ);
-  return addConstraint(
-      std::make_unique<PrismaticJoint>(name, bodyI, pointI, bodyJ, pointJ, axis, phi0));
-}
-
-ConstraintIndex System::addFixedJoint(const std::string& name, BodyIndex bodyI,
-                                      const Vec2& pointI, BodyIndex bodyJ, const Vec2& pointJ) {
-  checkBody(bodyI, "joint '" + name + "'");
-  checkBody(bodyJ, "joint '" + name + "'");
-  const double phi0 = initialRelativeAngle(bodyI, pointI, bodyJ, pointJ);
-  return addConstraint(std::make_unique<FixedJoint>(name, bodyI, pointI, bodyJ, pointJ, phi0));
-}
-
-ConstraintIndex System::addBodyCoordinateDriver(const std::string& name, BodyIndex b,
-                                                const std::string& coordinate, TimeLawPtr law) {
-  checkBody(b, "driver '" + name + "'");
-  const auto names = body(b).coordinateNames();
-  for (int k = 0; k < static_cast<int>(names.size()); ++k) {
-    if (names[k] == coordinate) {
-      if (body(b).coordinatesOfVelocities({k}) != std::vector<int>{k}) {
-        throw InputError("driver '" + name + "': coordinate '" + coordinate + "' of body '" + body(b).name() +
-                         "' is a rotation parameter; drive a joint angle instead");
-      }
-      return addConstraint(std::make_unique<BodyCoordinateDriver>(name, b, k, coordinate, std::move(law)));
-    }
-  }
-  std::string known;
-  for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-  throw InputError("driver '" + name + "': body '" + body(b).name() + "' has no coordinate '" +
-                   coordinate + "' (it has: " + (known.empty() ? "none" : known) + ")");
-}
-
-ConstraintIndex System::addJointDriver(const std::string& name, ConstraintIndex joint,
-                                       TimeLawPtr law) {
-  if (joint.value < 0 || joint.value >= numConstraints()) {
-    throw InputError("driver '" + name + "': joint index does not exist");
-  }
-  const Constraint& c = constraint(joint);
-  if (const auto* r = dynamic_cast<const RevoluteJoint*>(&c)) {
-    return addConstraint(std::make_unique<JointAngleDriver>(name, r->bodies()[0], r->pointI(),
-                                                            r->bodies()[1], r->pointJ(), std::move(law)));
-  }
-  if (const auto* p = dynamic_cast<const PrismaticJoint*>(&c)) {
-    return addConstraint(std::make_unique<JointDisplacementDriver>(
-        name, p->bodies()[0], p->pointI(), p->bodies()[1], p->pointJ(), p->axis(), std::move(law)));
-  }
-  throw InputError("driver '" + name + "': joint '" + c.name() + "' is a " + c.typeName() +
-                   " joint; expected a revolute (angle) or prismatic (displacement) joint");
-}
-
-ForceIndex System::addSpringDamper(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
-                                   BodyIndex bodyJ, const Vec2& pointJ, double stiffness,
-                                   double damping, double freeLength) {
-  checkBody(bodyI, "force '" + name + "'");
-  checkBody(bodyJ, "force '" + name + "'");
-  return addForce(std::make_unique<SpringDamper>(name, bodyI, pointI, bodyJ, pointJ, stiffness,
-                                                 damping, freeLength));
-}
-
-ForceIndex System::addRotationalSpringDamper(const std::string& name, ConstraintIndex joint,
-                                             double stiffness, double damping, double freeAngle) {
-  if (joint.value < 0 || joint.value >= numConstraints()) {
-    throw InputError("force '" + name + "': joint index does not exist");
-  }
-  const auto* r = dynamic_cast<const RevoluteJoint*>(&constraint(joint));
-  if (!r) {
-    throw InputError("force '" + name + "': joint '" + constraint(joint).name() +
-                     "' is not a revolute joint; a rotational spring-damper needs one");
-  }
-  return addForce(std::make_unique<RotationalSpringDamper>(name, r->bodies()[0], r->pointI(),
-                                                           r->bodies()[1], r->pointJ(), stiffness,
-                                                           damping, freeAngle));
-}
-
-ForceIndex System::addAppliedLoad(const std::string& name, BodyIndex b, const Vec2& point,
-                                  TimeLawPtr forceX, TimeLawPtr forceY, TimeLawPtr torque) {
-  checkBody(b, "force '" + name + "'");
-  return addForce(std::make_unique<AppliedLoad>(name, b, point, std::move(forceX),
-                                                std::move(forceY), std::move(torque)));
 }
 
 BodyIndex System::findBody(const std::string& name) const {

@@ -13,9 +13,6 @@
 
 namespace flexmbd {
 
-struct RigidBodyProperties;
-struct FrameState2d;
-
 /// A planar multibody system. Build phase: add*; then finalize(); afterwards the model
 /// is immutable and add* throws InputError. Body 0 is the ground ("ground").
 class System {
@@ -33,30 +30,8 @@ class System {
   void setGravity(const Vec3& g);
   void setGravity(const Vec2& g) { setGravity(lift(g)); }
 
-  // Convenience builders (the C++ API most users need).
-  BodyIndex addRigidBody(const std::string& name, const RigidBodyProperties& props,
-                         const FrameState2d& initial);
-  ConstraintIndex addRevoluteJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
-                                   BodyIndex bodyJ, const Vec2& pointJ);
-  /// The relative rotation is locked at its value in the initial positions.
-  ConstraintIndex addPrismaticJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
-                                    BodyIndex bodyJ, const Vec2& pointJ, const Vec2& axis);
-  /// The relative rotation is locked at its value in the initial positions.
-  ConstraintIndex addFixedJoint(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
-                                BodyIndex bodyJ, const Vec2& pointJ);
-  /// Prescribes coordinate `coordinate` ("x", "y", "theta", ...) of a body.
-  ConstraintIndex addBodyCoordinateDriver(const std::string& name, BodyIndex body,
-                                          const std::string& coordinate, TimeLawPtr law);
-  /// Prescribes a revolute joint's relative angle or a prismatic joint's displacement.
-  ConstraintIndex addJointDriver(const std::string& name, ConstraintIndex joint, TimeLawPtr law);
-  ForceIndex addSpringDamper(const std::string& name, BodyIndex bodyI, const Vec2& pointI,
-                             BodyIndex bodyJ, const Vec2& pointJ, double stiffness,
-                             double damping, double freeLength);
-  /// Acts on a revolute joint's relative angle; freeAngle: angle of zero torque.
-  ForceIndex addRotationalSpringDamper(const std::string& name, ConstraintIndex revoluteJoint,
-                                       double stiffness, double damping, double freeAngle);
-  ForceIndex addAppliedLoad(const std::string& name, BodyIndex body, const Vec2& point,
-                            TimeLawPtr forceX, TimeLawPtr forceY, TimeLawPtr torque);
+  // The convenience builders of concrete bodies, joints and forces (addRigidBody(sys, ...),
+  // addRevoluteJoint(sys, ...), ...) are free functions: builders/planar_builders.hpp.
 
   /// Freezes the model: index maps, checks of attachment points and names.
   void finalize();
@@ -130,8 +105,6 @@ class System {
   void requireFinalized(const char* what) const;
   void checkNewName(const std::string& name, const std::string& kind) const;
   void checkBody(BodyIndex i, const std::string& user) const;
-  double initialRelativeAngle(BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
-                              const Vec2& pointJ) const;
 
   std::vector<std::unique_ptr<Body>> bodies_;
   std::vector<std::unique_ptr<Constraint>> constraints_;

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "integrators/simulation.hpp"
 
 int main(int argc, char** argv) {
@@ -26,14 +27,15 @@ int main(int argc, char** argv) {
   const double rodMass = rodModel->invariants().mass;
 
   System sys;
-  const BodyIndex crank = sys.addRigidBody("crank", {0.1, 1e-4, {crankLength / 2, 0}}, {{0, 0}, 0.0});
+  const BodyIndex crank = addRigidBody(sys, "crank", {0.1, 1e-4, {crankLength / 2, 0}}, {{0, 0}, 0.0});
   const BodyIndex rod = sys.addBody(std::make_unique<FfrBody2d>("rod", rodModel, FrameState2d{{crankLength, 0}, 0.0}));
-  const BodyIndex slider = sys.addRigidBody("slider", {rodMass / 2, 1e-6, {0, 0}}, {{crankLength + rodLength, 0}, 0.0});
-  sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  sys.addRevoluteJoint("O2", crank, {crankLength, 0}, rod, {0, 0});
-  sys.addRevoluteJoint("O3", rod, {rodLength, 0}, slider, {0, 0});
-  sys.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(speed));
+  const BodyIndex slider =
+      addRigidBody(sys, "slider", {rodMass / 2, 1e-6, {0, 0}}, {{crankLength + rodLength, 0}, 0.0});
+  addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(sys, "O2", crank, {crankLength, 0}, rod, {0, 0});
+  addRevoluteJoint(sys, "O3", rod, {rodLength, 0}, slider, {0, 0});
+  addPrismaticJoint(sys, "P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(speed));
   sys.finalize();
 
   SolverSettings settings;

@@ -3,21 +3,21 @@
 #include <cmath>
 #include <cstdio>
 
-#include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "integrators/simulation.hpp"
 
 int main() {
   using namespace flexmbd;
   System sys;
-  //                                   mass inertia  com            position  angle
-  const BodyIndex crank = sys.addRigidBody("crank", {1.0, 0.1, {0.5, 0.0}}, {{0.0, 0.0}, 0.0});
-  const BodyIndex rod = sys.addRigidBody("rod", {1.0, 0.4, {1.0, 0.0}}, {{1.0, 0.0}, 0.0});
-  const BodyIndex slider = sys.addRigidBody("slider", {0.5, 0.01, {0.0, 0.0}}, {{3.0, 0.0}, 0.0});
-  sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  sys.addRevoluteJoint("O2", crank, {1, 0}, rod, {0, 0});
-  sys.addRevoluteJoint("O3", rod, {2, 0}, slider, {0, 0});
-  sys.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, /*axis=*/{1, 0});
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(1.0));
+  //                                    mass inertia  com            position  angle
+  const BodyIndex crank = addRigidBody(sys, "crank", {1.0, 0.1, {0.5, 0.0}}, {{0.0, 0.0}, 0.0});
+  const BodyIndex rod = addRigidBody(sys, "rod", {1.0, 0.4, {1.0, 0.0}}, {{1.0, 0.0}, 0.0});
+  const BodyIndex slider = addRigidBody(sys, "slider", {0.5, 0.01, {0.0, 0.0}}, {{3.0, 0.0}, 0.0});
+  addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(sys, "O2", crank, {1, 0}, rod, {0, 0});
+  addRevoluteJoint(sys, "O3", rod, {2, 0}, slider, {0, 0});
+  addPrismaticJoint(sys, "P", kGround, {0, 0}, slider, {0, 0}, /*axis=*/{1, 0});
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(1.0));
   sys.finalize();
 
   SolverSettings settings;  // GGL index-2, rtol 1e-8

@@ -27,6 +27,7 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "joints/point_pair.hpp"
@@ -276,7 +277,7 @@ void parseBody(const json& j, const std::string& where, System& sys) {
   props.inertia = r.positive("inertia");
   props.com = r.vec2("com", Vec2::Zero());
   const FrameState2d init = parseFrameState(r);
-  located(r.where(), [&] { return sys.addRigidBody(name, props, init); });
+  located(r.where(), [&] { return addRigidBody(sys, name, props, init); });
 }
 
 void parseJoint(const json& j, const std::string& where, System& sys) {
@@ -298,13 +299,13 @@ void parseJoint(const json& j, const std::string& where, System& sys) {
   if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a joint connects two different bodies");
   const auto points = r.pointPair("points");
   if (type == "revolute") {
-    located(r.where(), [&] { return sys.addRevoluteJoint(name, bi, points[0], bj, points[1]); });
+    located(r.where(), [&] { return addRevoluteJoint(sys, name, bi, points[0], bj, points[1]); });
   } else if (type == "fixed") {
-    located(r.where(), [&] { return sys.addFixedJoint(name, bi, points[0], bj, points[1]); });
+    located(r.where(), [&] { return addFixedJoint(sys, name, bi, points[0], bj, points[1]); });
   } else {
     const Vec2 axis = r.vec2("axis");
     if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0]");
-    located(r.where(), [&] { return sys.addPrismaticJoint(name, bi, points[0], bj, points[1], axis); });
+    located(r.where(), [&] { return addPrismaticJoint(sys, name, bi, points[0], bj, points[1], axis); });
   }
 }
 
@@ -329,12 +330,12 @@ void parseDriver(const json& j, const std::string& where, System& sys) {
                                         : " (it has no free motion to drive)"));
     }
     TimeLawPtr law = parseTimeLaw(r.object("law"), r.where() + ".law");
-    located(r.where(), [&] { return sys.addJointDriver(name, joint, law); });
+    located(r.where(), [&] { return addJointDriver(sys, name, joint, law); });
   } else {
     const BodyIndex body = lookupBody(sys, r.name("body"), r);
     const std::string coordinate = type == "body_angle" ? "theta" : type == "body_x" ? "x" : "y";
     TimeLawPtr law = parseTimeLaw(r.object("law"), r.where() + ".law");
-    located(r.where(), [&] { return sys.addBodyCoordinateDriver(name, body, coordinate, law); });
+    located(r.where(), [&] { return addBodyCoordinateDriver(sys, name, body, coordinate, law); });
   }
 }
 
@@ -365,7 +366,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
       });
     }
     located(r.where(), [&] {
-      return sys.addSpringDamper(name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
+      return addSpringDamper(sys, name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
     });
   } else if (type == "rotational_spring_damper") {
     r.allowOnly(scenekeys::kRotationalSpringDamper, forA);
@@ -380,7 +381,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
     const double damping = r.nonNegative("damping", 0.0);
     const double freeAngle = r.has("free_angle") ? r.number("free_angle")
                                                  : located(r.where(), [&] { return initialJointAngle(sys, joint); });
-    located(r.where(), [&] { return sys.addRotationalSpringDamper(name, joint, stiffness, damping, freeAngle); });
+    located(r.where(), [&] { return addRotationalSpringDamper(sys, name, joint, stiffness, damping, freeAngle); });
   } else {
     r.allowOnly(scenekeys::kAppliedLoad, forA);
     const std::string name = r.name("name");
@@ -393,7 +394,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
     if (r.has("force_x")) fx = parseTimeLaw(r.object("force_x"), r.where() + ".force_x");
     if (r.has("force_y")) fy = parseTimeLaw(r.object("force_y"), r.where() + ".force_y");
     if (r.has("torque")) tau = parseTimeLaw(r.object("torque"), r.where() + ".torque");
-    located(r.where(), [&] { return sys.addAppliedLoad(name, body, point, fx, fy, tau); });
+    located(r.where(), [&] { return addAppliedLoad(sys, name, body, point, fx, fy, tau); });
   }
 }
 
@@ -591,11 +592,9 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
     return {f.r.x(), f.r.y(), f.r.z(), vel.x(), vel.y(), vel.z()};
   }
   if (type == Type::Deflection) {
-    const FfrBeamModel& model = *static_cast<const FfrBody2d&>(b).beamModel();
-    const VecX qf = q.segment(off + 3, model.numElastic());
-    const Vec2 u = model.materialPoint(element, xi).shape * qf;
-    const Vec2 f = model.sectionForces(qf, element, xi);
-    return {u.x(), u.y(), f.x(), f.y()};
+    const FfrBody2d::BeamDeflection d =
+        static_cast<const FfrBody2d&>(b).beamDeflection(q.segment(off, b.numCoordinates()), element, xi);
+    return {d.displacement.x(), d.displacement.y(), d.sectionForces.x(), d.sectionForces.y()};
   }
   const int n = b.numCoordinates();
   const PointKinematics pk = b.pointKinematics(q.segment(off, n), point, false);

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bodies/rigid_body_3d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
@@ -160,7 +161,7 @@ void parseSpatialDriver(const json& j, const std::string& where, System& sys) {
     const BodyIndex body = lookupBody(sys, r.name("body"), r);
     TimeLawPtr law = parseTimeLaw(r.object("law"), r.where() + ".law");
     const std::string coordinate = type.substr(5);
-    located(r.where(), [&] { return sys.addBodyCoordinateDriver(name, body, coordinate, law); });
+    located(r.where(), [&] { return addBodyCoordinateDriver(sys, name, body, coordinate, law); });
     return;
   }
   const std::string jointName = r.name("joint");

@@ -210,7 +210,7 @@ void VtkWriter::write(const OutputSample& s) {
     if (dynamic_cast<const RigidBody3d*>(&body)) {
       // an oriented body: a triad of its axes at the centre of mass (the cells' order: x, y,
       // z) and a line to each joint point
-      const Vec3 c = q.head<3>();
+      const Vec3 c = body.centreOfMass(q);
       const Mat3 A = RigidBody3d::rotationOf(q);
       auto addLine = [&](const Vec3& a, const Vec3& b) {
         g.cells.push_back({static_cast<int>(g.points.size()), static_cast<int>(g.points.size()) + 1});
@@ -224,32 +224,27 @@ void VtkWriter::write(const OutputSample& s) {
       for (int k = 0; k < 3; ++k) addLine(c, c + triad_ * A.col(k));
       for (const Vec3& p : spatialPoints_[b]) addLine(c, c + A * p);
     } else if (fb && fb->beamModel()) {
-      const FfrBeamModel& m = *fb->beamModel();
-      const VecX qf = q.tail(m.numElastic());
-      const Mat2 A = rotation(q[2]);
-      for (int e = 0; e < static_cast<int>(m.elements().size()); ++e) {
+      const int elements = static_cast<int>(fb->beamModel()->elements().size());
+      for (int e = 0; e < elements; ++e) {
         std::vector<int> line;
         for (int k = 0; k <= subdivisions_; ++k) {
           const double xi = static_cast<double>(k) / subdivisions_;
-          const FfrPoint p = m.materialPoint(e, xi);
-          const Vec2 u = p.shape * qf;
+          const FfrBody2d::BeamDeflection d = fb->beamDeflection(q, e, xi);
           line.push_back(static_cast<int>(g.points.size()));
-          g.points.push_back(in3d(q.head<2>() + A * (p.position + u)));
-          displacement.push_back(in3d(A * u));
-          const Vec2 nm = m.sectionForces(qf, e, xi);
-          axial.push_back(nm.x());
-          moment.push_back(nm.y());
+          g.points.push_back(in3d(d.position));
+          displacement.push_back(in3d(d.worldDisplacement));
+          axial.push_back(d.sectionForces.x());
+          moment.push_back(d.sectionForces.y());
         }
         g.cells.push_back(line);
       }
     } else if (!rigidPoints_[b].empty()) {
       std::vector<int> line;
-      const Mat2 A = rotation(q[2]);
       for (std::size_t k = 0; k < rigidPoints_[b].size(); ++k) {
         line.push_back(static_cast<int>(g.points.size()));
         g.points.push_back(in3d(body.pointKinematics(q, rigidPoints_[b][k], false).r));
         // invariants body: u = S_k q_f of its k-th point, world axes
-        displacement.push_back(fb ? in3d(A * (fb->invariants().points[k].shape * q.tail(fb->numElastic())))
+        displacement.push_back(fb ? in3d(fb->worldElasticDisplacement(q, fb->invariants().points[k]))
                                   : Eigen::Vector3d::Zero());
         axial.push_back(0.0);
         moment.push_back(0.0);

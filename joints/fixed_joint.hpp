@@ -6,8 +6,8 @@
 namespace flexmbd {
 
 /// h = [r_j - r_i; phi_j - phi_i - phi0] = 0 (3 equations); phi0 is the relative
-/// angle of the assembled model (System::addFixedJoint takes it from the initial
-/// positions).
+/// angle of the assembled model (addFixedJoint of builders/planar_builders.hpp takes it
+/// from the initial positions).
 class FixedJoint final : public TwoPointConstraint {
  public:
   FixedJoint(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,

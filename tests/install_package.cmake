@@ -21,7 +21,8 @@ foreach(item config library)
     message(FATAL_ERROR "install: no ${item} installed under ${prefix}")
   endif()
 endforeach()
-foreach(file include/flexmbd/core/types.hpp include/flexmbd/io/results_writer.hpp
+foreach(file include/flexmbd/core/types.hpp include/flexmbd/builders/planar_builders.hpp
+             include/flexmbd/io/results_writer.hpp
              include/flexmbd/integrators/simulation.hpp include/flexmbd/linkage/kinematic_analysis.hpp
              include/flexmbd/tensegrity/tensegrity_structure.hpp bin/flexmbd)
   if(NOT EXISTS "${prefix}/${file}")

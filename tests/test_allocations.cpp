@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bodies/rigid_body_3d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/dae_system.hpp"
 #include "forces/spatial_forces.hpp"
 #include "joints/spatial_drivers.hpp"
@@ -174,19 +175,19 @@ TEST(Allocations, EveryJointDriverAndForceType) {
   sb.position = Vec2(1.0, 0.2);
   sc.position = Vec2(2.0, -0.1);
   sc.angle = 0.3;
-  const BodyIndex a = sys.addRigidBody("a", p, sa);
-  const BodyIndex b = sys.addRigidBody("b", p, sb);
-  const BodyIndex c = sys.addRigidBody("c", p, sc);
-  const ConstraintIndex rev = sys.addRevoluteJoint("rev", kGround, Vec2::Zero(), a, Vec2::Zero());
-  const ConstraintIndex pri = sys.addPrismaticJoint("pri", a, Vec2(0.5, 0.0), b, Vec2::Zero(), Vec2(1.0, 0.1));
-  sys.addFixedJoint("fix", b, Vec2(0.5, 0.0), c, Vec2(-0.5, 0.0));
-  sys.addJointDriver("angle", rev, makeHarmonicLaw(0.2, 3.0));
-  sys.addJointDriver("slide", pri, makeConstantSpeedLaw(0.1, 0.5));
-  sys.addBodyCoordinateDriver("cx", c, "x", makePolynomialLaw({2.0, 0.1}));
-  sys.addSpringDamper("spring", kGround, Vec2(0.0, 1.0), b, Vec2(0.1, 0.0), 100.0, 2.0, 0.5);
-  sys.addRotationalSpringDamper("torsion", rev, 10.0, 0.5, 0.1);
-  sys.addAppliedLoad("load", c, Vec2(0.2, 0.0), makeConstantLaw(1.0), makeHarmonicLaw(2.0, 1.0),
-                     makeConstantLaw(0.3));
+  const BodyIndex a = addRigidBody(sys, "a", p, sa);
+  const BodyIndex b = addRigidBody(sys, "b", p, sb);
+  const BodyIndex c = addRigidBody(sys, "c", p, sc);
+  const ConstraintIndex rev = addRevoluteJoint(sys, "rev", kGround, Vec2::Zero(), a, Vec2::Zero());
+  const ConstraintIndex pri = addPrismaticJoint(sys, "pri", a, Vec2(0.5, 0.0), b, Vec2::Zero(), Vec2(1.0, 0.1));
+  addFixedJoint(sys, "fix", b, Vec2(0.5, 0.0), c, Vec2(-0.5, 0.0));
+  addJointDriver(sys, "angle", rev, makeHarmonicLaw(0.2, 3.0));
+  addJointDriver(sys, "slide", pri, makeConstantSpeedLaw(0.1, 0.5));
+  addBodyCoordinateDriver(sys, "cx", c, "x", makePolynomialLaw({2.0, 0.1}));
+  addSpringDamper(sys, "spring", kGround, Vec2(0.0, 1.0), b, Vec2(0.1, 0.0), 100.0, 2.0, 0.5);
+  addRotationalSpringDamper(sys, "torsion", rev, 10.0, 0.5, 0.1);
+  addAppliedLoad(sys, "load", c, Vec2(0.2, 0.0), makeConstantLaw(1.0), makeHarmonicLaw(2.0, 1.0),
+                 makeConstantLaw(0.3));
   sys.setGravity(Vec2(0.0, -9.81));
   sys.finalize();
   expectAllocationFree(sys, "every component type");
@@ -222,7 +223,7 @@ TEST(Allocations, EverySpatialJointDriverAndForceType) {
   sys.addConstraint(std::make_unique<SpatialJointAngleDriver>("angle", b[0], f0, b[1], f1, makeHarmonicLaw(0.2, 3.0)));
   sys.addConstraint(
       std::make_unique<SpatialJointDisplacementDriver>("slide", b[1], f0, b[2], f1, makeConstantSpeedLaw(0.1, 0.5)));
-  sys.addBodyCoordinateDriver("z", b[7], "z", makeConstantLaw(0.0));
+  addBodyCoordinateDriver(sys, "z", b[7], "z", makeConstantLaw(0.0));
   sys.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), b[3], f1.point, 100.0, 2.0, 0.5));
   sys.addForce(std::make_unique<SpatialRotationalSpringDamper>("torsion", b[0], f0, b[1], f1, 10.0, 0.5, 0.1));
   sys.addForce(std::make_unique<SpatialBushing>("bushing", b[5], f1, b[6], f0, std::array<double, 6>{1, 2, 3, 4, 5, 6},

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/dae_system.hpp"
 #include "core/errors.hpp"
 #include "core/system.hpp"
@@ -154,10 +155,10 @@ TEST(RigidBody2d, BadMassOrInertiaThrowsInputErrorNamingTheBody) {
     expectThrowsMentioning<InputError>(
         [&] { RigidBody2d("flywheel", pi, FrameState2d{}); }, {"'flywheel'", "inertia"},
         "inertia = " + std::to_string(bad));
-    // also through the System builder
+    // also through the builder
     System sys;
-    expectThrowsMentioning<InputError>([&] { sys.addRigidBody("rotor", pm, FrameState2d{}); },
-                                       {"'rotor'", "mass"}, "System::addRigidBody mass");
+    expectThrowsMentioning<InputError>([&] { addRigidBody(sys, "rotor", pm, FrameState2d{}); },
+                                       {"'rotor'", "mass"}, "addRigidBody mass");
     EXPECT_EQ(sys.numBodies(), 1);  // nothing was added
   }
   RigidBodyProperties pc;
@@ -173,11 +174,11 @@ TEST(RigidBody2d, BadMassOrInertiaThrowsInputErrorNamingTheBody) {
 TEST(ConstraintValues, RevoluteJointVanishesWhenAssembled) {
   Random rnd(kSeed + 10);
   System sys;
-  const BodyIndex a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
-  const BodyIndex b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const BodyIndex a = addRigidBody(sys, "a", randomProperties(rnd), FrameState2d{});
+  const BodyIndex b = addRigidBody(sys, "b", randomProperties(rnd), FrameState2d{});
   const Vec2 ua = rnd.vec2(-1.5, 1.5), ub = rnd.vec2(-1.5, 1.5), ug = rnd.vec2(-2.0, 2.0);
-  const ConstraintIndex ab = sys.addRevoluteJoint("hinge", a, ua, b, ub);
-  const ConstraintIndex gb = sys.addRevoluteJoint("pin", kGround, ug, b, ub);
+  const ConstraintIndex ab = addRevoluteJoint(sys, "hinge", a, ua, b, ub);
+  const ConstraintIndex gb = addRevoluteJoint(sys, "pin", kGround, ug, b, ub);
   sys.finalize();
   for (int s = 0; s < kSamples; ++s) {
     VecX q(sys.numCoordinates());
@@ -202,8 +203,8 @@ TEST(ConstraintValues, RevoluteJointVanishesWhenAssembled) {
 TEST(ConstraintValues, PrismaticNormalEquationIsSignedDistanceToAxisLine) {
   Random rnd(kSeed + 11);
   System sys;
-  const BodyIndex a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
-  const BodyIndex b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const BodyIndex a = addRigidBody(sys, "a", randomProperties(rnd), FrameState2d{});
+  const BodyIndex b = addRigidBody(sys, "b", randomProperties(rnd), FrameState2d{});
   const Vec2 axis(2.0, 1.0);  // not unit, not axis-aligned: the joint normalises it
   const Vec2 aHat = axis.normalized();
   const double reference = 0.4;
@@ -252,8 +253,8 @@ TEST(ConstraintValues, PrismaticNormalEquationIsSignedDistanceToAxisLine) {
 TEST(ConstraintValues, JointDisplacementDriverIsProjectionOnRotatingAxis) {
   Random rnd(kSeed + 12);
   System sys;
-  const BodyIndex a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
-  const BodyIndex b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const BodyIndex a = addRigidBody(sys, "a", randomProperties(rnd), FrameState2d{});
+  const BodyIndex b = addRigidBody(sys, "b", randomProperties(rnd), FrameState2d{});
   const Vec2 axis(-0.6, 1.7);
   const Vec2 ua = rnd.vec2(-1.0, 1.0), ub = rnd.vec2(-1.0, 1.0);
   const auto law = makeHarmonicLaw(0.5, 2.0, 0.3, 0.1);
@@ -341,18 +342,18 @@ std::unique_ptr<SliderCrank> makeSliderCrank(double l2, int drivers) {
   // (not reaching: the rod leans 1 rad below the horizontal, a regular configuration)
   const double xs = pin.x() + (reach2 > 0 ? std::sqrt(reach2) : l2 * std::cos(1.0));
   const double rodAngle = reach2 > 0 ? std::atan2(-pin.y(), xs - pin.x()) : -1.0;
-  sc->crank = sys.addRigidBody("crank", {1.0, 0.1, Vec2(0.5, 0.05)}, {Vec2::Zero(), kCrank0, Vec2::Zero(), 0.0});
-  sc->rod = sys.addRigidBody("rod", {2.0, 0.7, Vec2(1.0, -0.1)}, {pin, rodAngle, Vec2::Zero(), 0.0});
-  sc->slider = sys.addRigidBody("slider", {0.5, 0.01, Vec2(0.02, 0.01)},
-                                {Vec2(xs, 0.0), 0.0, Vec2::Zero(), 0.0});
-  sc->pivot = sys.addRevoluteJoint("pivot", kGround, Vec2::Zero(), sc->crank, Vec2::Zero());
-  sys.addRevoluteJoint("crank_pin", sc->crank, Vec2(kL1, 0.0), sc->rod, Vec2::Zero());
-  sys.addRevoluteJoint("wrist", sc->rod, Vec2(l2, 0.0), sc->slider, Vec2::Zero());
-  sys.addPrismaticJoint("slide", kGround, Vec2::Zero(), sc->slider, Vec2::Zero(), Vec2(1.0, 0.0));
+  sc->crank = addRigidBody(sys, "crank", {1.0, 0.1, Vec2(0.5, 0.05)}, {Vec2::Zero(), kCrank0, Vec2::Zero(), 0.0});
+  sc->rod = addRigidBody(sys, "rod", {2.0, 0.7, Vec2(1.0, -0.1)}, {pin, rodAngle, Vec2::Zero(), 0.0});
+  sc->slider = addRigidBody(sys, "slider", {0.5, 0.01, Vec2(0.02, 0.01)},
+                            {Vec2(xs, 0.0), 0.0, Vec2::Zero(), 0.0});
+  sc->pivot = addRevoluteJoint(sys, "pivot", kGround, Vec2::Zero(), sc->crank, Vec2::Zero());
+  addRevoluteJoint(sys, "crank_pin", sc->crank, Vec2(kL1, 0.0), sc->rod, Vec2::Zero());
+  addRevoluteJoint(sys, "wrist", sc->rod, Vec2(l2, 0.0), sc->slider, Vec2::Zero());
+  addPrismaticJoint(sys, "slide", kGround, Vec2::Zero(), sc->slider, Vec2::Zero(), Vec2(1.0, 0.0));
   if (drivers >= 1) {
-    sys.addBodyCoordinateDriver("motor", sc->crank, "theta", makeConstantSpeedLaw(kOmega, kCrank0));
+    addBodyCoordinateDriver(sys, "motor", sc->crank, "theta", makeConstantSpeedLaw(kOmega, kCrank0));
   }
-  if (drivers >= 2) sys.addJointDriver("motor2", sc->pivot, makeConstantSpeedLaw(kOmega, kCrank0));
+  if (drivers >= 2) addJointDriver(sys, "motor2", sc->pivot, makeConstantSpeedLaw(kOmega, kCrank0));
   sys.finalize();
   return sc;
 }
@@ -496,15 +497,15 @@ TEST(ConsistentState, RodTooShortToReachTheSlideLineCannotBeAssembled) {
 
 TEST(System, AddingAfterFinalizeThrowsInputError) {
   System sys;
-  const BodyIndex a = sys.addRigidBody("a", {}, {});
-  const ConstraintIndex j = sys.addRevoluteJoint("pin", kGround, Vec2::Zero(), a, Vec2::Zero());
+  const BodyIndex a = addRigidBody(sys, "a", {}, {});
+  const ConstraintIndex j = addRevoluteJoint(sys, "pin", kGround, Vec2::Zero(), a, Vec2::Zero());
   sys.finalize();
   EXPECT_TRUE(sys.isFinalized());
   const std::vector<std::pair<std::string, std::function<void()>>> late = {
-      {"body", [&] { sys.addRigidBody("b", {}, {}); }},
-      {"joint", [&] { sys.addRevoluteJoint("pin2", kGround, Vec2(1.0, 0.0), a, Vec2(1.0, 0.0)); }},
-      {"driver", [&] { sys.addJointDriver("motor", j, makeConstantLaw(0.0)); }},
-      {"force", [&] { sys.addSpringDamper("spring", kGround, Vec2(1.0, 0.0), a, Vec2::Zero(), 1.0, 0.0, 0.0); }},
+      {"body", [&] { addRigidBody(sys, "b", {}, {}); }},
+      {"joint", [&] { addRevoluteJoint(sys, "pin2", kGround, Vec2(1.0, 0.0), a, Vec2(1.0, 0.0)); }},
+      {"driver", [&] { addJointDriver(sys, "motor", j, makeConstantLaw(0.0)); }},
+      {"force", [&] { addSpringDamper(sys, "spring", kGround, Vec2(1.0, 0.0), a, Vec2::Zero(), 1.0, 0.0, 0.0); }},
       {"gravity", [&] { sys.setGravity(Vec2(0.0, -9.81)); }},
       {"finalize", [&] { sys.finalize(); }},
   };
@@ -518,23 +519,23 @@ TEST(System, AddingAfterFinalizeThrowsInputError) {
 
 TEST(System, DuplicateNamesThrowInputError) {
   System sys;
-  const BodyIndex a = sys.addRigidBody("arm", {}, {});
-  const BodyIndex b = sys.addRigidBody("link", {}, {});
-  const ConstraintIndex j = sys.addRevoluteJoint("hinge", a, Vec2(1.0, 0.0), b, Vec2::Zero());
-  sys.addSpringDamper("spring", kGround, Vec2(0.0, 1.0), a, Vec2::Zero(), 10.0, 0.0, 1.0);
-  expectThrowsMentioning<InputError>([&] { sys.addRigidBody("arm", {}, {}); }, {"'arm'", "duplicate"},
+  const BodyIndex a = addRigidBody(sys, "arm", {}, {});
+  const BodyIndex b = addRigidBody(sys, "link", {}, {});
+  const ConstraintIndex j = addRevoluteJoint(sys, "hinge", a, Vec2(1.0, 0.0), b, Vec2::Zero());
+  addSpringDamper(sys, "spring", kGround, Vec2(0.0, 1.0), a, Vec2::Zero(), 10.0, 0.0, 1.0);
+  expectThrowsMentioning<InputError>([&] { addRigidBody(sys, "arm", {}, {}); }, {"'arm'", "duplicate"},
                                      "body twice");
-  expectThrowsMentioning<InputError>([&] { sys.addRigidBody("ground", {}, {}); },
+  expectThrowsMentioning<InputError>([&] { addRigidBody(sys, "ground", {}, {}); },
                                      {"'ground'", "duplicate"}, "body named ground");
   expectThrowsMentioning<InputError>(
-      [&] { sys.addRevoluteJoint("link", a, Vec2::Zero(), b, Vec2(1.0, 0.0)); }, {"'link'", "duplicate"},
+      [&] { addRevoluteJoint(sys, "link", a, Vec2::Zero(), b, Vec2(1.0, 0.0)); }, {"'link'", "duplicate"},
       "joint named like a body");
-  expectThrowsMentioning<InputError>([&] { sys.addJointDriver("hinge", j, makeConstantLaw(0.0)); },
+  expectThrowsMentioning<InputError>([&] { addJointDriver(sys, "hinge", j, makeConstantLaw(0.0)); },
                                      {"'hinge'", "duplicate"}, "driver named like a joint");
   expectThrowsMentioning<InputError>(
-      [&] { sys.addRotationalSpringDamper("spring", j, 1.0, 0.0, 0.0); }, {"'spring'", "duplicate"},
+      [&] { addRotationalSpringDamper(sys, "spring", j, 1.0, 0.0, 0.0); }, {"'spring'", "duplicate"},
       "force twice");
-  expectThrowsMentioning<InputError>([&] { sys.addRigidBody("spring", {}, {}); },
+  expectThrowsMentioning<InputError>([&] { addRigidBody(sys, "spring", {}, {}); },
                                      {"'spring'", "duplicate"}, "body named like a force");
   EXPECT_EQ(sys.numBodies(), 3);
   EXPECT_EQ(sys.numConstraints(), 1);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/force.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
@@ -96,7 +97,7 @@ TEST(Diagnostics, DivergedSolutionIsCalledDiverged) {
   RigidBodyProperties p;
   FrameState2d init;
   init.position = Vec2(1.0, 0.0);
-  const BodyIndex b = sys.addRigidBody("runaway", p, init);
+  const BodyIndex b = addRigidBody(sys, "runaway", p, init);
   sys.addForce(std::make_unique<RepellingForce>(b, 1e6));
   sys.finalize();
   SolverSettings st;

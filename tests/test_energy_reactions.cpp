@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 
@@ -31,18 +32,18 @@ Model makeModel() {
   Model m;
   System& s = m.sys;
   s.setGravity(Vec2(0.0, -9.81));
-  m.crank = s.addRigidBody("crank", {1.0, 0.1, {0.5, 0.05}}, {{0, 0}, 0.4, {0, 0}, 3.0});
+  m.crank = addRigidBody(s, "crank", {1.0, 0.1, {0.5, 0.05}}, {{0, 0}, 0.4, {0, 0}, 3.0});
   const Vec2 b(std::cos(0.4), std::sin(0.4));
   const double xs = b.x() + std::sqrt(4.0 - b.y() * b.y());
-  m.rod = s.addRigidBody("rod", {1.0, 0.4, {1.0, -0.03}}, {b, std::atan2(-b.y(), xs - b.x())});
-  m.slider = s.addRigidBody("slider", {0.5, 0.01, {0.05, 0.02}}, {{xs, 0}, 0.0});
+  m.rod = addRigidBody(s, "rod", {1.0, 0.4, {1.0, -0.03}}, {b, std::atan2(-b.y(), xs - b.x())});
+  m.slider = addRigidBody(s, "slider", {0.5, 0.01, {0.05, 0.02}}, {{xs, 0}, 0.0});
   m.joints = {{"O1", kGround, m.crank, {0, 0}, {0, 0}},
               {"O2", m.crank, m.rod, {1, 0}, {0, 0}},
               {"O3", m.rod, m.slider, {2, 0}, {0, 0}}};
-  for (const auto& j : m.joints) s.addRevoluteJoint(j.name, j.i, j.pi, j.j, j.pj);
-  s.addPrismaticJoint("P", kGround, {0, 0}, m.slider, {0, 0}, {1, 0});
+  for (const auto& j : m.joints) addRevoluteJoint(s, j.name, j.i, j.pi, j.j, j.pj);
+  addPrismaticJoint(s, "P", kGround, {0, 0}, m.slider, {0, 0}, {1, 0});
   m.joints.push_back({"P", kGround, m.slider, {0, 0}, {0, 0}});
-  s.addSpringDamper("spring", kGround, kAnchor, m.slider, {0, 0}, kStiffness, 0.0, kFreeLength);
+  addSpringDamper(s, "spring", kGround, kAnchor, m.slider, {0, 0}, kStiffness, 0.0, kFreeLength);
   s.finalize();
   return m;
 }

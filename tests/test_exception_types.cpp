@@ -26,6 +26,7 @@
 #include "integrators/cvode_solver.hpp"
 #include "integrators/dae_integrator.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/force.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
@@ -292,7 +293,7 @@ class FaultyLoad final : public Force {
 TEST(ExceptionTypes, SimulateLetsInputErrorsAndAssemblyBugsThroughButReportsModelErrorsAsAFailedRun) {
   const auto run = [](Raise raise) {
     System sys;
-    const BodyIndex b = sys.addRigidBody("b", {1.0, 0.1, {0.0, 0.0}}, {});
+    const BodyIndex b = addRigidBody(sys, "b", {1.0, 0.1, {0.0, 0.0}}, {});
     sys.addForce(std::make_unique<FaultyLoad>(b, std::move(raise)));
     sys.finalize();
     SolverSettings st;

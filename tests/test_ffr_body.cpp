@@ -552,6 +552,34 @@ TEST(FfrBody2d, CentreOfMassAndInitialState) {
   expectMatrixNear(body.planarCentreOfMass(qr), c / body.mass(), kExactTol, "centre of mass", 1.0);
 }
 
+TEST(FfrBody2d, DeflectionOutputsFromTheBodysOwnCoordinates) {
+  // What io reads of a flexible body (deflection outputs, VTK) comes from the body, given
+  // its own coordinates: u = N q_f (body axes), N and M of the model, r = R + A (u0 + u).
+  const auto model = makeModel(lFrame(2, Vec2(0.1, 0.2)), options(RC::Clamped));
+  const FfrBody2d body("flex", model, FrameState2d{});
+  Random rnd(kSeed + 4);
+  const VecX qr = randomCoordinates(rnd, *model, 0.3);
+  const VecX qf = qr.tail(body.numElastic());
+  const Mat2 A = rotation(qr[2]);
+  for (int e = 0; e < int(model->elements().size()); ++e) {
+    for (double xi : {0.0, 0.3, 1.0}) {
+      const FfrBody2d::BeamDeflection d = body.beamDeflection(qr, e, xi);
+      const FfrPoint p = model->materialPoint(e, xi);
+      const Vec2 u = p.shape * qf;
+      EXPECT_EQ(d.displacement, u);
+      EXPECT_EQ(d.sectionForces, model->sectionForces(qf, e, xi));
+      EXPECT_EQ(d.worldDisplacement, A * u);
+      expectMatrixNear(d.position, body.pointKinematics(qr, p, false).r, kExactTol, "deformed position", 1.0);
+    }
+  }
+  // a body given by its invariants: displacements of its points, no section forces
+  const FfrBody2d direct("direct", model->invariants(), FrameState2d{});
+  for (const FfrPoint& p : direct.invariants().points) {
+    EXPECT_EQ(direct.worldElasticDisplacement(qr, p), A * (p.shape * qf));
+  }
+  expectInputError([&] { direct.beamDeflection(qr, 0, 0.5); }, {"body 'direct'", "beam mesh"});
+}
+
 // ----- rigid-body displacements store no strain energy ------------------------------------
 
 TEST(FfrBeamModel, RigidDisplacementsGiveNoElasticForce) {

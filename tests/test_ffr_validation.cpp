@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "integrators/static_equilibrium.hpp"
@@ -52,7 +53,7 @@ TEST(FfrStatic, CantileverUnderOwnWeightMatchesRhoAgL4Over8EI) {
   System sys;
   sys.setGravity(Vec2(0, -9.81));
   const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("beam", model, FrameState2d{}));
-  sys.addFixedJoint("root", kGround, {0, 0}, b, {0, 0});
+  addFixedJoint(sys, "root", kGround, {0, 0}, b, {0, 0});
   sys.finalize();
   const StaticEquilibrium eq = solveStaticEquilibrium(sys, 0.0, sys.initialCoordinates());
   const VecX qf = eq.q.tail(model->numElastic());
@@ -241,8 +242,8 @@ TEST(FfrGeometricStiffening, SpinUpPastFirstFrequencyStaysBoundedOnlyWithStiffen
     auto model = std::make_shared<FfrBeamModel>(BeamMesh2d::straight(1.0, 6, s), o, "blade");
     System sys;
     const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("blade", model, FrameState2d{}));
-    sys.addRevoluteJoint("hub", kGround, {0, 0}, b, {0, 0});
-    sys.addBodyCoordinateDriver("motor", b, "theta", makeSpinUpLaw(Omega, 15.0));
+    addRevoluteJoint(sys, "hub", kGround, {0, 0}, b, {0, 0});
+    addBodyCoordinateDriver(sys, "motor", b, "theta", makeSpinUpLaw(Omega, 15.0));
     sys.finalize();
     SolverSettings st;
     st.rtol = 1e-7;

@@ -21,6 +21,7 @@
 #include "bodies/ffr_beam_model.hpp"
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/dae_system.hpp"
 #include "core/errors.hpp"
 #include "core/sparse_pattern.hpp"
@@ -243,8 +244,8 @@ void checkConstraintDerivatives(const System& sys, ConstraintIndex ci, const Vec
 TEST(ConstraintJacobians, EveryConstraintTypeBetweenBodiesAndWithGround) {
   Random rnd(kSeed + 10);
   System sys;
-  const BodyIndex a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
-  const BodyIndex b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  const BodyIndex a = addRigidBody(sys, "a", randomProperties(rnd), FrameState2d{});
+  const BodyIndex b = addRigidBody(sys, "b", randomProperties(rnd), FrameState2d{});
   const Vec2 prismaticAxis(0.6, -1.3);      // not unit, not axis-aligned
   const Vec2 displacementAxis(-0.8, 0.5);   // not unit, not axis-aligned
   const double prismaticReference = 0.7;
@@ -270,21 +271,21 @@ TEST(ConstraintJacobians, EveryConstraintTypeBetweenBodiesAndWithGround) {
   }
   // Body-coordinate drivers on every coordinate of b.
   for (const char* c : {"x", "y", "theta"}) {
-    all.push_back(sys.addBodyCoordinateDriver(std::string("drv_") + c, b, c,
-                                              makeHarmonicLaw(1.0, 3.0)));
+    all.push_back(addBodyCoordinateDriver(sys, std::string("drv_") + c, b, c,
+                                          makeHarmonicLaw(1.0, 3.0)));
   }
-  // The convenience builders of System (reference angles from the initial positions,
+  // The convenience builders (builders/; reference angles from the initial positions,
   // drivers derived from the joints).
-  const ConstraintIndex rev = sys.addRevoluteJoint("rev_builder", a, Vec2(0.4, -0.2), b,
-                                                   Vec2(-0.6, 0.3));
+  const ConstraintIndex rev = addRevoluteJoint(sys, "rev_builder", a, Vec2(0.4, -0.2), b,
+                                               Vec2(-0.6, 0.3));
   const ConstraintIndex pri =
-      sys.addPrismaticJoint("pri_builder", kGround, Vec2(0.5, 0.5), b, Vec2(0.2, -0.1),
-                            Vec2(1.0, 2.0));
+      addPrismaticJoint(sys, "pri_builder", kGround, Vec2(0.5, 0.5), b, Vec2(0.2, -0.1),
+                        Vec2(1.0, 2.0));
   all.push_back(rev);
   all.push_back(pri);
-  all.push_back(sys.addFixedJoint("fix_builder", a, Vec2(1.0, 0.0), b, Vec2(0.0, 1.0)));
-  all.push_back(sys.addJointDriver("ang_builder", rev, makeConstantSpeedLaw(1.0)));
-  all.push_back(sys.addJointDriver("dis_builder", pri, makeConstantSpeedLaw(1.0)));
+  all.push_back(addFixedJoint(sys, "fix_builder", a, Vec2(1.0, 0.0), b, Vec2(0.0, 1.0)));
+  all.push_back(addJointDriver(sys, "ang_builder", rev, makeConstantSpeedLaw(1.0)));
+  all.push_back(addJointDriver(sys, "dis_builder", pri, makeConstantSpeedLaw(1.0)));
   sys.finalize();
 
   for (int s = 0; s < kSamples; ++s) {
@@ -367,8 +368,8 @@ struct ForceCase {
 std::unique_ptr<ForceCase> makeForceCase(Random& rnd) {
   auto fc = std::make_unique<ForceCase>();
   System& sys = fc->sys;
-  fc->a = sys.addRigidBody("a", randomProperties(rnd), FrameState2d{});
-  fc->b = sys.addRigidBody("b", randomProperties(rnd), FrameState2d{});
+  fc->a = addRigidBody(sys, "a", randomProperties(rnd), FrameState2d{});
+  fc->b = addRigidBody(sys, "b", randomProperties(rnd), FrameState2d{});
   const BodyIndex a = fc->a, b = fc->b;
   const std::vector<std::pair<BodyIndex, BodyIndex>> pairs = {{a, b}, {kGround, b}, {a, kGround}};
   const std::vector<std::string> pairNames = {"a_b", "ground_b", "a_ground"};
@@ -491,35 +492,35 @@ System makeEverythingSystem() {
   const Vec2 sliderPos = sSlider * slideAxis;
   const double rodAngle = std::atan2(sliderPos.y() - pin.y(), sliderPos.x() - pin.x());
 
-  const BodyIndex crank = sys.addRigidBody("crank", {2.0, 0.2, Vec2(0.45, 0.06)},
-                                           {Vec2::Zero(), crank0, Vec2::Zero(), 0.0});
-  const BodyIndex rod = sys.addRigidBody("rod", {3.0, 1.1, Vec2(1.1, -0.12)},
-                                         {pin, rodAngle, Vec2::Zero(), 0.0});
-  const BodyIndex slider = sys.addRigidBody("slider", {1.5, 0.05, Vec2(0.08, 0.03)},
-                                            {sliderPos, slideAngle, Vec2::Zero(), 0.0});
+  const BodyIndex crank = addRigidBody(sys, "crank", {2.0, 0.2, Vec2(0.45, 0.06)},
+                                       {Vec2::Zero(), crank0, Vec2::Zero(), 0.0});
+  const BodyIndex rod = addRigidBody(sys, "rod", {3.0, 1.1, Vec2(1.1, -0.12)},
+                                     {pin, rodAngle, Vec2::Zero(), 0.0});
+  const BodyIndex slider = addRigidBody(sys, "slider", {1.5, 0.05, Vec2(0.08, 0.03)},
+                                        {sliderPos, slideAngle, Vec2::Zero(), 0.0});
   const Vec2 weldPoint(1.0, 0.2);
   const Vec2 weightPos = pin + rotation(rodAngle) * weldPoint;
-  const BodyIndex weight = sys.addRigidBody("weight", {0.3, 0.01, Vec2(0.02, -0.05)},
-                                            {weightPos, rodAngle + 0.5, Vec2::Zero(), 0.0});
-  const ConstraintIndex pivot = sys.addRevoluteJoint("pivot", kGround, Vec2::Zero(), crank, Vec2::Zero());
+  const BodyIndex weight = addRigidBody(sys, "weight", {0.3, 0.01, Vec2(0.02, -0.05)},
+                                        {weightPos, rodAngle + 0.5, Vec2::Zero(), 0.0});
+  const ConstraintIndex pivot = addRevoluteJoint(sys, "pivot", kGround, Vec2::Zero(), crank, Vec2::Zero());
   (void)pivot;
-  const ConstraintIndex crankPin = sys.addRevoluteJoint("crank_pin", crank, Vec2(l1, 0.0), rod, Vec2::Zero());
-  sys.addRevoluteJoint("wrist", rod, Vec2(l2, 0.0), slider, Vec2::Zero());
-  sys.addPrismaticJoint("slide", kGround, Vec2::Zero(), slider, Vec2::Zero(), slideAxis);
-  sys.addFixedJoint("weld", rod, weldPoint, weight, Vec2::Zero());
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeHarmonicLaw(0.4, 3.0, 0.2, crank0));
+  const ConstraintIndex crankPin = addRevoluteJoint(sys, "crank_pin", crank, Vec2(l1, 0.0), rod, Vec2::Zero());
+  addRevoluteJoint(sys, "wrist", rod, Vec2(l2, 0.0), slider, Vec2::Zero());
+  addPrismaticJoint(sys, "slide", kGround, Vec2::Zero(), slider, Vec2::Zero(), slideAxis);
+  addFixedJoint(sys, "weld", rod, weldPoint, weight, Vec2::Zero());
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeHarmonicLaw(0.4, 3.0, 0.2, crank0));
 
   const Vec2 carriageAxis(-0.5, 1.0);
-  const BodyIndex carriage = sys.addRigidBody("carriage", {1.2, 0.3, Vec2(-0.1, 0.2)},
-                                              {Vec2(3.0, 1.0), 0.25, Vec2::Zero(), 0.0});
-  const BodyIndex arm = sys.addRigidBody("arm", {0.8, 0.15, Vec2(0.6, 0.05)},
-                                         {Vec2(3.2, 1.1), -0.6, Vec2::Zero(), 0.0});
+  const BodyIndex carriage = addRigidBody(sys, "carriage", {1.2, 0.3, Vec2(-0.1, 0.2)},
+                                          {Vec2(3.0, 1.0), 0.25, Vec2::Zero(), 0.0});
+  const BodyIndex arm = addRigidBody(sys, "arm", {0.8, 0.15, Vec2(0.6, 0.05)},
+                                     {Vec2(3.2, 1.1), -0.6, Vec2::Zero(), 0.0});
   const ConstraintIndex carriageSlide =
-      sys.addPrismaticJoint("carriage_slide", kGround, Vec2(3.0, 1.0), carriage, Vec2::Zero(), carriageAxis);
+      addPrismaticJoint(sys, "carriage_slide", kGround, Vec2(3.0, 1.0), carriage, Vec2::Zero(), carriageAxis);
   const ConstraintIndex hinge =
-      sys.addRevoluteJoint("hinge", carriage, Vec2(0.2, 0.1), arm, Vec2::Zero());
-  sys.addJointDriver("lift", carriageSlide, makePolynomialLaw({0.0, 0.2, -0.1}));
-  sys.addJointDriver("swing", hinge, makeHarmonicLaw(0.3, 1.5, 0.0, -0.85));
+      addRevoluteJoint(sys, "hinge", carriage, Vec2(0.2, 0.1), arm, Vec2::Zero());
+  addJointDriver(sys, "lift", carriageSlide, makePolynomialLaw({0.0, 0.2, -0.1}));
+  addJointDriver(sys, "swing", hinge, makeHarmonicLaw(0.3, 1.5, 0.0, -0.85));
 
   // A flexible beam (4 FFR elements, geometric stiffening, damping) hinged at its middle
   // node to the arm, loaded at a quarter node, sprung at its end node: joints and forces
@@ -536,16 +537,16 @@ System makeEverythingSystem() {
                                                         "body 'beam'");
   const BodyIndex beam = sys.addBody(std::make_unique<FfrBody2d>(
       "beam", beamModel, FrameState2d{Vec2(2.7, 1.6), 0.3, Vec2::Zero(), 0.0}));
-  sys.addRevoluteJoint("beam_hinge", arm, Vec2(0.6, 0.0), beam, Vec2(0.5, 0.0));
-  sys.addSpringDamper("beam_spring", kGround, Vec2(4.0, 2.5), beam, Vec2(1.0, 0.0), 50.0, 2.0, 1.0);
-  sys.addAppliedLoad("beam_load", beam, Vec2(0.25, 0.0), makeHarmonicLaw(1.0, 2.0, 0.1), makeConstantLaw(0.5),
-                     makeConstantLaw(0.2));
-  sys.addBodyCoordinateDriver("beam_mode", beam, "q4", makeHarmonicLaw(0.01, 5.0, 0.0));
+  addRevoluteJoint(sys, "beam_hinge", arm, Vec2(0.6, 0.0), beam, Vec2(0.5, 0.0));
+  addSpringDamper(sys, "beam_spring", kGround, Vec2(4.0, 2.5), beam, Vec2(1.0, 0.0), 50.0, 2.0, 1.0);
+  addAppliedLoad(sys, "beam_load", beam, Vec2(0.25, 0.0), makeHarmonicLaw(1.0, 2.0, 0.1), makeConstantLaw(0.5),
+                 makeConstantLaw(0.2));
+  addBodyCoordinateDriver(sys, "beam_mode", beam, "q4", makeHarmonicLaw(0.01, 5.0, 0.0));
 
-  sys.addSpringDamper("spring", kGround, Vec2(-1.0, 0.5), slider, Vec2(0.1, 0.05), 120.0, 3.0, 1.5);
-  sys.addRotationalSpringDamper("torsion", crankPin, 25.0, 1.5, 0.2);
-  sys.addAppliedLoad("load", rod, Vec2(1.5, 0.1), makeHarmonicLaw(4.0, 2.5, 0.3),
-                     makeConstantLaw(-2.0), makePolynomialLaw({0.5, -0.3}));
+  addSpringDamper(sys, "spring", kGround, Vec2(-1.0, 0.5), slider, Vec2(0.1, 0.05), 120.0, 3.0, 1.5);
+  addRotationalSpringDamper(sys, "torsion", crankPin, 25.0, 1.5, 0.2);
+  addAppliedLoad(sys, "load", rod, Vec2(1.5, 0.1), makeHarmonicLaw(4.0, 2.5, 0.3),
+                 makeConstantLaw(-2.0), makePolynomialLaw({0.5, -0.3}));
   sys.finalize();
   return sys;
 }

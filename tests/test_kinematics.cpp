@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "integrators/simulation.hpp"
 #include "linkage/kinematic_analysis.hpp"
@@ -198,14 +199,14 @@ SolverSettings tightSettings() {
 
 TEST(KinematicsAgainstDynamics, SliderCrankDrivenThroughIda) {
   System sys;
-  const BodyIndex crank = sys.addRigidBody("crank", {1.0, 0.1, {0.5, 0}}, {{0, 0}, 0});
-  const BodyIndex rod = sys.addRigidBody("rod", {1.0, 0.4, {1.0, 0}}, {{1, 0}, 0});
-  const BodyIndex slider = sys.addRigidBody("slider", {0.5, 0.01, {0, 0}}, {{3, 0}, 0});
-  sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  sys.addRevoluteJoint("O2", crank, {1, 0}, rod, {0, 0});
-  sys.addRevoluteJoint("O3", rod, {2, 0}, slider, {0, 0});
-  sys.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(1.0));
+  const BodyIndex crank = addRigidBody(sys, "crank", {1.0, 0.1, {0.5, 0}}, {{0, 0}, 0});
+  const BodyIndex rod = addRigidBody(sys, "rod", {1.0, 0.4, {1.0, 0}}, {{1, 0}, 0});
+  const BodyIndex slider = addRigidBody(sys, "slider", {0.5, 0.01, {0, 0}}, {{3, 0}, 0});
+  addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(sys, "O2", crank, {1, 0}, rod, {0, 0});
+  addRevoluteJoint(sys, "O3", rod, {2, 0}, slider, {0, 0});
+  addPrismaticJoint(sys, "P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(1.0));
   sys.finalize();
   const int ix = sys.coordinateOffset(slider), ir = sys.coordinateOffset(rod);
 
@@ -236,14 +237,14 @@ TEST(KinematicsAgainstDynamics, SliderCrankDrivenThroughIda) {
 TEST(KinematicsAgainstDynamics, FourBarDrivenThroughIda) {
   const auto r0 = reference::fourBar(30, 60, 80, 100, 0.0);
   System sys;
-  const BodyIndex crank = sys.addRigidBody("crank", {1.0, 75.0, {15, 0}}, {{0, 0}, 0});
-  const BodyIndex coupler = sys.addRigidBody("coupler", {2.0, 600.0, {30, 0}}, {{30, 0}, r0.phi2});
-  const BodyIndex rocker = sys.addRigidBody("rocker", {2.5, 1300.0, {40, 0}}, {{100, 0}, r0.phi3});
-  sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  sys.addRevoluteJoint("O2", crank, {30, 0}, coupler, {0, 0});
-  sys.addRevoluteJoint("O3", coupler, {60, 0}, rocker, {80, 0});
-  sys.addRevoluteJoint("O4", kGround, {100, 0}, rocker, {0, 0});
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(1.0));
+  const BodyIndex crank = addRigidBody(sys, "crank", {1.0, 75.0, {15, 0}}, {{0, 0}, 0});
+  const BodyIndex coupler = addRigidBody(sys, "coupler", {2.0, 600.0, {30, 0}}, {{30, 0}, r0.phi2});
+  const BodyIndex rocker = addRigidBody(sys, "rocker", {2.5, 1300.0, {40, 0}}, {{100, 0}, r0.phi3});
+  addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(sys, "O2", crank, {30, 0}, coupler, {0, 0});
+  addRevoluteJoint(sys, "O3", coupler, {60, 0}, rocker, {80, 0});
+  addRevoluteJoint(sys, "O4", kGround, {100, 0}, rocker, {0, 0});
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(1.0));
   sys.finalize();
   const int ir = sys.coordinateOffset(rocker);
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "elements/beam_element_2d.hpp"
 #include "integrators/simulation.hpp"
@@ -189,7 +190,7 @@ double cantileverTip(int elements, bool stiffening) {
   const double g = kLinearTip * 8.0 * s.bendingStiffness() / (s.massPerLength() * std::pow(kBeamLength, 4));
   sys.setGravity(Vec2(0, -g));
   const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("beam", model, FrameState2d{}));
-  sys.addFixedJoint("root", kGround, {0, 0}, b, {0, 0});
+  addFixedJoint(sys, "root", kGround, {0, 0}, b, {0, 0});
   sys.finalize();
   const StaticEquilibrium eq = solveStaticEquilibrium(sys, 0.0, sys.initialCoordinates());
   const VecX qf = eq.q.tail(model->numElastic());
@@ -371,8 +372,8 @@ TEST(MembraneLocking, SpinUpResponseConvergesFromFourElements) {
     auto model = std::make_shared<FfrBeamModel>(bladeModel(elements));
     System sys;
     const BodyIndex b = sys.addBody(std::make_unique<FfrBody2d>("blade", model, FrameState2d{}));
-    sys.addRevoluteJoint("hub", kGround, {0, 0}, b, {0, 0});
-    sys.addBodyCoordinateDriver("motor", b, "theta", makeSpinUpLaw(w1, T));
+    addRevoluteJoint(sys, "hub", kGround, {0, 0}, b, {0, 0});
+    addBodyCoordinateDriver(sys, "motor", b, "theta", makeSpinUpLaw(w1, T));
     sys.finalize();
     SolverSettings st;
     st.rtol = 1e-8;

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "tests/reference_solutions.hpp"
@@ -21,8 +22,8 @@ const double kPhi0 = 170.0 * M_PI / 180.0;  // from the downward vertical
 System makePendulum(Formulation) {
   System sys;
   sys.setGravity(Vec2(0.0, -kGravity));
-  const BodyIndex b = sys.addRigidBody("bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
-  sys.addRevoluteJoint("pivot", kGround, {0, 0}, b, {0, 0});
+  const BodyIndex b = addRigidBody(sys, "bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
+  addRevoluteJoint(sys, "pivot", kGround, {0, 0}, b, {0, 0});
   sys.finalize();
   return sys;
 }

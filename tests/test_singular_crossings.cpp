@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
@@ -160,16 +161,16 @@ TEST(SingularCrossings, MultiParallelogramOfThreeBarsAndTwoCouplers) {
     f.position = Vec2(2.0 * i, 0.0);
     f.angle = theta0;
     f.angularVelocity = omega0;
-    bars.push_back(sys.addRigidBody(i == 0 ? "crank" : "bar" + std::to_string(i + 1), bar, f));
-    sys.addRevoluteJoint("pivot" + std::to_string(i + 1), BodyIndex(0), f.position, bars.back(), Vec2::Zero());
+    bars.push_back(addRigidBody(sys, i == 0 ? "crank" : "bar" + std::to_string(i + 1), bar, f));
+    addRevoluteJoint(sys, "pivot" + std::to_string(i + 1), BodyIndex(0), f.position, bars.back(), Vec2::Zero());
   }
   for (int i = 0; i < 2; ++i) {
     FrameState2d f;
     f.position = Vec2(2.0 * i, 0.0) + tip;
     f.velocity = tipVelocity;
-    const BodyIndex c = sys.addRigidBody("coupler" + std::to_string(i + 1), coupler, f);
-    sys.addRevoluteJoint("A" + std::to_string(i + 1), bars[i], Vec2(1.0, 0.0), c, Vec2::Zero());
-    sys.addRevoluteJoint("B" + std::to_string(i + 1), bars[i + 1], Vec2(1.0, 0.0), c, Vec2(2.0, 0.0));
+    const BodyIndex c = addRigidBody(sys, "coupler" + std::to_string(i + 1), coupler, f);
+    addRevoluteJoint(sys, "A" + std::to_string(i + 1), bars[i], Vec2(1.0, 0.0), c, Vec2::Zero());
+    addRevoluteJoint(sys, "B" + std::to_string(i + 1), bars[i + 1], Vec2(1.0, 0.0), c, Vec2(2.0, 0.0));
   }
   sys.setGravity(Vec2(0.0, -kGravity));
   sys.finalize();

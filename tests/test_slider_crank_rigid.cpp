@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
 #include "tests/reference_solutions.hpp"
@@ -63,14 +64,14 @@ TEST(RigidSliderCrank, OffsetCrankAngleApiBuiltMatchesClosedForm) {
   const Vec2 pB(l1 * std::cos(a0), l1 * std::sin(a0));
   const double rodAngle = std::atan2(-pB.y(), ref0.x - pB.x());
   System sys;
-  const BodyIndex crank = sys.addRigidBody("crank", {2.0, 0.05, {0.2, 0.0}}, {{0, 0}, a0});
-  const BodyIndex rod = sys.addRigidBody("rod", {1.5, 0.3, {0.65, 0.02}}, {pB, rodAngle});
-  const BodyIndex slider = sys.addRigidBody("slider", {0.8, 0.01, {0.1, 0.0}}, {{ref0.x, 0}, 0.0});
-  sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  sys.addRevoluteJoint("O2", crank, {l1, 0}, rod, {0, 0});
-  sys.addRevoluteJoint("O3", rod, {l2, 0}, slider, {0, 0});
-  sys.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
-  sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(w, a0));
+  const BodyIndex crank = addRigidBody(sys, "crank", {2.0, 0.05, {0.2, 0.0}}, {{0, 0}, a0});
+  const BodyIndex rod = addRigidBody(sys, "rod", {1.5, 0.3, {0.65, 0.02}}, {pB, rodAngle});
+  const BodyIndex slider = addRigidBody(sys, "slider", {0.8, 0.01, {0.1, 0.0}}, {{ref0.x, 0}, 0.0});
+  addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(sys, "O2", crank, {l1, 0}, rod, {0, 0});
+  addRevoluteJoint(sys, "O3", rod, {l2, 0}, slider, {0, 0});
+  addPrismaticJoint(sys, "P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
+  addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(w, a0));
   sys.finalize();
   SolverSettings st;
   st.rtol = 1e-8;

@@ -12,6 +12,7 @@
 
 #include "bodies/rigid_body_2d.hpp"
 #include "bodies/rigid_body_3d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
@@ -208,8 +209,8 @@ TEST(SpatialInPlane, PendulumOnARevoluteJointGivesThePlanarResult) {
   constexpr double kAgreement = 1e-7;
   System planar;
   planar.setGravity(Vec2(0.0, -kGravity));
-  const BodyIndex bp = planar.addRigidBody("bob", {m, Ic, {L, 0.0}}, {{0, 0}, phi0 - M_PI / 2});
-  planar.addRevoluteJoint("pivot", kGround, {0, 0}, bp, {0, 0});
+  const BodyIndex bp = addRigidBody(planar, "bob", {m, Ic, {L, 0.0}}, {{0, 0}, phi0 - M_PI / 2});
+  addRevoluteJoint(planar, "pivot", kGround, {0, 0}, bp, {0, 0});
   planar.finalize();
   System spatial;
   spatial.setGravity(Vec2(0.0, -kGravity));

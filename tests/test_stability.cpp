@@ -17,6 +17,7 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
@@ -432,14 +433,14 @@ TEST(Ratios, SliderMass1e6BelowTo1e6AboveTheLinksKeepsTheDriverTorqueExact) {
   for (double ratio : {1e-6, 1.0, 1e6}) {
     const double ms = 0.5 * ratio;
     System sys;
-    const BodyIndex crank = sys.addRigidBody("crank", {1.0, 0.1, {0.5, 0.0}}, {{0, 0}, 0.0});
-    const BodyIndex rod = sys.addRigidBody("rod", {1.0, 0.4, {1.0, 0.0}}, {{1, 0}, 0.0});
-    const BodyIndex slider = sys.addRigidBody("slider", {ms, 0.01 * ratio, {0.0, 0.0}}, {{3, 0}, 0.0});
-    sys.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-    sys.addRevoluteJoint("O2", crank, {1, 0}, rod, {0, 0});
-    sys.addRevoluteJoint("O3", rod, {2, 0}, slider, {0, 0});
-    sys.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
-    sys.addBodyCoordinateDriver("motor", crank, "theta", makeConstantSpeedLaw(1.0));
+    const BodyIndex crank = addRigidBody(sys, "crank", {1.0, 0.1, {0.5, 0.0}}, {{0, 0}, 0.0});
+    const BodyIndex rod = addRigidBody(sys, "rod", {1.0, 0.4, {1.0, 0.0}}, {{1, 0}, 0.0});
+    const BodyIndex slider = addRigidBody(sys, "slider", {ms, 0.01 * ratio, {0.0, 0.0}}, {{3, 0}, 0.0});
+    addRevoluteJoint(sys, "O1", kGround, {0, 0}, crank, {0, 0});
+    addRevoluteJoint(sys, "O2", crank, {1, 0}, rod, {0, 0});
+    addRevoluteJoint(sys, "O3", rod, {2, 0}, slider, {0, 0});
+    addPrismaticJoint(sys, "P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
+    addBodyCoordinateDriver(sys, "motor", crank, "theta", makeConstantSpeedLaw(1.0));
     sys.finalize();
     SolverSettings st;
     st.tEnd = 2 * M_PI;
@@ -487,12 +488,12 @@ ChainResult runChain(double m1, double m2, double k1, double k2, double rtol, bo
   Eigen::Vector2d phi = es.eigenvectors().col(0);
   phi *= 0.1 / phi.cwiseAbs().maxCoeff();  // largest displacement 0.1 (lengths ~1)
   System sys;
-  const BodyIndex b1 = sys.addRigidBody("m1", {m1, m1, {0, 0}}, {{1 + phi[0], 0}, 0.0});
-  const BodyIndex b2 = sys.addRigidBody("m2", {m2, m2, {0, 0}}, {{2 + phi[1], 0}, 0.0});
-  sys.addPrismaticJoint("P1", kGround, {0, 0}, b1, {0, 0}, {1, 0});
-  sys.addPrismaticJoint("P2", kGround, {0, 0}, b2, {0, 0}, {1, 0});
-  sys.addSpringDamper("k1", kGround, {0, 0}, b1, {0, 0}, k1, 0.0, 1.0);
-  sys.addSpringDamper("k2", b1, {0, 0}, b2, {0, 0}, k2, 0.0, 1.0);
+  const BodyIndex b1 = addRigidBody(sys, "m1", {m1, m1, {0, 0}}, {{1 + phi[0], 0}, 0.0});
+  const BodyIndex b2 = addRigidBody(sys, "m2", {m2, m2, {0, 0}}, {{2 + phi[1], 0}, 0.0});
+  addPrismaticJoint(sys, "P1", kGround, {0, 0}, b1, {0, 0}, {1, 0});
+  addPrismaticJoint(sys, "P2", kGround, {0, 0}, b2, {0, 0}, {1, 0});
+  addSpringDamper(sys, "k1", kGround, {0, 0}, b1, {0, 0}, k1, 0.0, 1.0);
+  addSpringDamper(sys, "k2", b1, {0, 0}, b2, {0, 0}, k2, 0.0, 1.0);
   sys.finalize();
   SolverSettings st;
   r.slowPeriod = 2 * M_PI / ws;
@@ -548,19 +549,19 @@ namespace {
 System springCrank(double sL, double sM) {
   System s;
   s.setGravity(Vec2(0.0, -9.81 * sL));
-  const BodyIndex crank = s.addRigidBody("crank", {1.0 * sM, 0.1 * sM * sL * sL, Vec2(0.5, 0.05) * sL},
-                                         {{0, 0}, 0.4, {0, 0}, 3.0});
+  const BodyIndex crank = addRigidBody(s, "crank", {1.0 * sM, 0.1 * sM * sL * sL, Vec2(0.5, 0.05) * sL},
+                                       {{0, 0}, 0.4, {0, 0}, 3.0});
   const Vec2 b(std::cos(0.4), std::sin(0.4));
   const double xs = b.x() + std::sqrt(4.0 - b.y() * b.y());
-  const BodyIndex rod = s.addRigidBody("rod", {1.0 * sM, 0.4 * sM * sL * sL, Vec2(1.0, -0.03) * sL},
-                                       {b * sL, std::atan2(-b.y(), xs - b.x())});
+  const BodyIndex rod = addRigidBody(s, "rod", {1.0 * sM, 0.4 * sM * sL * sL, Vec2(1.0, -0.03) * sL},
+                                     {b * sL, std::atan2(-b.y(), xs - b.x())});
   const BodyIndex slider =
-      s.addRigidBody("slider", {0.5 * sM, 0.01 * sM * sL * sL, Vec2(0.05, 0.02) * sL}, {{xs * sL, 0}, 0.0});
-  s.addRevoluteJoint("O1", kGround, {0, 0}, crank, {0, 0});
-  s.addRevoluteJoint("O2", crank, Vec2(1, 0) * sL, rod, {0, 0});
-  s.addRevoluteJoint("O3", rod, Vec2(2, 0) * sL, slider, {0, 0});
-  s.addPrismaticJoint("P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
-  s.addSpringDamper("spring", kGround, Vec2(4.0, 0.8) * sL, slider, {0, 0}, 40.0 * sM, 0.0, 0.5 * sL);
+      addRigidBody(s, "slider", {0.5 * sM, 0.01 * sM * sL * sL, Vec2(0.05, 0.02) * sL}, {{xs * sL, 0}, 0.0});
+  addRevoluteJoint(s, "O1", kGround, {0, 0}, crank, {0, 0});
+  addRevoluteJoint(s, "O2", crank, Vec2(1, 0) * sL, rod, {0, 0});
+  addRevoluteJoint(s, "O3", rod, Vec2(2, 0) * sL, slider, {0, 0});
+  addPrismaticJoint(s, "P", kGround, {0, 0}, slider, {0, 0}, {1, 0});
+  addSpringDamper(s, "spring", kGround, Vec2(4.0, 0.8) * sL, slider, {0, 0}, 40.0 * sM, 0.0, 0.5 * sL);
   s.finalize();
   return s;
 }

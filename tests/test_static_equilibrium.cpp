@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/static_equilibrium.hpp"
@@ -34,8 +35,8 @@ void buildCantilever(Cantilever& c, double tipLoad, bool stiffening) {
   o.geometricStiffening = stiffening;
   c.model = std::make_shared<FfrBeamModel>(BeamMesh2d::straight(kLength, 8, s), o, "beam");
   const BodyIndex b = c.sys.addBody(std::make_unique<FfrBody2d>("beam", c.model, FrameState2d{}));
-  c.sys.addFixedJoint("root", kGround, {0, 0}, b, {0, 0});
-  c.sys.addAppliedLoad("tip", b, {kLength, 0}, nullptr, makeConstantLaw(-tipLoad), nullptr);
+  addFixedJoint(c.sys, "root", kGround, {0, 0}, b, {0, 0});
+  addAppliedLoad(c.sys, "tip", b, {kLength, 0}, nullptr, makeConstantLaw(-tipLoad), nullptr);
   c.sys.finalize();
 }
 

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "bodies/rigid_body_2d.hpp"
+#include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
@@ -36,8 +37,8 @@ int main(int argc, char** argv) {
   // Frame at the pivot, centre of mass at (L, 0) in the body: angle = phi - pi/2.
   System sys;
   sys.setGravity(Vec2(0.0, -kGravity));
-  const BodyIndex bob = sys.addRigidBody("bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
-  sys.addRevoluteJoint("pivot", kGround, {0, 0}, bob, {0, 0});
+  const BodyIndex bob = addRigidBody(sys, "bob", {kMass, kInertiaCom, {kLength, 0.0}}, {{0, 0}, kPhi0 - M_PI / 2});
+  addRevoluteJoint(sys, "pivot", kGround, {0, 0}, bob, {0, 0});
   sys.finalize();
 
   SolverSettings settings;
