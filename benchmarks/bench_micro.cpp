@@ -7,6 +7,7 @@
 //   bari_ggl     Simeon's crank of the Bari test set (examples/bari_slider_crank.json), GGL
 //   bari_index1  the same, index 1
 //   bari_hand    the test set's hand-coded equations (benchmarks/problems/bari_crank.hpp)
+//   rigid_crank  the rigid slider-crank (examples/slider_crank_rigid.json), GGL
 // After the runs: the cost of a Jacobian and of a refactorisation in residual evaluations
 // (target: a Jacobian costs at most a few residuals).
 //
@@ -45,7 +46,7 @@ struct Fixture {
   std::vector<SuiteSparse_long> colStart, rowIndex;
 };
 
-/// "crank<N>", "bari_ggl", "bari_index1" or "bari_hand".
+/// "crank<N>", "bari_ggl", "bari_index1", "bari_hand" or "rigid_crank".
 Fixture& fixture(const std::string& model) {
   static std::map<std::string, std::unique_ptr<Fixture>> all;
   auto& f = all[model];
@@ -56,8 +57,12 @@ Fixture& fixture(const std::string& model) {
       bari::HandCodedCrank::initialValues(f->y, f->yp);
     } else {
       const bool bari = model.rfind("bari", 0) == 0;
-      f->scene = bari ? loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json")
-                      : testmodels::elasticSliderCrank(std::stoi(model.substr(5)), 1.0, 0, 1.0, 1e-6, 1e-8);
+      if (model == "rigid_crank") {
+        f->scene = loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json");
+      } else {
+        f->scene = bari ? loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json")
+                        : testmodels::elasticSliderCrank(std::stoi(model.substr(5)), 1.0, 0, 1.0, 1e-6, 1e-8);
+      }
       const System& sys = f->scene.system;
       const ConsistentState cs = computeConsistentState(sys, kTime, sys.initialCoordinates(), sys.initialVelocities());
       auto dae = std::make_unique<DaeSystem>(sys, model == "bari_index1" ? Formulation::Index1 : Formulation::Ggl);
@@ -173,7 +178,7 @@ int main(int argc, char** argv) {
   if (elementList.empty()) elementList = opt.quick ? std::vector<std::string>{"8", "32"} : std::vector<std::string>{"8", "256"};
   std::vector<std::string> models;
   for (const std::string& e : elementList) models.push_back("crank" + std::to_string(Options::toInt(e, "--elements")));
-  for (const char* m : {"bari_ggl", "bari_index1", "bari_hand"}) models.push_back(m);
+  for (const char* m : {"bari_ggl", "bari_index1", "bari_hand", "rigid_crank"}) models.push_back(m);
 
   std::vector<std::string> args = {argv[0]};
   if (opt.quick) args.push_back("--benchmark_min_time=0.02");
