@@ -11,8 +11,10 @@
 // After the runs: the cost of a Jacobian and of a refactorisation in residual evaluations
 // (target: a Jacobian costs at most a few residuals).
 //
-// Options of its own (--elements, --quick, --repeat, --csv, --out-dir); any other
-// argument goes to Google Benchmark (--benchmark_filter=..., ...).
+// Options of its own (--elements, --quick, --repeat, --csv, --out-dir, --loop); any other
+// argument goes to Google Benchmark (--benchmark_filter=..., ...). --loop MODEL:KIND:N
+// (KIND residual or jacobian) only makes N evaluations of one model and exits, for
+// instruction counts under callgrind (benchmarks/compare_builds.py --callgrind).
 #include <benchmark/benchmark.h>
 #include <klu.h>
 
@@ -173,8 +175,30 @@ int main(int argc, char** argv) {
               1);
   std::vector<std::string> elementList;
   opt.addList("--elements", "rod meshes (default 8,256; --quick: 8,32)", &elementList);
+  std::string loop;
+  opt.addString("--loop", "MODEL:KIND:N: N residual or jacobian evaluations of one model, no timing (callgrind)", &loop);
   std::vector<std::string> gbArgs;
   opt.parse(argc, argv, &gbArgs);
+  if (!loop.empty()) {
+    const size_t a = loop.find(':'), b = loop.rfind(':');
+    if (a == std::string::npos || b == a) {
+      std::fprintf(stderr, "bench_micro: --loop MODEL:KIND:N\n");
+      return 2;
+    }
+    const std::string model = loop.substr(0, a), kind = loop.substr(a + 1, b - a - 1);
+    const int n = Options::toInt(loop.substr(b + 1), "--loop");
+    Fixture& f = fixture(model);
+    for (int i = 0; i < n; ++i) {
+      if (kind == "residual") {
+        residual(f);
+      } else {
+        assembleJacobian(f);
+      }
+    }
+    benchmark::DoNotOptimize(f.F.data());
+    benchmark::DoNotOptimize(f.values.data());
+    return 0;
+  }
   if (elementList.empty()) elementList = opt.quick ? std::vector<std::string>{"8", "32"} : std::vector<std::string>{"8", "256"};
   std::vector<std::string> models;
   for (const std::string& e : elementList) models.push_back("crank" + std::to_string(Options::toInt(e, "--elements")));

@@ -25,7 +25,8 @@
 //     joint at the slider (18 independent equations). Rounds interleave the models; the
 //     ratio spatial / planar is the median over the rounds of the ratio within a round.
 //     DAE sizes of each, and one revolution of each model at rtol 1e-6, 1e-8, 1e-10
-//     against the closed form (runs interleaved).
+//     against the closed form (runs interleaved), with the planar model also with its
+//     body frames at the centres of mass (as the spatial bodies have them).
 //
 // Usage: bench_spatial [--repeat N] [--rounds N] [--quick] [--min-rtol X] [--max-rtol X]
 //                      [--ref-rtol X] [--skip-sweeps] [--profile planar|revolute|cardan]
@@ -209,22 +210,28 @@ SpatialCrank buildCrank(const CrankGeometry& C, const RigidBody3dProperties& pc,
   sys.addConstraint(
       std::make_unique<SpatialJoint>("bearing", SpatialJointType::Revolute, kGround, origin, m.crank, crankAxis));
   if (revolutes) {
-    // joint axes: the frames' z axes, world z for both bodies (in the plane, rod axes = world axes up to a turn about z)
-    sys.addConstraint(std::make_unique<SpatialJoint>("pin", SpatialJointType::Revolute, m.crank, crankPin, m.rod, rodStart));
+    // joint axes: the frames' z axes, world z for both bodies (in the plane, rod axes = world axes up to a turn about
+    // z)
+    sys.addConstraint(
+        std::make_unique<SpatialJoint>("pin", SpatialJointType::Revolute, m.crank, crankPin, m.rod, rodStart));
     JointFrame sliderPin;
-    sys.addConstraint(std::make_unique<SpatialJoint>("wrist", SpatialJointType::Revolute, m.slider, sliderPin, m.rod, rodEnd));
+    sys.addConstraint(
+        std::make_unique<SpatialJoint>("wrist", SpatialJointType::Revolute, m.slider, sliderPin, m.rod, rodEnd));
   } else {
     // the cross: frame x on the slider along world y, frame y on the rod along `cross`
     sliderCross.axes << 0, -1, 0, 1, 0, 0, 0, 0, 1;
     rodEnd.axes.col(0) = Vec3::UnitY();
     rodEnd.axes.col(1) = Vec3::UnitZ();
     rodEnd.axes.col(2) = Vec3::UnitX();
-    sys.addConstraint(std::make_unique<SpatialJoint>("pin", SpatialJointType::Spherical, m.crank, crankPin, m.rod, rodStart));
-    sys.addConstraint(std::make_unique<SpatialJoint>("cardan", SpatialJointType::Universal, m.slider, sliderCross, m.rod, rodEnd));
+    sys.addConstraint(
+        std::make_unique<SpatialJoint>("pin", SpatialJointType::Spherical, m.crank, crankPin, m.rod, rodStart));
+    sys.addConstraint(
+        std::make_unique<SpatialJoint>("cardan", SpatialJointType::Universal, m.slider, sliderCross, m.rod, rodEnd));
   }
-  sys.addConstraint(std::make_unique<SpatialJoint>("rail", SpatialJointType::Prismatic, kGround, rail, m.slider, railOnSlider));
+  sys.addConstraint(
+      std::make_unique<SpatialJoint>("rail", SpatialJointType::Prismatic, kGround, rail, m.slider, railOnSlider));
   sys.addConstraint(std::make_unique<SpatialJointAngleDriver>("motor", kGround, origin, m.crank, crankAxis,
-                                                             makeConstantSpeedLaw(C.w, C.th0)));
+                                                              makeConstantSpeedLaw(C.w, C.th0)));
   sys.finalize();
   return m;
 }
@@ -362,19 +369,21 @@ WpRow runCrank(double rtol) {
 void printWp(const char* title, const char* h1, const char* h2, const char* h3, const char* h4,
              const std::vector<WpRow>& rows, CsvWriter& csv, const std::string& model) {
   std::printf("\n%s\n", title);
-  std::printf("%7s %10s %7s %7s %6s %5s %5s %10s %10s", "rtol", "CPU [ms]", "steps", "res", "jac", "etf", "ncf", h1, h2);
+  std::printf("%7s %10s %7s %7s %6s %5s %5s %10s %10s", "rtol", "CPU [ms]", "steps", "res", "jac", "etf", "ncf", h1,
+              h2);
   if (h3) std::printf(" %10s", h3);
   if (h4) std::printf(" %10s", h4);
   std::printf("\n");
   for (const WpRow& r : rows) {
-    std::printf("%7.0e %10.2f %7ld %7ld %6ld %5ld %5ld %10.2e %10.2e", r.rtol, 1e3 * r.cpu, r.steps, r.res, r.jac, r.etf,
-                r.ncf, r.e1, r.e2);
+    std::printf("%7.0e %10.2f %7ld %7ld %6ld %5ld %5ld %10.2e %10.2e", r.rtol, 1e3 * r.cpu, r.steps, r.res, r.jac,
+                r.etf, r.ncf, r.e1, r.e2);
     if (h3) std::printf(" %10.2e", r.e3);
     if (h4) std::printf(" %10.2e", r.e4);
     if (!r.ok) std::printf("  FAILED: %s", r.message.c_str());
     std::printf("\n");
     csv.row({model, fmt(r.rtol, "%.0e"), fmt(r.cpu), std::to_string(r.steps), std::to_string(r.res),
-             std::to_string(r.jac), std::to_string(r.etf), std::to_string(r.ncf), sci(r.e1), sci(r.e2), sci(r.e3), sci(r.e4), r.ok ? "1" : "0"});
+             std::to_string(r.jac), std::to_string(r.etf), std::to_string(r.ncf), sci(r.e1), sci(r.e2), sci(r.e3),
+             sci(r.e4), r.ok ? "1" : "0"});
   }
 }
 
@@ -383,7 +392,7 @@ void printWp(const char* title, const char* h1, const char* h2, const char* h3, 
 
 struct EvalModel {
   std::string name;
-  std::unique_ptr<Scene> scene;        // planar model
+  std::unique_ptr<Scene> scene;         // planar model
   std::unique_ptr<SpatialCrank> crank;  // spatial model
   std::unique_ptr<DaeSystem> dae;
   std::unique_ptr<DaeScratch> scratch;
@@ -473,8 +482,10 @@ int main(int argc, char** argv) {
   bool skipSweeps = false;
   std::string profile;
   opt.flag("--skip-sweeps", "only the evaluation costs and the in-plane runs (part b)", &skipSweeps);
-  opt.addString("--profile", "planar|revolute|cardan: only the residual and Jacobian loops of that in-plane model, "
-                "--rounds times, no output (for callgrind)", &profile);
+  opt.addString("--profile",
+                "planar|revolute|cardan: only the residual and Jacobian loops of that in-plane model, "
+                "--rounds times, no output (for callgrind)",
+                &profile);
   opt.parse(argc, argv);
   if (opt.quick) {
     opt.repeat = 1;
@@ -487,74 +498,83 @@ int main(int argc, char** argv) {
   CsvWriter csv(opt.csvPath("bench_spatial.csv"),
                 {"model", "rtol", "cpu_s", "steps", "residual_evals", "jacobian_evals", "error_test_failures",
                  "convergence_failures", "e1", "e2", "e3", "e4", "ok"});
-  csv.comment("free_body: e1 = |w - w_ref|/|w_ref| at 20 s, e2 = orientation error [rad] at 20 s, e3 = energy drift, e4 = angular momentum drift");
+  csv.comment(
+      "free_body: e1 = |w - w_ref|/|w_ref| at 20 s, e2 = orientation error [rad] at 20 s, e3 = energy drift, e4 = "
+      "angular momentum drift");
   csv.comment("heavy_top: e1 = max tilt error [rad], e2 = max azimuth error [rad]");
   csv.comment("slider_crank: e1 = max |x - s| [m], e2 = max |x' - s'| [m/s], e3 = max |x'' - s''| [m/s^2]");
 
   if (!profile.empty()) skipSweeps = true;
   if (!skipSweeps) {
-  std::printf("Spatial models, GGL, IDA, atol = rtol/100; CPU time of simulate() (initialisation and outputs\n"
-              "included), median of %d runs\n", opt.repeat);
+    std::printf(
+        "Spatial models, GGL, IDA, atol = rtol/100; CPU time of simulate() (initialisation and outputs\n"
+        "included), median of %d runs\n",
+        opt.repeat);
 
-  // --- free body -------------------------------------------------------------------
-  {
-    FreeBodyEnd ref;
-    const WpRow r = runFreeBody(refRtol, &ref, nullptr);
-    std::vector<WpRow> rows;
-    for (double rtol : rtols) rows.push_back(timed(rtol, opt.repeat, [&](double rt) { return runFreeBody(rt, nullptr, &ref); }));
-    char title[512];
-    std::snprintf(title, sizeof title,
-                  "Torque-free asymmetric body, J = (1, 2, 3), w0 = (1, 2, -1.5) rad/s, 20 s, outputs every 0.05 s.\n"
-                  "err w, err A: angular velocity (relative) and orientation [rad] at 20 s against rtol %.0e "
-                  "(%ld steps%s);\ndE, dH: max relative change of the energy and of the angular momentum (world)",
-                  refRtol, r.steps, r.ok ? "" : ", FAILED");
-    printWp(title, "err w", "err A", "dE", "dH", rows, csv, "free_body");
-    std::printf("%7s %10s %7ld %7ld %6ld %5ld %5ld %10s %10s %10.2e %10.2e   (reference)\n",
-                fmt(refRtol, "%.0e").c_str(), "", r.steps, r.res, r.jac, r.etf, r.ncf, "", "", r.e3, r.e4);
-  }
-  // --- heavy top -------------------------------------------------------------------
-  {
-    std::vector<WpRow> rows;
-    for (double rtol : rtols) rows.push_back(timed(rtol, opt.repeat, runTop));
-    rows.push_back(timed(refRtol, 1, runTop));
-    char title[512];
-    std::snprintf(title, sizeof title,
-                  "Heavy symmetric top in steady precession (m = 1.5, l = 0.2, tilt 0.5 rad, spin 100 rad/s,\n"
-                  "precession %.4f rad/s), 2 s, outputs every 0.01 s; max error against the closed form [rad]; the "
-                  "last row once",
-                  Top::precessionRate());
-    printWp(title, "tilt", "azimuth", nullptr, nullptr, rows, csv, "heavy_top");
-  }
-  // --- spatial slider crank --------------------------------------------------------
-  {
-    std::vector<WpRow> rows;
-    for (double rtol : rtols) rows.push_back(timed(rtol, opt.repeat, runCrank));
-    rows.push_back(timed(refRtol, 1, runCrank));
-    printWp("Spatial slider crank (revolute, spherical, universal, prismatic, angle driver; r = 0.15, L = 0.45,\n"
-            "h = 0.1 m, 1 rev/s), 2 s, outputs every 0.01 s; max error of the slider against the closed form:\n"
-            "x [m], x' [m/s], x'' [m/s^2]; the last row once",
-            "err x", "err x'", "err x''", nullptr, rows, csv, "slider_crank");
-  }
+    // --- free body -------------------------------------------------------------------
+    {
+      FreeBodyEnd ref;
+      const WpRow r = runFreeBody(refRtol, &ref, nullptr);
+      std::vector<WpRow> rows;
+      for (double rtol : rtols)
+        rows.push_back(timed(rtol, opt.repeat, [&](double rt) { return runFreeBody(rt, nullptr, &ref); }));
+      char title[512];
+      std::snprintf(title, sizeof title,
+                    "Torque-free asymmetric body, J = (1, 2, 3), w0 = (1, 2, -1.5) rad/s, 20 s, outputs every 0.05 s.\n"
+                    "err w, err A: angular velocity (relative) and orientation [rad] at 20 s against rtol %.0e "
+                    "(%ld steps%s);\ndE, dH: max relative change of the energy and of the angular momentum (world)",
+                    refRtol, r.steps, r.ok ? "" : ", FAILED");
+      printWp(title, "err w", "err A", "dE", "dH", rows, csv, "free_body");
+      std::printf("%7s %10s %7ld %7ld %6ld %5ld %5ld %10s %10s %10.2e %10.2e   (reference)\n",
+                  fmt(refRtol, "%.0e").c_str(), "", r.steps, r.res, r.jac, r.etf, r.ncf, "", "", r.e3, r.e4);
+    }
+    // --- heavy top -------------------------------------------------------------------
+    {
+      std::vector<WpRow> rows;
+      for (double rtol : rtols) rows.push_back(timed(rtol, opt.repeat, runTop));
+      rows.push_back(timed(refRtol, 1, runTop));
+      char title[512];
+      std::snprintf(title, sizeof title,
+                    "Heavy symmetric top in steady precession (m = 1.5, l = 0.2, tilt 0.5 rad, spin 100 rad/s,\n"
+                    "precession %.4f rad/s), 2 s, outputs every 0.01 s; max error against the closed form [rad]; the "
+                    "last row once",
+                    Top::precessionRate());
+      printWp(title, "tilt", "azimuth", nullptr, nullptr, rows, csv, "heavy_top");
+    }
+    // --- spatial slider crank --------------------------------------------------------
+    {
+      std::vector<WpRow> rows;
+      for (double rtol : rtols) rows.push_back(timed(rtol, opt.repeat, runCrank));
+      rows.push_back(timed(refRtol, 1, runCrank));
+      printWp(
+          "Spatial slider crank (revolute, spherical, universal, prismatic, angle driver; r = 0.15, L = 0.45,\n"
+          "h = 0.1 m, 1 rev/s), 2 s, outputs every 0.01 s; max error of the slider against the closed form:\n"
+          "x [m], x' [m/s], x'' [m/s^2]; the last row once",
+          "err x", "err x'", "err x''", nullptr, rows, csv, "slider_crank");
+    }
   }  // !skipSweeps
 
   // --- (b) cost per evaluation -------------------------------------------------------
   std::vector<EvalModel> models(3);
-  models[0].name = "planar (3 revolute, prismatic, body angle driver)";
-  models[0].scene = std::make_unique<Scene>(loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json"));
+  models[0].name = "planar: 3 revolute + prismatic + body angle driver";
+  models[0].scene =
+      std::make_unique<Scene>(loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json"));
   {
     const System& sys = models[0].sys();
-    const ConsistentState cs = computeConsistentState(sys, kEvalTime, sys.initialCoordinates(), sys.initialVelocities());
+    const ConsistentState cs =
+        computeConsistentState(sys, kEvalTime, sys.initialCoordinates(), sys.initialVelocities());
     prepare(models[0], cs.q, cs.v, cs.a, cs.lambda);
   }
-  models[1].name = "spatial, 3 revolute + prismatic + angle driver";
+  models[1].name = "spatial: 3 revolute + prismatic + angle driver";
   models[1].crank = std::make_unique<SpatialCrank>(planeCrank(true));
-  models[2].name = "spatial, revolute + spherical + universal + prismatic + driver";
+  models[2].name = "spatial: revolute + spherical + universal + prismatic + driver";
   models[2].crank = std::make_unique<SpatialCrank>(planeCrank(false));
   {
     // The consistent state of the non-redundant model; the revolute model has the same
     // bodies and coordinates, its multipliers are the minimum-norm ones.
     const System& sys = models[2].sys();
-    const ConsistentState cs = computeConsistentState(sys, kEvalTime, sys.initialCoordinates(), sys.initialVelocities());
+    const ConsistentState cs =
+        computeConsistentState(sys, kEvalTime, sys.initialCoordinates(), sys.initialVelocities());
     prepare(models[2], cs.q, cs.v, cs.a, cs.lambda);
     VecX a, lambda;
     computeAccelerations(models[1].sys(), kEvalTime, cs.q, cs.v, a, lambda);
@@ -583,8 +603,8 @@ int main(int argc, char** argv) {
   }
   for (int round = 0; round < rounds; ++round) {
     for (EvalModel& m : models) {
-      m.tRes.push_back(cpuPerCall(
-          [&] { m.dae->residual(kEvalTime, m.y.data(), m.yp.data(), m.F.data(), *m.scratch); }, nRes));
+      m.tRes.push_back(
+          cpuPerCall([&] { m.dae->residual(kEvalTime, m.y.data(), m.yp.data(), m.F.data(), *m.scratch); }, nRes));
       m.tJac.push_back(cpuPerCall(
           [&] {
             std::fill(m.values.begin(), m.values.end(), 0.0);
@@ -594,16 +614,17 @@ int main(int argc, char** argv) {
           nJac));
     }
   }
-  std::printf("\nOne residual and one Jacobian (sparse, into the DAE's pattern) of the slider crank l1 = 1, l2 = 2\n"
-              "in the x-y plane, GGL, at the consistent state at t = %.1f; scratch of makeScratch(); CPU time,\n"
-              "median of %d interleaved rounds (%d residuals, %d Jacobians per round and model); ratios: median\n"
-              "over the rounds of spatial / planar within the round\n\n",
-              kEvalTime, rounds, nRes, nJac);
-  std::printf("%-62s %4s %4s %4s %5s %6s %8s %8s %8s %9s %9s %9s\n", "model", "nq", "nv", "m", "size", "nnz",
-              "max|g|", "res [us]", "jac [us]", "jac/res", "res ratio", "jac ratio");
-  CsvWriter ecsv(opt.csvPath("bench_spatial_eval.csv", false),
-                 {"model", "nq", "nv", "m", "dae_size", "nnz", "residual_us", "jacobian_us", "residual_ratio",
-                  "jacobian_ratio"});
+  std::printf(
+      "\nOne residual and one Jacobian (sparse, into the DAE's pattern) of the slider crank l1 = 1, l2 = 2\n"
+      "in the x-y plane, GGL, at the consistent state at t = %.1f; scratch of makeScratch(); CPU time,\n"
+      "median of %d interleaved rounds (%d residuals, %d Jacobians per round and model); ratios: median\n"
+      "over the rounds of spatial / planar within the round\n\n",
+      kEvalTime, rounds, nRes, nJac);
+  std::printf("%-62s %4s %4s %4s %5s %6s %8s %8s %8s %9s %9s %9s\n", "model", "nq", "nv", "m", "size", "nnz", "max|g|",
+              "res [us]", "jac [us]", "jac/res", "res ratio", "jac ratio");
+  CsvWriter ecsv(
+      opt.csvPath("bench_spatial_eval.csv", false),
+      {"model", "nq", "nv", "m", "dae_size", "nnz", "residual_us", "jacobian_us", "residual_ratio", "jacobian_ratio"});
   for (const EvalModel& m : models) {
     std::vector<double> rr, rj;
     for (int k = 0; k < rounds; ++k) {
@@ -623,13 +644,16 @@ int main(int argc, char** argv) {
 
   // one revolution of each (the same mechanism: the planar closed form)
   {
-    std::printf("\nOne revolution (60 outputs), CPU time of simulate(), median of %d runs; err x: max relative\n"
-                "error of the slider against the closed form of the planar slider crank; ratio: CPU time / planar at\n"
-                "the same rtol\n\n", opt.repeat);
+    std::printf(
+        "\nOne revolution (60 outputs), CPU time of simulate(), median of %d runs; err x: max relative\n"
+        "error of the slider against the closed form of the planar slider crank; ratio: CPU time / planar at\n"
+        "the same rtol\n\n",
+        opt.repeat);
     std::printf("%-62s %6s %9s %6s %6s %5s %5s %5s %10s %7s\n", "model", "rtol", "CPU [ms]", "steps", "res", "jac",
                 "etf", "ncf", "err x", "ratio");
     auto planarScene = [] {
-      auto scene = std::make_shared<Scene>(loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json"));
+      auto scene =
+          std::make_shared<Scene>(loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json"));
       const System& s = scene->system;
       return std::make_pair(std::shared_ptr<const System>(scene, &s), s.coordinateOffset(s.findBody("slider")));
     };
@@ -660,7 +684,8 @@ int main(int argc, char** argv) {
     };
     CsvWriter rcsv(opt.csvPath("bench_spatial_in_plane.csv", false),
                    {"model", "rtol", "cpu_s", "steps", "residual_evals", "jacobian_evals", "err_x", "ok"});
-    const std::vector<double> revRtols = opt.quick ? std::vector<double>{1e-6, 1e-8} : std::vector<double>{1e-6, 1e-8, 1e-10};
+    const std::vector<double> revRtols =
+        opt.quick ? std::vector<double>{1e-6, 1e-8} : std::vector<double>{1e-6, 1e-8, 1e-10};
     for (double rtol : revRtols) {
       RevolutionRun runs[4];
       // interleaved: planar, spatial (revolutes), spatial (cardan), planar (frames at the
@@ -680,10 +705,10 @@ int main(int argc, char** argv) {
       for (int k = 0; k < 4; ++k) runs[k].cpu = median(runs[k].times);
       for (int k : {0, 3, 1, 2}) {
         const RevolutionRun& r = runs[k];
-        const std::string name = k < 3 ? models[k].name : "planar, body frames at the centres of mass";
+        const std::string name = k < 3 ? models[k].name : "planar: body frames at the centres of mass";
         if (r.ok) {
-          std::printf("%-62s %6.0e %9.2f %6ld %6ld %5ld %5ld %5ld %10.2e %7.2f\n", name.c_str(), rtol,
-                      1e3 * r.cpu, r.steps, r.res, r.jac, r.etf, r.ncf, r.err, r.cpu / runs[0].cpu);
+          std::printf("%-62s %6.0e %9.2f %6ld %6ld %5ld %5ld %5ld %10.2e %7.2f\n", name.c_str(), rtol, 1e3 * r.cpu,
+                      r.steps, r.res, r.jac, r.etf, r.ncf, r.err, r.cpu / runs[0].cpu);
         } else {
           std::string msg = r.message;
           const size_t cut = msg.find(" defined before");

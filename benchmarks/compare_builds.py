@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Planar benchmark figures of two builds, runs alternating (old, new, old, new, ...).
+"""Planar benchmark figures of two builds, runs alternating (old, new, new, old, ...).
 
 Runs, per round and build: bench_rigid_slider_crank --repeat 3, bench_elastic_slider_crank
 --repeat 1, bench_micro (residual and Jacobian benchmarks only) and bench_kinematics;
@@ -11,7 +11,10 @@ bench_rigid_slider_crank and bench_elastic_slider_crank (fixed work) is added, l
 sensitive to a loaded machine.
 
     /usr/bin/python3 benchmarks/compare_builds.py --old ../wt-bench-old/build --new build \
-        --rounds 5 [--out results/compare.md]
+        --rounds 10 [--callgrind] [--out results/compare.md]
+
+--callgrind adds the instructions per residual and per Jacobian (reused scratch) of four
+models, counted by callgrind: deterministic, unlike the times on a shared machine.
 
 The builds need the targets bench_rigid_slider_crank, bench_elastic_slider_crank,
 bench_micro and bench_kinematics; their source files must be the same in both trees
@@ -105,6 +108,32 @@ def kinematics(build, tmp):
     return times, counters
 
 
+def instructions(build, model, kind, n):
+    """Instructions (callgrind) of bench_micro --loop MODEL:KIND:N."""
+    out = subprocess.run(["nice", "valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
+                          os.path.join(build, "benchmarks", "bench_micro"), "--loop", f"{model}:{kind}:{n}"],
+                         capture_output=True, text=True)
+    m = re.search(r"Collected : (\d+)", out.stderr)
+    if out.returncode != 0 or not m:
+        sys.stderr.write(out.stderr)
+        raise SystemExit("valgrind --tool=callgrind failed")
+    return int(m.group(1))
+
+
+def callgrind_table(builds, n=1000):
+    """Instructions per evaluation (reused scratch), deterministic: (Ir(N) - Ir(0)) / N."""
+    lines = ["", f"Instructions per evaluation (callgrind, bench_micro --loop MODEL:KIND:{n} minus :0)", "",
+             "| model | evaluation | old [Ir] | new [Ir] | new/old |", "|---|---|---|---|---|"]
+    for model in ("rigid_crank", "bari_ggl", "bari_index1", "crank8"):
+        for kind in ("residual", "jacobian"):
+            per = {}
+            for which in ("old", "new"):
+                per[which] = (instructions(builds[which], model, kind, n) - instructions(builds[which], model, kind, 0)) / n
+            lines.append(f"| {model} | {kind} | {per['old']:.0f} | {per['new']:.0f} | {per['new'] / per['old']:.3f} |")
+            print(f"callgrind {model} {kind} done", file=sys.stderr, flush=True)
+    return lines
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--old", required=True, help="build directory of the old tree")
@@ -112,6 +141,8 @@ def main():
     ap.add_argument("--rounds", type=int, default=5)
     ap.add_argument("--out", help="also write the table (markdown) to this file")
     ap.add_argument("--skip", default="", help="comma-separated: rigid,elastic,micro,kinematics")
+    ap.add_argument("--callgrind", action="store_true",
+                    help="also count instructions per residual and Jacobian (valgrind; bench_micro --loop)")
     args = ap.parse_args()
     skip = set(filter(None, args.skip.split(",")))
     benches = [(n, f) for n, f in [("rigid", rigid), ("elastic", elastic), ("micro", micro),
@@ -122,8 +153,11 @@ def main():
     order = []
     with tempfile.TemporaryDirectory() as tmp:
         for r in range(args.rounds):
-            for which in ("old", "new"):
-                for name, fn in benches:
+            # each binary runs for both builds back to back, the order alternating from
+            # round to round (old, new / new, old): a change of the machine's load between
+            # two binaries' runs biases neither build
+            for name, fn in benches:
+                for which in (("old", "new") if r % 2 == 0 else ("new", "old")):
                     t, c = fn(builds[which], tmp)
                     if name in ("rigid", "elastic"):  # whole-binary CPU time (fixed work)
                         binary = "bench_rigid_slider_crank" if name == "rigid" else "bench_elastic_slider_crank"
@@ -133,8 +167,9 @@ def main():
                         if k not in order:
                             order.append(k)
                     counters[which].update(c)
-                print(f"round {r + 1}/{args.rounds} {which} done", file=sys.stderr, flush=True)
-    lines = [f"{args.rounds} rounds, alternating old/new; medians over the rounds",
+            print(f"round {r + 1}/{args.rounds} done", file=sys.stderr, flush=True)
+    lines = [f"{args.rounds} rounds; in each, every binary runs for both builds back to back "
+             f"(order old/new, then new/old in the next round); medians over the rounds",
              "",
              "| figure | old | new | new/old (medians) | new/old (median of per-round ratios) | counters equal |",
              "|---|---|---|---|---|---|"]
@@ -148,6 +183,8 @@ def main():
         if k in counters["old"] and k in counters["new"]:
             ceq = "yes" if counters["old"][k] == counters["new"][k] else f"no: {counters['old'][k]} / {counters['new'][k]}"
         lines.append(f"| {k} | {mo:.4g} | {mn:.4g} | {mn / mo:.3f} | {per:.3f} | {ceq} |")
+    if args.callgrind:
+        lines += callgrind_table(builds)
     text = "\n".join(lines)
     print(text)
     if args.out:
