@@ -7,11 +7,14 @@
 //   bari_ggl     Simeon's crank of the Bari test set (examples/bari_slider_crank.json), GGL
 //   bari_index1  the same, index 1
 //   bari_hand    the test set's hand-coded equations (benchmarks/problems/bari_crank.hpp)
+//   rigid_crank  the rigid slider-crank (examples/slider_crank_rigid.json), GGL
 // After the runs: the cost of a Jacobian and of a refactorisation in residual evaluations
 // (target: a Jacobian costs at most a few residuals).
 //
-// Options of its own (--elements, --quick, --repeat, --csv, --out-dir); any other
-// argument goes to Google Benchmark (--benchmark_filter=..., ...).
+// Options of its own (--elements, --quick, --repeat, --csv, --out-dir, --loop); any other
+// argument goes to Google Benchmark (--benchmark_filter=..., ...). --loop MODEL:KIND:N
+// (KIND residual or jacobian) only makes N evaluations of one model and exits, for
+// instruction counts under callgrind (benchmarks/compare_builds.py --callgrind).
 #include <benchmark/benchmark.h>
 #include <klu.h>
 
@@ -45,7 +48,7 @@ struct Fixture {
   std::vector<SuiteSparse_long> colStart, rowIndex;
 };
 
-/// "crank<N>", "bari_ggl", "bari_index1" or "bari_hand".
+/// "crank<N>", "bari_ggl", "bari_index1", "bari_hand" or "rigid_crank".
 Fixture& fixture(const std::string& model) {
   static std::map<std::string, std::unique_ptr<Fixture>> all;
   auto& f = all[model];
@@ -56,8 +59,12 @@ Fixture& fixture(const std::string& model) {
       bari::HandCodedCrank::initialValues(f->y, f->yp);
     } else {
       const bool bari = model.rfind("bari", 0) == 0;
-      f->scene = bari ? loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json")
-                      : testmodels::elasticSliderCrank(std::stoi(model.substr(5)), 1.0, 0, 1.0, 1e-6, 1e-8);
+      if (model == "rigid_crank") {
+        f->scene = loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json");
+      } else {
+        f->scene = bari ? loadScene(std::string(FLEXMBD_SOURCE_DIR) + "/examples/bari_slider_crank.json")
+                        : testmodels::elasticSliderCrank(std::stoi(model.substr(5)), 1.0, 0, 1.0, 1e-6, 1e-8);
+      }
       const System& sys = f->scene.system;
       const ConsistentState cs = computeConsistentState(sys, kTime, sys.initialCoordinates(), sys.initialVelocities());
       auto dae = std::make_unique<DaeSystem>(sys, model == "bari_index1" ? Formulation::Index1 : Formulation::Ggl);
@@ -168,12 +175,34 @@ int main(int argc, char** argv) {
               1);
   std::vector<std::string> elementList;
   opt.addList("--elements", "rod meshes (default 8,256; --quick: 8,32)", &elementList);
+  std::string loop;
+  opt.addString("--loop", "MODEL:KIND:N: N residual or jacobian evaluations of one model, no timing (callgrind)", &loop);
   std::vector<std::string> gbArgs;
   opt.parse(argc, argv, &gbArgs);
+  if (!loop.empty()) {
+    const size_t a = loop.find(':'), b = loop.rfind(':');
+    if (a == std::string::npos || b == a) {
+      std::fprintf(stderr, "bench_micro: --loop MODEL:KIND:N\n");
+      return 2;
+    }
+    const std::string model = loop.substr(0, a), kind = loop.substr(a + 1, b - a - 1);
+    const int n = Options::toInt(loop.substr(b + 1), "--loop");
+    Fixture& f = fixture(model);
+    for (int i = 0; i < n; ++i) {
+      if (kind == "residual") {
+        residual(f);
+      } else {
+        assembleJacobian(f);
+      }
+    }
+    benchmark::DoNotOptimize(f.F.data());
+    benchmark::DoNotOptimize(f.values.data());
+    return 0;
+  }
   if (elementList.empty()) elementList = opt.quick ? std::vector<std::string>{"8", "32"} : std::vector<std::string>{"8", "256"};
   std::vector<std::string> models;
   for (const std::string& e : elementList) models.push_back("crank" + std::to_string(Options::toInt(e, "--elements")));
-  for (const char* m : {"bari_ggl", "bari_index1", "bari_hand"}) models.push_back(m);
+  for (const char* m : {"bari_ggl", "bari_index1", "bari_hand", "rigid_crank"}) models.push_back(m);
 
   std::vector<std::string> args = {argv[0]};
   if (opt.quick) args.push_back("--benchmark_min_time=0.02");
