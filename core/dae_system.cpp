@@ -100,10 +100,11 @@ void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, c
     const int b = sys.constraint(ci).bodies()[k].value;
     const std::vector<int>& qc = *st.qcols;
     const std::vector<int>& vc = *st.cols;
+    const bool identity = st.body.velocitiesAreCoordinateRates();  // S.T[b] is not filled then
     for (size_t i = 0; i < qc.size(); ++i) {
       for (size_t j = 0; j < vc.size(); ++j) {
-        Tl(r + i, c + j) = S.T[b](qc[i], vc[j]);
-        Til(c + j, r + i) = S.Tinv[b](vc[j], qc[i]);
+        Tl(r + i, c + j) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : S.T[b](qc[i], vc[j]);
+        Til(c + j, r + i) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : S.Tinv[b](vc[j], qc[i]);
       }
     }
     r += static_cast<int>(qc.size());
@@ -187,12 +188,20 @@ std::vector<int64_t> DaeSystem::eliminationGroups() const {
 
 std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
   const System& sys = sys_;
+  const bool identityT = sys.velocitiesAreCoordinateRates();
   auto s = std::make_unique<DaeSystemScratch>();
+  s->bodyForce.reserve(sys.numBodies());
+  if (!identityT) {
+    s->T.resize(sys.numBodies());
+    s->Tinv.resize(sys.numBodies());
+  }
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const Body& body = sys.body(BodyIndex(b));
-    s->bodyForce.emplace_back(body.numVelocities());
-    s->T.emplace_back(MatX::Zero(body.numCoordinates(), body.numVelocities()));
-    s->Tinv.emplace_back(MatX::Zero(body.numVelocities(), body.numCoordinates()));
+    const BodyIndex bi(b);
+    s->bodyForce.emplace_back(sys.numVelocities(bi));
+    if (!identityT && !sys.body(bi).velocitiesAreCoordinateRates()) {  // T and T+ only where T != I
+      s->T[b].setZero(sys.numCoordinates(bi), sys.numVelocities(bi));
+      s->Tinv[b].setZero(sys.numVelocities(bi), sys.numCoordinates(bi));
+    }
   }
   s->constraints.resize(sys.numConstraints());
   for (int c = 0; c < sys.numConstraints(); ++c) {
@@ -203,7 +212,6 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     cs.vl.resize(nl);
     cs.al.resize(nl);
     cs.Hv.resize(nl);
-    cs.wl.resize(nql);
     cs.Hx.resize(nl, nql);
     cs.vH.resize(me, nql);
     cs.dFdq.resize(me, nql);
@@ -220,10 +228,12 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
   }
   s->qPlus.resize(sys.numCoordinates());
   s->qMinus.resize(sys.numCoordinates());
-  s->DGtmu.resize(sys.numVelocities());
-  s->w.resize(sys.numVelocities());
-  s->Tv.resize(sys.numCoordinates());
-  s->TvPlus.resize(sys.numCoordinates());
+  if (!identityT) {
+    s->DGtmu.resize(sys.numVelocities());
+    s->w.resize(sys.numVelocities());
+    s->Tv.resize(sys.numCoordinates());
+    s->TvPlus.resize(sys.numCoordinates());
+  }
   return s;
 }
 
@@ -257,9 +267,9 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
   Fv.setZero();
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
-    const Body& body = sys.body(bi);
-    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
     if (nqb == 0) continue;
+    const Body& body = sys.body(bi);
     const int voff = sys.velocityOffset(bi);
     const auto qb = q.segment(sys.coordinateOffset(bi), nqb);
     VecX& Qb = S.bodyForce[b];
@@ -297,7 +307,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
       case Formulation::Ggl: {
         // F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f'
         const double* mu = y + L.mu + row;
-        if (const double period = con.equationPeriod(); period > 0.0) {
+        if (const double period = sys.constraintPeriod(ci); period > 0.0) {
           for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
         }
         if (identityT) {
@@ -315,7 +325,7 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
         break;
       }
       case Formulation::Index3:
-        if (const double period = con.equationPeriod(); period > 0.0) {
+        if (const double period = sys.constraintPeriod(ci); period > 0.0) {
           for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
         }
         Fc = ev.h - cs.f;
@@ -361,13 +371,13 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
   // cj I and -T (with T = I: -I)
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
-    const Body& body = sys.body(bi);
-    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
     if (nqb == 0) continue;
+    const Body& body = sys.body(bi);
     const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
     const auto qb = q.segment(qoff, nqb);
     for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.q + qoff + k, cj);
-    if (body.velocitiesAreCoordinateRates()) {
+    if (identityT || body.velocitiesAreCoordinateRates()) {
       for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.v + voff + k, -1.0);
     } else {
       body.coordinateRateMatrix(qb, S.T[b]);

@@ -119,11 +119,15 @@ void System::finalize() {
   }
   bodyOffset_.clear();
   bodyVelocityOffset_.clear();
+  bodyNq_.clear();
+  bodyNv_.clear();
   nq_ = nv_ = 0;
   coordinateRates_ = true;
   for (const auto& b : bodies_) {
     bodyOffset_.push_back(nq_);
     bodyVelocityOffset_.push_back(nv_);
+    bodyNq_.push_back(b->numCoordinates());
+    bodyNv_.push_back(b->numVelocities());
     nq_ += b->numCoordinates();
     nv_ += b->numVelocities();
     coordinateRates_ = coordinateRates_ && b->velocitiesAreCoordinateRates();
@@ -173,7 +177,9 @@ void System::finalize() {
   constraintQCols_.clear();
   constraintUsed_.clear();
   constraintUsedQ_.clear();
+  constraintPeriod_.clear();
   for (const auto& c : constraints_) {
+    constraintPeriod_.push_back(c->equationPeriod());
     constraintOffset_.push_back(m_);
     m_ += c->numEquations();
     constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), [&](int slot) { return c->coordinatesUsed(slot); }));

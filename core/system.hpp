@@ -57,6 +57,11 @@ class System {
   int numConstraintEquations() const { return m_; }
   int coordinateOffset(BodyIndex i) const { return bodyOffset_.at(i.value); }
   int velocityOffset(BodyIndex i) const { return bodyVelocityOffset_.at(i.value); }
+  /// Body b's numbers of coordinates and velocities (cached at finalize: no virtual call).
+  int numCoordinates(BodyIndex i) const { return bodyNq_[i.value]; }
+  int numVelocities(BodyIndex i) const { return bodyNv_[i.value]; }
+  /// Constraint::equationPeriod() of each constraint, cached at finalize.
+  double constraintPeriod(ConstraintIndex i) const { return constraintPeriod_[i.value]; }
   int constraintOffset(ConstraintIndex i) const { return constraintOffset_.at(i.value); }
   /// True when every body has q' = v (T = I; planar models): nq == nv and the maps agree.
   bool velocitiesAreCoordinateRates() const { return coordinateRates_; }
@@ -113,7 +118,8 @@ class System {
   bool finalized_ = false;
   int nq_ = 0, nv_ = 0, m_ = 0;
   bool coordinateRates_ = true;
-  std::vector<int> bodyOffset_, bodyVelocityOffset_, constraintOffset_;
+  std::vector<int> bodyOffset_, bodyVelocityOffset_, bodyNq_, bodyNv_, constraintOffset_;
+  std::vector<double> constraintPeriod_;
   std::vector<std::vector<int>> constraintCols_, forceCols_, constraintQCols_, forceQCols_;
   // per constraint / force, per body slot: the body-local velocities / coordinates used
   std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_, constraintUsedQ_, forceUsedQ_;
