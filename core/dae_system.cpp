@@ -250,10 +250,28 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
 }
 
 void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
+  if (sys_.velocitiesAreCoordinateRates()) {
+    residualImpl<true>(t, y, yp, F, scratch);
+  } else {
+    residualImpl<false>(t, y, yp, F, scratch);
+  }
+}
+
+void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                         DaeScratch& scratch) const {
+  if (sys_.velocitiesAreCoordinateRates()) {
+    jacobianImpl<true>(t, y, yp, cj, J, scratch);
+  } else {
+    jacobianImpl<false>(t, y, yp, cj, J, scratch);
+  }
+}
+
+template <bool IdentityT>
+void DaeSystem::residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
-  const bool identityT = sys.velocitiesAreCoordinateRates();
+  constexpr bool identityT = IdentityT;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), qp(yp + L.q, L.nq), vp(yp + L.v, L.nv);
   Eigen::Map<VecX> Fq(F + L.q, L.nq), Fv(F + L.v, L.nv);
   // F_q = q' - T (v - D G^T mu): with T = I written at once, otherwise after the
@@ -360,12 +378,13 @@ void DaeSystem::residual(double t, const double* y, const double* yp, double* F,
   }
 }
 
-void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
-                         DaeScratch& scratch) const {
+template <bool IdentityT>
+void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                             DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
-  const bool identityT = sys.velocitiesAreCoordinateRates();
+  constexpr bool identityT = IdentityT;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), vp(yp + L.v, L.nv);
   // F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body; F_q = q' - T w:
   // cj I and -T (with T = I: -I)

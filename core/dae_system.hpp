@@ -86,6 +86,13 @@ class DaeSystem final : public DaeProblem {
                  VecX& yp) const;
 
  private:
+  // One source for both: instantiated with IdentityT = true for models whose velocities are
+  // all coordinate rates (planar), where the T(q) terms compile away, and false otherwise.
+  template <bool IdentityT>
+  void residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const;
+  template <bool IdentityT>
+  void jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+                    DaeScratch& scratch) const;
   const System& sys_;
   Formulation formulation_;
   DaeLayout layout_;
