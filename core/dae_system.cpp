@@ -212,6 +212,9 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     cs.vl.resize(nl);
     cs.al.resize(nl);
     cs.Hv.resize(nl);
+    cs.f.setZero(me);
+    cs.df.setZero(me);
+    cs.ddf.setZero(me);
     cs.Hx.resize(nl, nql);
     cs.vH.resize(me, nql);
     cs.dFdq.resize(me, nql);
@@ -316,7 +319,8 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     ConstraintScratch& cs = S.constraints[c];
     const ConstraintEvaluation& ev = cs.ev;
     con.evaluate(sys.constraintStates(ci, q.data()), needH, cs.ev);
-    con.timeFunction(t, cs.f, cs.df, cs.ddf);
+    // joints prescribe nothing: their f, f', f'' stay the zeros makeScratch set
+    if (sys.constraintIsDriver(ci)) con.timeFunction(t, cs.f, cs.df, cs.ddf);
     // F_v += G^T lambda (G is m_c x n_c, a few entries: plain loops beat Eigen's GEMV)
     const double* lambda = y + L.lambda + row;
     for (int k = 0; k < nl; ++k) Fv[cols[k]] += columnDot(ev.G, k, lambda);

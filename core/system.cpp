@@ -178,8 +178,10 @@ void System::finalize() {
   constraintUsed_.clear();
   constraintUsedQ_.clear();
   constraintPeriod_.clear();
+  constraintIsDriver_.clear();
   for (const auto& c : constraints_) {
     constraintPeriod_.push_back(c->equationPeriod());
+    constraintIsDriver_.push_back(c->isDriver() ? 1 : 0);
     constraintOffset_.push_back(m_);
     m_ += c->numEquations();
     constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), [&](int slot) { return c->coordinatesUsed(slot); }));

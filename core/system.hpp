@@ -62,6 +62,8 @@ class System {
   int numVelocities(BodyIndex i) const { return bodyNv_[i.value]; }
   /// Constraint::equationPeriod() of each constraint, cached at finalize.
   double constraintPeriod(ConstraintIndex i) const { return constraintPeriod_[i.value]; }
+  /// Constraint::isDriver() of each constraint, cached at finalize (a joint's f(t) is zero).
+  bool constraintIsDriver(ConstraintIndex i) const { return constraintIsDriver_[i.value]; }
   int constraintOffset(ConstraintIndex i) const { return constraintOffset_.at(i.value); }
   /// True when every body has q' = v (T = I; planar models): nq == nv and the maps agree.
   bool velocitiesAreCoordinateRates() const { return coordinateRates_; }
@@ -120,6 +122,7 @@ class System {
   bool coordinateRates_ = true;
   std::vector<int> bodyOffset_, bodyVelocityOffset_, bodyNq_, bodyNv_, constraintOffset_;
   std::vector<double> constraintPeriod_;
+  std::vector<char> constraintIsDriver_;
   std::vector<std::vector<int>> constraintCols_, forceCols_, constraintQCols_, forceQCols_;
   // per constraint / force, per body slot: the body-local velocities / coordinates used
   std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_, constraintUsedQ_, forceUsedQ_;
