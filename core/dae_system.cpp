@@ -40,7 +40,7 @@ void addRowsBlock(JacobianSink& J, int row0, int colOffset, const std::vector<in
 struct ConstraintScratch {
   ConstraintEvaluation ev, plus, minus;  ///< at q; at q +- h e_k (index-1 third derivatives)
   VecX f, df, ddf;                       ///< prescribed motion and its derivatives
-  VecX vl, al, Hv, wl;                   ///< local velocities, accelerations, H_a w, (T v) local
+  VecX vl, al, Hv, wl, wlMinus;          ///< local velocities, accelerations, H_a w, (T v) local (and at q - h e_k)
   MatX Hx, vH, dFdq, dFdv;               ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq and d/dv
   MatX Tl, Til, THx, TGt, TDG;           ///< T and T+ over the local columns (T != I only), products
 };
@@ -521,24 +521,19 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
           S.qMinus[qc] = q[qc] - h;
           con.evaluate(sys.constraintStates(ci, S.qPlus.data()), true, cs.plus);
           con.evaluate(sys.constraintStates(ci, S.qMinus.data()), true, cs.minus);
+          if (!identityT) {  // (T v) at the perturbed coordinates, once per coordinate
+            coordinateRates(sys, S.qPlus.data(), v.data(), S.TvPlus);
+            gather(qcols, S.TvPlus.data(), cs.wl);
+            coordinateRates(sys, S.qMinus.data(), v.data(), S.TvPlus);
+            gather(qcols, S.TvPlus.data(), cs.wlMinus);
+          }
+          const VecX& wPlus = identityT ? cs.vl : cs.wl;
+          const VecX& wMinus = identityT ? cs.vl : cs.wlMinus;
           for (int a = 0; a < me; ++a) {
-            double plus = 0.0, minus = 0.0;
-            if (identityT) {
-              cs.Hv.noalias() = cs.plus.H[a] * cs.vl;
-              plus = cs.vl.dot(cs.Hv);
-              cs.Hv.noalias() = cs.minus.H[a] * cs.vl;
-              minus = cs.vl.dot(cs.Hv);
-            } else {
-              coordinateRates(sys, S.qPlus.data(), v.data(), S.TvPlus);
-              gather(qcols, S.TvPlus.data(), cs.wl);
-              cs.Hv.noalias() = cs.plus.H[a] * cs.wl;
-              plus = cs.vl.dot(cs.Hv);
-              coordinateRates(sys, S.qMinus.data(), v.data(), S.TvPlus);
-              gather(qcols, S.TvPlus.data(), cs.wl);
-              cs.Hv.noalias() = cs.minus.H[a] * cs.wl;
-              minus = cs.vl.dot(cs.Hv);
-            }
-            cs.dFdq(a, k) += (plus - minus) / (2.0 * h);
+            cs.Hv.noalias() = cs.plus.H[a] * wPlus;
+            const double plus = cs.vl.dot(cs.Hv);
+            cs.Hv.noalias() = cs.minus.H[a] * wMinus;
+            cs.dFdq(a, k) += (plus - cs.vl.dot(cs.Hv)) / (2.0 * h);
           }
           S.qPlus[qc] = S.qMinus[qc] = q[qc];
         }

@@ -47,6 +47,17 @@ BodyIndex lookupBody(const System& sys, const std::string& name, const ObjectRea
   r.fail("unknown body " + inQuotes(name) + " (known bodies: " + join(known) + ")");
 }
 
+std::array<BodyIndex, 2> lookupBodyPair(const System& sys, const ObjectReader& r, const std::string& what) {
+  const auto names = r.namePair("bodies");
+  const BodyIndex bi = lookupBody(sys, names[0], r);
+  const BodyIndex bj = lookupBody(sys, names[1], r);
+  if (bi == bj) {
+    r.fail("key \"bodies\" names the same body twice (" + inQuotes(names[0]) + "); " + what +
+           " connects two different bodies");
+  }
+  return {bi, bj};
+}
+
 /// A joint (not a driver) by name.
 ConstraintIndex lookupJoint(const System& sys, const std::string& name, const ObjectReader& r) {
   std::vector<std::string> known;
@@ -64,6 +75,7 @@ ConstraintIndex lookupJoint(const System& sys, const std::string& name, const Ob
 namespace {
 
 using scenereaders::lookupBody;
+using scenereaders::lookupBodyPair;
 using scenereaders::lookupJoint;
 
 /// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
@@ -293,10 +305,7 @@ void parseJoint(const json& j, const std::string& where, System& sys) {
     r.allowOnly(scenekeys::kJoint, " for a " + type + " joint");
   }
   const std::string name = r.name("name");
-  const auto bodyNames = r.namePair("bodies");
-  const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
-  const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
-  if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a joint connects two different bodies");
+  const auto [bi, bj] = lookupBodyPair(sys, r, "a joint");
   const auto points = r.pointPair("points");
   if (type == "revolute") {
     located(r.where(), [&] { return addRevoluteJoint(sys, name, bi, points[0], bj, points[1]); });
@@ -347,10 +356,7 @@ void parseForce(const json& j, const std::string& where, System& sys) {
   if (type == "spring_damper") {
     r.allowOnly(scenekeys::kSpringDamper, forA);
     const std::string name = r.name("name");
-    const auto bodyNames = r.namePair("bodies");
-    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
-    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
-    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a spring connects two different bodies");
+    const auto [bi, bj] = lookupBodyPair(sys, r, "a spring");
     const auto points = r.pointPair("points");
     const double stiffness = r.nonNegative("stiffness");
     const double damping = r.nonNegative("damping", 0.0);

@@ -48,6 +48,13 @@ JointFrame parseJointFrame(const json& j, const std::string& where) {
   return f;
 }
 
+/// Key "frames": [frameI, frameJ], one on each body.
+std::array<JointFrame, 2> parseFramePair(const ObjectReader& r) {
+  const json& frames = r.requiredArray("frames");
+  if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
+  return {parseJointFrame(frames[0], r.where() + ".frames[0]"), parseJointFrame(frames[1], r.where() + ".frames[1]")};
+}
+
 /// The frames of a spatial joint (for its drivers).
 const SpatialJoint& spatialJoint(const System& sys, ConstraintIndex c, const ObjectReader& r) {
   const auto* joint = dynamic_cast<const SpatialJoint*>(&sys.constraint(c));
@@ -126,14 +133,8 @@ void parseSpatialJoint(const json& j, const std::string& where, System& sys) {
       readType(r, "joint", {"spherical", "revolute", "prismatic", "cylindrical", "universal", "fixed", "planar"});
   r.allowOnly(scenekeys::kSpatialJoint, " for a joint in a spatial scene");
   const std::string name = r.name("name");
-  const auto bodyNames = r.namePair("bodies");
-  const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
-  const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
-  if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a joint connects two different bodies");
-  const json& frames = r.requiredArray("frames");
-  if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
-  const JointFrame fi = parseJointFrame(frames[0], r.where() + ".frames[0]");
-  const JointFrame fj = parseJointFrame(frames[1], r.where() + ".frames[1]");
+  const auto [bi, bj] = lookupBodyPair(sys, r, "a joint");
+  const auto [fi, fj] = parseFramePair(r);
   static const std::array<std::pair<const char*, SpatialJointType>, 7> types = {{
       {"spherical", SpatialJointType::Spherical}, {"revolute", SpatialJointType::Revolute},
       {"prismatic", SpatialJointType::Prismatic}, {"cylindrical", SpatialJointType::Cylindrical},
@@ -195,14 +196,8 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
   if (type == "bushing") {
     r.allowOnly(scenekeys::kBushing, forA);
     const std::string name = r.name("name");
-    const auto bodyNames = r.namePair("bodies");
-    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
-    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
-    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a bushing connects two different bodies");
-    const json& frames = r.requiredArray("frames");
-    if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
-    const JointFrame fi = parseJointFrame(frames[0], r.where() + ".frames[0]");
-    const JointFrame fj = parseJointFrame(frames[1], r.where() + ".frames[1]");
+    const auto [bi, bj] = lookupBodyPair(sys, r, "a bushing");
+    const auto [fi, fj] = parseFramePair(r);
     std::array<double, 6> k{}, c{};
     const VecX kv = r.vector("stiffness", 6);
     const VecX cv = r.has("damping") ? r.vector("damping", 6) : VecX::Zero(6);
@@ -250,10 +245,7 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
   if (type == "spring_damper") {
     r.allowOnly(scenekeys::kSpringDamper, forA);
     const std::string name = r.name("name");
-    const auto bodyNames = r.namePair("bodies");
-    const BodyIndex bi = lookupBody(sys, bodyNames[0], r);
-    const BodyIndex bj = lookupBody(sys, bodyNames[1], r);
-    if (bi == bj) r.fail("key \"bodies\" names the same body twice (" + inQuotes(bodyNames[0]) + "); a spring connects two different bodies");
+    const auto [bi, bj] = lookupBodyPair(sys, r, "a spring");
     const json& points = r.requiredArray("points");
     if (points.size() != 2 || !points[0].is_array() || !points[1].is_array()) {
       r.fail("key \"points\" must be two points [[xi, yi, zi], [xj, yj, zj]]");

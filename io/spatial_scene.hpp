@@ -3,6 +3,7 @@
 // (docs/scene-format.md, "Spatial scenes"). Called by io/scene.cpp.
 #pragma once
 
+#include <array>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -15,6 +16,9 @@ namespace flexmbd::scenereaders {
 /// A body / a joint (not a driver) by name. @throws InputError listing the known ones.
 BodyIndex lookupBody(const System& sys, const std::string& name, const jsonread::ObjectReader& r);
 ConstraintIndex lookupJoint(const System& sys, const std::string& name, const jsonread::ObjectReader& r);
+/// The two different bodies of key "bodies" ["I", "J"]; `what` names the element in the
+/// message ("a joint connects two different bodies").
+std::array<BodyIndex, 2> lookupBodyPair(const System& sys, const jsonread::ObjectReader& r, const std::string& what);
 
 /// A rotation from an "orientation" object: {"quaternion": [e0, e1, e2, e3]} (normalised),
 /// {"axis": [x, y, z], "angle": a} (radians) or {"matrix": [[...], [...], [...]]} (rows;

@@ -66,6 +66,28 @@ Vec3 angularMomentum(const System& sys, const VecX& q, const VecX& v) {
          (b.inertia() * v.segment<3>(sys.velocityOffset(BodyIndex(1)) + 3));
 }
 
+/// A symmetric top (mass m, moments Ic about its centre of mass, I3 about its axis) on a
+/// spherical joint at its tip, its centre of mass l up its axis, tilted by theta about world
+/// x, turning at wBody (body axes) about the fixed tip; gravity along -z. The top is body 1.
+System heavyTop(double m, double l, double Ic, double I3, double theta, const Vec3& wBody) {
+  System sys;
+  sys.setGravity(Vec3(0.0, 0.0, -kGravity));
+  RigidBody3dProperties p;
+  p.mass = m;
+  p.inertia = Vec3(Ic, Ic, I3).asDiagonal();
+  FrameState3d s0;
+  s0.orientation = rotationX(theta);
+  s0.position = s0.orientation * Vec3(0.0, 0.0, l);
+  s0.angularVelocity = wBody;
+  s0.velocity = (s0.orientation * wBody).cross(s0.position);
+  const BodyIndex top = sys.addBody(std::make_unique<RigidBody3d>("top", p, s0));
+  JointFrame tip;
+  tip.point = Vec3(0.0, 0.0, -l);
+  sys.addConstraint(std::make_unique<SpatialJoint>("tip", SpatialJointType::Spherical, kGround, JointFrame{}, top, tip));
+  sys.finalize();
+  return sys;
+}
+
 }  // namespace
 
 TEST(FreeRigidBody, AsymmetricBodyConservesEnergyAndAngularMomentum) {
@@ -168,22 +190,8 @@ TEST(HeavyTop, SteadyPrecessionAtTheClosedFormRate) {
   const double I1 = Ic + m * l * l;
   const double a = I1 * std::cos(theta), b = -I3 * w3, c = m * kGravity * l;
   const double phid = (-b - std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a);
-  System sys;
-  sys.setGravity(Vec3(0.0, 0.0, -kGravity));
-  RigidBody3dProperties p;
-  p.mass = m;
-  p.inertia = Vec3(Ic, Ic, I3).asDiagonal();
-  FrameState3d s0;
-  s0.orientation = rotationX(theta);
-  s0.position = s0.orientation * Vec3(0.0, 0.0, l);
-  const Vec3 wBody(0.0, phid * std::sin(theta), w3);
-  s0.angularVelocity = wBody;
-  s0.velocity = (s0.orientation * wBody).cross(s0.position);
-  const BodyIndex top = sys.addBody(std::make_unique<RigidBody3d>("top", p, s0));
-  JointFrame tip;
-  tip.point = Vec3(0.0, 0.0, -l);
-  sys.addConstraint(std::make_unique<SpatialJoint>("tip", SpatialJointType::Spherical, kGround, JointFrame{}, top, tip));
-  sys.finalize();
+  const System sys = heavyTop(m, l, Ic, I3, theta, Vec3(0.0, phid * std::sin(theta), w3));
+  const BodyIndex top(1);
   // rtol 1e-10 over 2 s (phi' = 2.87 rad/s: 0.9 turn): tilt and azimuth errors ~1e-8.
   constexpr double kAngleTol = 1e-6;
   double worstTilt = 0.0, worstAzimuth = 0.0;
@@ -458,21 +466,8 @@ TEST(HeavyTop, NutationStaysBetweenTheClosedFormBounds) {
   const double I1 = Ic + m * l * l, a = I3 * w3 / I1, beta = 2.0 * m * kGravity * l / I1, u0 = std::cos(theta0);
   const double u1 = (a * a - std::sqrt(std::pow(a, 4) - 4.0 * beta * a * a * u0 + 4.0 * beta * beta)) / (2.0 * beta);
   const double theta1 = std::acos(u1);
-  System sys;
-  sys.setGravity(Vec3(0.0, 0.0, -kGravity));
-  RigidBody3dProperties p;
-  p.mass = m;
-  p.inertia = Vec3(Ic, Ic, I3).asDiagonal();
-  FrameState3d s0;
-  s0.orientation = rotationX(theta0);
-  s0.position = s0.orientation * Vec3(0.0, 0.0, l);
-  s0.angularVelocity = Vec3(0.0, 0.0, w3);
-  s0.velocity = (s0.orientation * s0.angularVelocity).cross(s0.position);
-  const BodyIndex top = sys.addBody(std::make_unique<RigidBody3d>("top", p, s0));
-  JointFrame tip;
-  tip.point = Vec3(0.0, 0.0, -l);
-  sys.addConstraint(std::make_unique<SpatialJoint>("tip", SpatialJointType::Spherical, kGround, JointFrame{}, top, tip));
-  sys.finalize();
+  const System sys = heavyTop(m, l, Ic, I3, theta0, Vec3(0.0, 0.0, w3));
+  const BodyIndex top(1);
   // rtol 1e-10 over 2 s (several nutation periods, output every 0.2 ms so the extremes
   // are sampled to (omega_n dt)^2 ~ 1e-6 of the amplitude): bounds to 1e-5 rad
   constexpr double kBoundTol = 1e-5;
