@@ -263,31 +263,34 @@ int FfrBody2d::findPoint(const Vec2& point) const {
   return -1;
 }
 
-void FfrBody2d::checkAttachmentPoint(const Vec2& point, const std::string& user) const {
-  if (findPoint(point) >= 0) return;
+int FfrBody2d::resolvePoint(const Vec3& point, const std::string& user) const {
+  const int k = point.z() == 0.0 ? findPoint(point.head<2>()) : -1;
+  if (k >= 0) return k;
   std::ostringstream os;
-  os << user << ": flexible body '" << name() << "' has no node at (" << point.x() << ", " << point.y()
-     << "); joints and forces attach to nodes (";
-  for (size_t k = 0; k < inv_.points.size() && k < 6; ++k) {
-    os << (k ? ", " : "") << "(" << inv_.points[k].position.x() << ", " << inv_.points[k].position.y() << ")";
+  os << user << ": flexible body '" << name() << "' has no node at (" << point.x() << ", " << point.y();
+  if (point.z() != 0.0) os << ", " << point.z();
+  os << "); joints and forces attach to nodes (";
+  for (size_t j = 0; j < inv_.points.size() && j < 6; ++j) {
+    os << (j ? ", " : "") << "(" << inv_.points[j].position.x() << ", " << inv_.points[j].position.y() << ")";
   }
   os << (inv_.points.size() > 6 ? ", ...)" : ")");
   throw InputError(os.str());
 }
 
-std::vector<int> FfrBody2d::pointSupport(const Vec2& point) const {
-  const int k = findPoint(point);
-  if (k < 0) checkAttachmentPoint(point, "attachment");
+const FfrPoint& FfrBody2d::node(const Vec2& point, int pointId) const {
+  if (pointId >= 0 && pointId < static_cast<int>(inv_.points.size())) return inv_.points[pointId];
+  return inv_.points[resolvePoint(lift(point), "attachment")];  // not resolved: found by its coordinates
+}
+
+std::vector<int> FfrBody2d::pointSupport(const Vec3& point, int pointId) const {
   std::vector<int> cols = {0, 1, 2};
-  for (int e : FfrInvariants::support(inv_.points[k])) cols.push_back(3 + e);
+  for (int e : FfrInvariants::support(node(point.head<2>(), pointId))) cols.push_back(3 + e);
   return cols;
 }
 
-void FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+void FfrBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
                                 bool withHessians, PointKinematics& out) const {
-  const int k = findPoint(point);
-  if (k < 0) checkAttachmentPoint(point, "attachment");
-  kinematicsOn(q, inv_.points[k], cols, withHessians, out);
+  kinematicsOn(q, node(point, pointId), cols, withHessians, out);
 }
 
 PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint& pt, bool withHessians) const {

@@ -63,11 +63,13 @@ class FfrBody2d final : public Body {
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
   /// phi = theta + Nphi q_f.
   using Body::pointKinematics;
-  void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
+                       bool withHessians,
                        PointKinematics& out) const override;
   /// The frame coordinates and the elastic coordinates the node's shape depends on.
-  std::vector<int> pointSupport(const Vec2& point) const override;
-  void checkAttachmentPoint(const Vec2& point, const std::string& user) const override;
+  std::vector<int> pointSupport(const Vec3& point, int pointId) const override;
+  /// The index of the node at `point` in invariants().points (z must be 0).
+  int resolvePoint(const Vec3& point, const std::string& user) const override;
   Vec3 centreOfMass(const ConstVecRef& q) const override;
   /// The centre of mass in the plane.
   Vec2 planarCentreOfMass(const ConstVecRef& q) const;
@@ -92,6 +94,8 @@ class FfrBody2d final : public Body {
 
  private:
   int findPoint(const Vec2& point) const;
+  /// The node `pointId` (resolvePoint), or the node at `point` when pointId is kAnyPoint.
+  const FfrPoint& node(const Vec2& point, int pointId) const;
   /// Mass matrix blocks: frame-frame (3 x 3) and column k of frame-elastic (3 x nf).
   Eigen::Matrix3d frameMass(const ConstVecRef& q) const;
   Eigen::Vector3d frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const;

@@ -89,7 +89,7 @@ double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec3& g3) const
   return -props_.mass * g.dot(planarCentreOfMass(q));
 }
 
-void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, int, const std::vector<int>* cols,
                                   bool withHessians, PointKinematics& p) const {
   // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta.
   const Vec2 au = rotation(q[2]) * point;

@@ -52,7 +52,8 @@ class RigidBody2d final : public Body {
   void addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const override;
   double gravityPotential(const ConstVecRef& q, const Vec3& g) const override;
   using Body::pointKinematics;
-  void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
+                       bool withHessians,
                        PointKinematics& out) const override;
   Vec3 centreOfMass(const ConstVecRef& q) const override;
   /// The centre of mass in the plane.

@@ -155,12 +155,12 @@ double RigidBody3d::gravityPotential(const ConstVecRef& q, const Vec3& g) const 
   return -props_.mass * g.dot(q.head<3>());
 }
 
-void RigidBody3d::pointKinematics(const ConstVecRef&, const Vec2&, const std::vector<int>*, bool,
+void RigidBody3d::pointKinematics(const ConstVecRef&, const Vec2&, int, const std::vector<int>*, bool,
                                   PointKinematics&) const {
   throw InputError("body '" + name() + "' is spatial: planar joints and forces need planar bodies");
 }
 
-void RigidBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+void RigidBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int, const std::vector<int>* cols,
                                   const std::vector<int>* qcols, FrameKinematics& out) const {
   // r = R + A u;  r' = R' - A u~ w;  omega = A w  (w in body axes)
   const Mat3 A = rotationOf(q);
@@ -185,7 +185,7 @@ void RigidBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, const
   }
 }
 
-void RigidBody3d::addFrameCurvature(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+void RigidBody3d::addFrameCurvature(const ConstVecRef& q, const Vec3& point, int, const std::vector<int>* cols,
                                     const std::vector<int>* qcols, const Vec3& wr, const Vec3& ww,
                                     Eigen::Ref<MatX> out) const {
   // Jr^T wr + Jw^T ww = [wr; u~ A^T wr + A^T ww]; d(A^T c)/dpi = (A^T c)~ for a body-axes

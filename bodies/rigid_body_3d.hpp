@@ -68,11 +68,12 @@ class RigidBody3d final : public Body {
   double gravityPotential(const ConstVecRef& q, const Vec3& g) const override;
   using Body::pointKinematics;
   /// @throws InputError: a spatial body has no planar point kinematics.
-  void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols, bool withHessians,
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
+                       bool withHessians,
                        PointKinematics& out) const override;
-  void frameKinematics(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+  void frameKinematics(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
                        const std::vector<int>* qcols, FrameKinematics& out) const override;
-  void addFrameCurvature(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+  void addFrameCurvature(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
                          const std::vector<int>* qcols, const Vec3& wr, const Vec3& ww,
                          Eigen::Ref<MatX> out) const override;
   Vec3 centreOfMass(const ConstVecRef& q) const override { return q.head<3>(); }

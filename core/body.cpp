@@ -6,8 +6,8 @@
 
 namespace flexmbd {
 
-std::vector<int> Body::pointSupport(const Vec2& point) const {
-  (void)point;
+std::vector<int> Body::pointSupport(const Vec3& point, int pointId) const {
+  (void)point; (void)pointId;
   std::vector<int> all(numVelocities());
   std::iota(all.begin(), all.end(), 0);
   return all;
@@ -23,12 +23,12 @@ void Body::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
   Tinv.setIdentity(numVelocities(), numCoordinates());
 }
 
-void Body::frameKinematics(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+void Body::frameKinematics(const ConstVecRef&, const Vec3&, int, const std::vector<int>*, const std::vector<int>*,
                            FrameKinematics&) const {
   throw InputError("body '" + name() + "' is planar: spatial joints and forces need spatial bodies (\"dimension\": 3)");
 }
 
-void Body::addFrameCurvature(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+void Body::addFrameCurvature(const ConstVecRef&, const Vec3&, int, const std::vector<int>*, const std::vector<int>*,
                              const Vec3&, const Vec3&, Eigen::Ref<MatX>) const {
   throw InputError("body '" + name() + "' is planar: spatial joints and forces need spatial bodies (\"dimension\": 3)");
 }

@@ -116,44 +116,60 @@ class Body {
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 
-  /// Kinematics of the material point with body-frame coordinates `point` over the
-  /// coordinates `cols` (ascending, a superset of pointSupport(point); null: all n), into
-  /// `out` (Jr is 2 x cols.size(), and so on; see PointKinematics::reset). Joints on large
-  /// flexible bodies use only the support, so their Jacobians do not grow with the body.
-  /// The Hessians (Hrx, Hry, Hphi) only if withHessians. Allocates nothing once `out`
-  /// has been filled for as many coordinates.
-  /// @throws InputError if the body has no material point there.
-  virtual void pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>* cols,
+  // ----- material points: where joints and forces attach ------------------------
+  /// Identifier of "no identifier needed": every point of the body is material (rigid).
+  static constexpr int kAnyPoint = -1;
+  /// The body's identifier of its material point at body coordinates `point` (a node of
+  /// a flexible body), resolved once by System::finalize so that evaluations do not
+  /// search: the point kinematics below take it with the coordinates. Default kAnyPoint.
+  /// @throws InputError naming `user` if the body has no material point there.
+  virtual int resolvePoint(const Vec3& point, const std::string& user) const {
+    (void)point; (void)user;
+    return kAnyPoint;
+  }
+  /// The body velocities the velocity of the point (coordinates `point`, identifier
+  /// `pointId` from resolvePoint) depends on (ascending; the coordinates are
+  /// coordinatesOfVelocities of them). Default: all.
+  virtual std::vector<int> pointSupport(const Vec3& point, int pointId) const;
+
+  /// Kinematics of the material point with body-frame coordinates `point` (identifier
+  /// `pointId` from resolvePoint) over the coordinates `cols` (ascending, a superset of
+  /// pointSupport; null: all n), into `out` (Jr is 2 x cols.size(), and so on; see
+  /// PointKinematics::reset). Joints on large flexible bodies use only the support, so
+  /// their Jacobians do not grow with the body. The Hessians (Hrx, Hry, Hphi) only if
+  /// withHessians. Allocates nothing once `out` has been filled for as many coordinates.
+  virtual void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
                                bool withHessians, PointKinematics& out) const = 0;
-  /// The same, returned (allocates; outputs and tests).
+  /// The same for a point not resolved before, returned (resolves it and allocates:
+  /// outputs and tests). @throws InputError if the body has no material point there.
   PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, bool withHessians = true) const {
     PointKinematics p;
-    pointKinematics(q, point, nullptr, withHessians, p);
+    pointKinematics(q, point, resolvePoint(lift(point), "point"), nullptr, withHessians, p);
     return p;
   }
   PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
                                   bool withHessians) const {
     PointKinematics p;
-    pointKinematics(q, point, &cols, withHessians, p);
+    pointKinematics(q, point, resolvePoint(lift(point), "point"), &cols, withHessians, p);
     return p;
   }
-  /// The body velocities the velocity of `point` depends on (ascending; the coordinates
-  /// are coordinatesOfVelocities of them). Default: all.
-  virtual std::vector<int> pointSupport(const Vec2& point) const;
-  /// Checks at model build time that `point` is a valid attachment point.
-  virtual void checkAttachmentPoint(const Vec2& point, const std::string& user) const {
-    (void)point; (void)user;
-  }
   // ----- spatial kinematics (spatial joints and forces) ---------------------------
-  /// Kinematics of the material frame at the body point `point` (body axes) over the used
-  /// velocities `cols` and coordinates `qcols` (null: all), into `out`. Allocates nothing
-  /// once `out` was filled for as many columns.
+  /// Kinematics of the material frame at the body point `point` (body axes, identifier
+  /// `pointId` from resolvePoint) over the used velocities `cols` and coordinates `qcols`
+  /// (null: all), into `out`. Allocates nothing once `out` was filled for as many columns.
   /// @throws InputError if the body has no spatial kinematics (planar bodies, so far).
-  virtual void frameKinematics(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+  virtual void frameKinematics(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
                                const std::vector<int>* qcols, FrameKinematics& out) const;
+  /// The same for a point not resolved before, over all columns, returned (resolves the
+  /// point and allocates: scene checks, outputs and tests).
+  FrameKinematics frameKinematics(const ConstVecRef& q, const Vec3& point) const {
+    FrameKinematics f;
+    frameKinematics(q, point, resolvePoint(point, "point"), nullptr, nullptr, f);
+    return f;
+  }
   /// out += d(Jr^T wr + Jw^T ww)/dq (nv_used x nq_used) for fixed weights wr, ww: the
   /// curvature of the point's motion that joint Jacobians need.
-  virtual void addFrameCurvature(const ConstVecRef& q, const Vec3& point, const std::vector<int>* cols,
+  virtual void addFrameCurvature(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
                                  const std::vector<int>* qcols, const Vec3& wr, const Vec3& ww,
                                  Eigen::Ref<MatX> out) const;
 

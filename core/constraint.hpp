@@ -29,22 +29,22 @@ struct BodyState {
   int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numVelocities(); }
   /// Number of used coordinates.
   int numUsedCoordinates() const { return qcols ? static_cast<int>(qcols->size()) : body.numCoordinates(); }
-  /// Kinematics of a body point over the used coordinates, into `out` (no allocation
-  /// once `out` has been filled before).
-  void point(const Vec2& p, bool withHessians, PointKinematics& out) const {
-    body.pointKinematics(q, p, cols, withHessians, out);
+  /// Kinematics of the body point `p` (identifier `id`: BodyStates::pointId) over the
+  /// used coordinates, into `out` (no allocation once `out` has been filled before).
+  void point(const Vec2& p, int id, bool withHessians, PointKinematics& out) const {
+    body.pointKinematics(q, p, id, cols, withHessians, out);
   }
   /// The same, returned (allocates).
-  PointKinematics point(const Vec2& p, bool withHessians) const {
+  PointKinematics point(const Vec2& p, int id, bool withHessians) const {
     PointKinematics out;
-    point(p, withHessians, out);
+    point(p, id, withHessians, out);
     return out;
   }
   /// Spatial kinematics of the material frame at a body point, over the used columns.
-  void frame(const Vec3& p, FrameKinematics& out) const { body.frameKinematics(q, p, cols, qcols, out); }
+  void frame(const Vec3& p, int id, FrameKinematics& out) const { body.frameKinematics(q, p, id, cols, qcols, out); }
   /// out += d(Jr^T wr + Jw^T ww)/dq over the used columns.
-  void addCurvature(const Vec3& p, const Vec3& wr, const Vec3& ww, Eigen::Ref<MatX> out) const {
-    body.addFrameCurvature(q, p, cols, qcols, wr, ww, out);
+  void addCurvature(const Vec3& p, int id, const Vec3& wr, const Vec3& ww, Eigen::Ref<MatX> out) const {
+    body.addFrameCurvature(q, p, id, cols, qcols, wr, ww, out);
   }
 };
 
@@ -63,10 +63,26 @@ class BodyStates {
   }
   int size() const { return n_; }
   const BodyState& operator[](int k) const { return *states_[k]; }
+  /// The body's identifier of the element's attachment k (in the order of its
+  /// attachments()), resolved by System::finalize; Body::kAnyPoint when not resolved.
+  int pointId(int k) const { return pointIds_ && k < numPointIds_ ? pointIds_[k] : Body::kAnyPoint; }
+  /// Identifiers of the attachments (System: its table, which outlives the states).
+  void setPointIds(const int* ids, int n) {
+    pointIds_ = ids;
+    numPointIds_ = n;
+  }
 
  private:
   std::array<std::optional<BodyState>, kMaxBodies> states_;
   int n_ = 0;
+  const int* pointIds_ = nullptr;
+  int numPointIds_ = 0;
+};
+
+/// A body point a constraint or force element attaches to (body axes; planar: z = 0).
+struct Attachment {
+  BodyIndex body;
+  Vec3 point = Vec3::Zero();
 };
 
 /// Constraint equations g(q, t) = h(q) - f(t) = 0 of the constraint's bodies. Their
@@ -93,8 +109,9 @@ class Constraint {
   /// The bodies whose coordinates enter h (ground included where it takes part).
   const std::vector<BodyIndex>& bodies() const { return bodies_; }
 
-  /// Body points the constraint attaches to (checked by System::finalize()).
-  virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
+  /// Body points the constraint attaches to, resolved by System::finalize() into the
+  /// identifiers BodyStates::pointId(k) gives in this order.
+  virtual std::vector<Attachment> attachments() const { return {}; }
   /// The coordinates of bodies()[slot] that h depends on (ascending), if the
   /// constraint knows them better than System::finalize(), which takes the union of
   /// the supports of the attachment points on that body, or all of its coordinates.

@@ -22,8 +22,9 @@ class Force {
   const std::string& name() const { return name_; }
   const std::vector<BodyIndex>& bodies() const { return bodies_; }
   virtual std::string typeName() const = 0;
-  /// Body points the force attaches to (checked by System::finalize()).
-  virtual std::vector<std::pair<BodyIndex, Vec2>> attachments() const { return {}; }
+  /// Body points the force attaches to, resolved by System::finalize() into the
+  /// identifiers BodyStates::pointId(k) gives in this order.
+  virtual std::vector<Attachment> attachments() const { return {}; }
 
   /// Q += generalised force; if dQdq / dQdv are given, they receive += its derivatives.
   /// `work` is the caller's working memory for this force: with it kept between calls,

@@ -24,13 +24,13 @@ class Ground final : public Body {
   void addGravityJacobian(const ConstVecRef&, const Vec3&, const MatrixSink&) const override {}
   double gravityPotential(const ConstVecRef&, const Vec3&) const override { return 0.0; }
   using Body::pointKinematics;
-  void pointKinematics(const ConstVecRef&, const Vec2& point, const std::vector<int>*, bool withHessians,
+  void pointKinematics(const ConstVecRef&, const Vec2& point, int, const std::vector<int>*, bool withHessians,
                        PointKinematics& out) const override {
     out.r = point;
     out.phi = 0.0;
     out.reset(0, withHessians);
   }
-  void frameKinematics(const ConstVecRef&, const Vec3& point, const std::vector<int>*, const std::vector<int>*,
+  void frameKinematics(const ConstVecRef&, const Vec3& point, int, const std::vector<int>*, const std::vector<int>*,
                        FrameKinematics& out) const override {
     out.r = point;
     out.A.setIdentity();
@@ -38,7 +38,7 @@ class Ground final : public Body {
     out.Jw.resize(3, 0);
     out.Tinv.resize(0, 0);
   }
-  void addFrameCurvature(const ConstVecRef&, const Vec3&, const std::vector<int>*, const std::vector<int>*,
+  void addFrameCurvature(const ConstVecRef&, const Vec3&, int, const std::vector<int>*, const std::vector<int>*,
                          const Vec3&, const Vec3&, Eigen::Ref<MatX>) const override {}
   Vec3 centreOfMass(const ConstVecRef&) const override { return Vec3::Zero(); }
 };

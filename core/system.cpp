@@ -109,14 +109,19 @@ ConstraintIndex System::findConstraint(const std::string& name) const {
 
 void System::finalize() {
   requireBuildPhase("finalize twice");
+  // Attachment points resolved once into the bodies' identifiers (nodes of flexible
+  // bodies): evaluations then find them without a search.
+  auto resolve = [&](const std::vector<Attachment>& attachments, const std::string& user) {
+    std::vector<int> ids;
+    for (const auto& a : attachments) ids.push_back(body(a.body).resolvePoint(a.point, user));
+    return ids;
+  };
+  constraintPointIds_.clear();
+  forcePointIds_.clear();
   for (const auto& c : constraints_) {
-    for (const auto& [b, p] : c->attachments()) {
-      body(b).checkAttachmentPoint(p, (c->isDriver() ? "driver '" : "joint '") + c->name() + "'");
-    }
+    constraintPointIds_.push_back(resolve(c->attachments(), (c->isDriver() ? "driver '" : "joint '") + c->name() + "'"));
   }
-  for (const auto& f : forces_) {
-    for (const auto& [b, p] : f->attachments()) body(b).checkAttachmentPoint(p, "force '" + f->name() + "'");
-  }
+  for (const auto& f : forces_) forcePointIds_.push_back(resolve(f->attachments(), "force '" + f->name() + "'"));
   bodyOffset_.clear();
   bodyVelocityOffset_.clear();
   bodyNq_.clear();
@@ -135,8 +140,8 @@ void System::finalize() {
   // Coordinates used of each body: the union of the supports of the attachment points
   // on it (a joint on a node of a large flexible body uses only the frame and that
   // node's coordinates), all of them if nothing is attached there.
-  auto usedCoordinates = [&](const std::vector<BodyIndex>& bs,
-                             const std::vector<std::pair<BodyIndex, Vec2>>& attachments,
+  auto usedCoordinates = [&](const std::vector<BodyIndex>& bs, const std::vector<Attachment>& attachments,
+                             const std::vector<int>& ids,
                              const std::function<std::optional<std::vector<int>>(int)>& declared) {
     std::vector<std::vector<int>> used;
     for (size_t slot = 0; slot < bs.size(); ++slot) {
@@ -146,10 +151,11 @@ void System::finalize() {
       }
       std::set<int> cols;
       bool attached = false;
-      for (const auto& [b, p] : attachments) {
+      for (size_t k = 0; k < attachments.size(); ++k) {
+        const BodyIndex b = attachments[k].body;
         if (b != bs[slot]) continue;
         attached = true;
-        for (int c : body(b).pointSupport(p)) cols.insert(c);
+        for (int c : body(b).pointSupport(attachments[k].point, ids[k])) cols.insert(c);
       }
       if (!attached) {
         for (int k = 0; k < body(bs[slot]).numVelocities(); ++k) cols.insert(k);
@@ -179,12 +185,13 @@ void System::finalize() {
   constraintUsedQ_.clear();
   constraintPeriod_.clear();
   constraintIsDriver_.clear();
-  for (const auto& c : constraints_) {
+  for (size_t ci = 0; ci < constraints_.size(); ++ci) {
+    const auto& c = constraints_[ci];
     constraintPeriod_.push_back(c->equationPeriod());
     constraintIsDriver_.push_back(c->isDriver() ? 1 : 0);
     constraintOffset_.push_back(m_);
     m_ += c->numEquations();
-    constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), [&](int slot) { return c->coordinatesUsed(slot); }));
+    constraintUsed_.push_back(usedCoordinates(c->bodies(), c->attachments(), constraintPointIds_[ci], [&](int slot) { return c->coordinatesUsed(slot); }));
     constraintUsedQ_.push_back(coordinatesOf(c->bodies(), constraintUsed_.back()));
     constraintCols_.push_back(globalColumns(c->bodies(), constraintUsed_.back(), bodyVelocityOffset_));
     constraintQCols_.push_back(globalColumns(c->bodies(), constraintUsedQ_.back(), bodyOffset_));
@@ -193,8 +200,9 @@ void System::finalize() {
   forceQCols_.clear();
   forceUsed_.clear();
   forceUsedQ_.clear();
-  for (const auto& f : forces_) {
-    forceUsed_.push_back(usedCoordinates(f->bodies(), f->attachments(), [](int) { return std::nullopt; }));
+  for (size_t fi = 0; fi < forces_.size(); ++fi) {
+    const auto& f = forces_[fi];
+    forceUsed_.push_back(usedCoordinates(f->bodies(), f->attachments(), forcePointIds_[fi], [](int) { return std::nullopt; }));
     forceUsedQ_.push_back(coordinatesOf(f->bodies(), forceUsed_.back()));
     forceCols_.push_back(globalColumns(f->bodies(), forceUsed_.back(), bodyVelocityOffset_));
     forceQCols_.push_back(globalColumns(f->bodies(), forceUsedQ_.back(), bodyOffset_));
@@ -254,11 +262,17 @@ BodyStates System::states(const std::vector<BodyIndex>& bs, const std::vector<st
 }
 
 BodyStates System::constraintStates(ConstraintIndex i, const double* q) const {
-  return states(constraint(i).bodies(), constraintUsed_.at(i.value), constraintUsedQ_.at(i.value), q);
+  BodyStates out = states(constraint(i).bodies(), constraintUsed_.at(i.value), constraintUsedQ_.at(i.value), q);
+  const std::vector<int>& ids = constraintPointIds_[i.value];
+  out.setPointIds(ids.data(), static_cast<int>(ids.size()));
+  return out;
 }
 
 BodyStates System::forceStates(ForceIndex i, const double* q) const {
-  return states(force(i).bodies(), forceUsed_.at(i.value), forceUsedQ_.at(i.value), q);
+  BodyStates out = states(force(i).bodies(), forceUsed_.at(i.value), forceUsedQ_.at(i.value), q);
+  const std::vector<int>& ids = forcePointIds_[i.value];
+  out.setPointIds(ids.data(), static_cast<int>(ids.size()));
+  return out;
 }
 
 std::string System::describeEquation(int row) const {

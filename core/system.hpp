@@ -126,6 +126,8 @@ class System {
   std::vector<std::vector<int>> constraintCols_, forceCols_, constraintQCols_, forceQCols_;
   // per constraint / force, per body slot: the body-local velocities / coordinates used
   std::vector<std::vector<std::vector<int>>> constraintUsed_, forceUsed_, constraintUsedQ_, forceUsedQ_;
+  /// Per element, the bodies' identifiers of its attachments (Body::resolvePoint).
+  std::vector<std::vector<int>> constraintPointIds_, forcePointIds_;
   BodyStates states(const std::vector<BodyIndex>& bodies, const std::vector<std::vector<int>>& used,
                     const std::vector<std::vector<int>>& usedQ, const double* q) const;
 };

@@ -18,7 +18,7 @@ AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, Ti
 void AppliedLoad::addForce(double t, const BodyStates& b, const VecX&, VecX& Q, MatX* dQdq, MatX*,
                            KinematicsWork& w) const {
   // Q = Jr^T F + tau Jphi^T (virtual work of a force F at the point and a torque tau)
-  b[0].point(point_, dQdq != nullptr, w.pi);
+  b[0].point(point_, b.pointId(0), dQdq != nullptr, w.pi);
   const PointKinematics& p = w.pi;
   const Vec2 F(forceX_ ? forceX_->evaluate(t).f : 0.0, forceY_ ? forceY_->evaluate(t).f : 0.0);
   const double tau = torque_ ? torque_->evaluate(t).f : 0.0;

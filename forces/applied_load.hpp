@@ -16,7 +16,7 @@ class AppliedLoad final : public Force {
                 KinematicsWork& work) const override;
   using Force::addForce;
   bool isConservative() const override { return false; }
-  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override { return {{bodies()[0], point_}}; }
+  std::vector<Attachment> attachments() const override { return {{bodies()[0], lift(point_)}}; }
 
  private:
   Vec2 point_;

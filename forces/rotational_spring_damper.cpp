@@ -26,8 +26,8 @@ RotationalSpringDamper::RotationalSpringDamper(std::string name, BodyIndex bodyI
 void RotationalSpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                                       KinematicsWork& w) const {
   const bool withHessians = dQdq != nullptr;
-  b[0].point(pointI_, withHessians, w.pi);
-  b[1].point(pointJ_, withHessians, w.pj);
+  b[0].point(pointI_, b.pointId(0), withHessians, w.pi);
+  b[1].point(pointJ_, b.pointId(1), withHessians, w.pj);
   makePointPair(w.pi, w.pj, withHessians, w.pair);
   const PointPair& p = w.pair;
   // phi = phi_j - phi_i, J = dphi/dq, tau = k (phi - phi0) + c J v, Q = -tau J^T
@@ -50,8 +50,8 @@ void RotationalSpringDamper::addForce(double, const BodyStates& b, const VecX& v
 }
 
 double RotationalSpringDamper::potentialEnergy(const BodyStates& b) const {
-  const double phi = b[1].point(pointJ_, false).phi -
-                     b[0].point(pointI_, false).phi;
+  const double phi = b[1].point(pointJ_, b.pointId(1), false).phi -
+                     b[0].point(pointI_, b.pointId(0), false).phi;
   return 0.5 * stiffness_ * (phi - freeAngle_) * (phi - freeAngle_);
 }
 

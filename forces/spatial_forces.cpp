@@ -24,10 +24,10 @@ void SpatialAppliedLoad::addForce(double t, const BodyStates& bodies, const VecX
     if (laws_[k]) F[k] = laws_[k]->evaluate(t).f;
     if (laws_[3 + k]) M[k] = laws_[3 + k]->evaluate(t).f;
   }
-  bodies[0].frame(point_, w.fi);
+  bodies[0].frame(point_, bodies.pointId(0), w.fi);
   Q.noalias() += w.fi.Jr.transpose() * F;
   Q.noalias() += w.fi.Jw.transpose() * M;
-  if (dQdq) bodies[0].addCurvature(point_, F, M, *dQdq);
+  if (dQdq) bodies[0].addCurvature(point_, bodies.pointId(0), F, M, *dQdq);
 }
 
 SpatialSpringDamper::SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ,

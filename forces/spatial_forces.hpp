@@ -17,6 +17,7 @@ class SpatialAppliedLoad final : public Force {
   /// laws: force x, y, z, torque x, y, z (null: zero); at least one given.
   SpatialAppliedLoad(std::string name, BodyIndex body, const Vec3& point, std::array<TimeLawPtr, 6> laws);
   std::string typeName() const override { return "applied_load"; }
+  std::vector<Attachment> attachments() const override { return {{bodies()[0], point_}}; }
   void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                 KinematicsWork& work) const override;
   using Force::addForce;
@@ -34,6 +35,9 @@ class SpatialSpringDamper final : public Force {
   SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
                       double stiffness, double damping, double freeLength);
   std::string typeName() const override { return "spring_damper"; }
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
+  }
   void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                 KinematicsWork& work) const override;
   using Force::addForce;
@@ -55,6 +59,9 @@ class SpatialRotationalSpringDamper final : public Force {
   SpatialRotationalSpringDamper(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
                                 const JointFrame& frameJ, double stiffness, double damping, double freeAngle);
   std::string typeName() const override { return "rotational_spring_damper"; }
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
+  }
   void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                 KinematicsWork& work) const override;
   using Force::addForce;
@@ -77,6 +84,9 @@ class SpatialBushing final : public Force {
   SpatialBushing(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
                  const JointFrame& frameJ, const std::array<double, 6>& stiffness, const std::array<double, 6>& damping);
   std::string typeName() const override { return "bushing"; }
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
+  }
   void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                 KinematicsWork& work) const override;
   using Force::addForce;

@@ -29,14 +29,14 @@ SpringDamper::SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI
 }
 
 double SpringDamper::length(const BodyStates& b) const {
-  return (b[1].point(pointJ_, false).r - b[0].point(pointI_, false).r).norm();
+  return (b[1].point(pointJ_, b.pointId(1), false).r - b[0].point(pointI_, b.pointId(0), false).r).norm();
 }
 
 void SpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                             KinematicsWork& w) const {
   const bool withHessians = dQdq != nullptr;
-  b[0].point(pointI_, withHessians, w.pi);
-  b[1].point(pointJ_, withHessians, w.pj);
+  b[0].point(pointI_, b.pointId(0), withHessians, w.pi);
+  b[1].point(pointJ_, b.pointId(1), withHessians, w.pj);
   makePointPair(w.pi, w.pj, withHessians, w.pair);
   const PointPair& p = w.pair;
   const double l = p.d.norm();

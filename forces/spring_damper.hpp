@@ -18,8 +18,8 @@ class SpringDamper final : public Force {
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0; }
-  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
-    return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], lift(pointI_)}, {bodies()[1], lift(pointJ_)}};
   }
   /// Current length (for outputs and tests).
   double length(const BodyStates& bodies) const;

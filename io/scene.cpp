@@ -445,6 +445,7 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
     if (out.type == OutputRequest::Type::Deflection) r.fail("a deflection output needs a flexible body: planar scenes only so far");
     out.spatial = true;
     out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
+    located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
     return out;
   }
   out.point = r.vec2("point", Vec2::Zero());
@@ -459,7 +460,7 @@ OutputRequest parseOutput(const json& j, const std::string& where, const System&
     }
     return out;
   }
-  located(r.where(), [&] { sys.body(out.body).checkAttachmentPoint(out.point, "output " + inQuotes(out.name)); });
+  located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(lift(out.point), "output " + inQuotes(out.name)); });
   return out;
 }
 
@@ -593,7 +594,7 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
   const int off = sys.coordinateOffset(body);
   if (spatial) {
     FrameKinematics f;
-    b.frameKinematics(q.segment(off, b.numCoordinates()), point3, nullptr, nullptr, f);
+    b.frameKinematics(q.segment(off, b.numCoordinates()), point3, pointId, nullptr, nullptr, f);
     const Vec3 vel = f.Jr * v.segment(sys.velocityOffset(body), b.numVelocities());
     return {f.r.x(), f.r.y(), f.r.z(), vel.x(), vel.y(), vel.z()};
   }
@@ -603,7 +604,8 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
     return {d.displacement.x(), d.displacement.y(), d.sectionForces.x(), d.sectionForces.y()};
   }
   const int n = b.numCoordinates();
-  const PointKinematics pk = b.pointKinematics(q.segment(off, n), point, false);
+  PointKinematics pk;
+  b.pointKinematics(q.segment(off, n), point, pointId, nullptr, false, pk);
   const Vec2 vel = n > 0 ? Vec2(pk.Jr * v.segment(off, n)) : Vec2::Zero();
   return {pk.r.x(), pk.r.y(), vel.x(), vel.y()};
 }

@@ -27,6 +27,7 @@ struct OutputRequest {
   Vec2 point = Vec2::Zero();   ///< Point, Deflection: body-frame coordinates of the point
   bool spatial = false;        ///< Point in a spatial scene: point3, columns x, y, z, vx, vy, vz
   Vec3 point3 = Vec3::Zero();  ///< Point (spatial): body-frame coordinates
+  int pointId = Body::kAnyPoint;  ///< Point: the body's identifier of the point (Body::resolvePoint)
   int element = 0;             ///< Deflection: element of the beam mesh holding the point
   double xi = 0.0;             ///< Deflection: its local coordinate in [0, 1]
 

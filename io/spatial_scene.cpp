@@ -260,10 +260,8 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
       freeLength = r.nonNegative("free_length");
     } else {
       freeLength = located(r.where(), [&] {
-        FrameKinematics a, b;
-        sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi, nullptr, nullptr, a);
-        sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj, nullptr, nullptr, b);
-        return (b.r - a.r).norm();
+        return (sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj).r -
+                sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi).r).norm();
       });
     }
     located(r.where(), [&] {

@@ -174,10 +174,10 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
     pts.push_back(p);
   };
   for (int c = 0; c < sys.numConstraints(); ++c) {
-    for (const auto& [b, p] : sys.constraint(ConstraintIndex(c)).attachments()) addPoint(b, p);
+    for (const auto& [b, p] : sys.constraint(ConstraintIndex(c)).attachments()) addPoint(b, p.head<2>());
   }
   for (int f = 0; f < sys.numForces(); ++f) {
-    for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p);
+    for (const auto& [b, p] : sys.force(ForceIndex(f)).attachments()) addPoint(b, p.head<2>());
   }
   // spatial bodies: lines from the centre of mass to each joint frame on the body
   spatialPoints_.resize(sys.numBodies());

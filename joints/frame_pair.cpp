@@ -19,8 +19,8 @@ FramePair::FramePair(const BodyStates& bodies, const JointFrame& frameI, const J
                      KinematicsWork& work)
     : bodies_(bodies), frameI_(frameI), frameJ_(frameJ), w_(work) {
   FrameKinematics &fi = w_.fi, &fj = w_.fj;
-  bodies[0].frame(frameI.point, fi);
-  bodies[1].frame(frameJ.point, fj);
+  bodies[0].frame(frameI.point, bodies.pointId(0), fi);
+  bodies[1].frame(frameJ.point, bodies.pointId(1), fj);
   ni_ = fi.numVelocities();
   nj_ = fj.numVelocities();
   qi_ = fi.numCoordinates();
@@ -53,7 +53,7 @@ void FramePair::axis(bool onI, int k, Vec3& u, Mat3X& J) const {
 void FramePair::axisCurvature(bool onI, const Vec3& u, const Mat3X& Ju, const Vec3& x, MatX& H) {
   const FrameKinematics& f = onI ? w_.fi : w_.fj;
   const int r0 = onI ? 0 : ni_, c0 = onI ? 0 : qi_, nr = onI ? ni_ : nj_, nc = onI ? qi_ : qj_;
-  bodies_[onI ? 0 : 1].addCurvature(onI ? frameI_.point : frameJ_.point, Vec3::Zero(), u.cross(x),
+  bodies_[onI ? 0 : 1].addCurvature(onI ? frameI_.point : frameJ_.point, bodies_.pointId(onI ? 0 : 1), Vec3::Zero(), u.cross(x),
                                     H.block(r0, c0, nr, nc));
   w_.JT.noalias() = Ju * w_.Tinv;  // 3 x nq
   const Mat3 X = skew(x);
@@ -63,8 +63,8 @@ void FramePair::axisCurvature(bool onI, const Vec3& u, const Mat3X& Ju, const Ve
 
 // H += d(J_d^T x)/dq at fixed x
 void FramePair::gapCurvature(const Vec3& x, MatX& H) {
-  bodies_[0].addCurvature(frameI_.point, -x, Vec3::Zero(), H.block(0, 0, ni_, qi_));
-  bodies_[1].addCurvature(frameJ_.point, x, Vec3::Zero(), H.block(ni_, qi_, nj_, qj_));
+  bodies_[0].addCurvature(frameI_.point, bodies_.pointId(0), -x, Vec3::Zero(), H.block(0, 0, ni_, qi_));
+  bodies_[1].addCurvature(frameJ_.point, bodies_.pointId(1), x, Vec3::Zero(), H.block(ni_, qi_, nj_, qj_));
 }
 
 // H += J_a^T (J_b T+) + J_b^T (J_a T+): the product rule's cross terms of h = a . b

@@ -59,8 +59,8 @@ TwoPointConstraint::TwoPointConstraint(std::string name, BodyIndex bodyI, const 
 }
 
 const PointPair& TwoPointConstraint::pair(const BodyStates& bodies, bool withHessians, KinematicsWork& w) const {
-  bodies[0].point(pointI_, withHessians, w.pi);
-  bodies[1].point(pointJ_, withHessians, w.pj);
+  bodies[0].point(pointI_, bodies.pointId(0), withHessians, w.pi);
+  bodies[1].point(pointJ_, bodies.pointId(1), withHessians, w.pj);
   makePointPair(w.pi, w.pj, withHessians, w.pair);
   return w.pair;
 }

@@ -26,8 +26,8 @@ class TwoPointConstraint : public Constraint {
                      const Vec2& pointJ);
   const Vec2& pointI() const { return pointI_; }
   const Vec2& pointJ() const { return pointJ_; }
-  std::vector<std::pair<BodyIndex, Vec2>> attachments() const override {
-    return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], lift(pointI_)}, {bodies()[1], lift(pointJ_)}};
   }
 
  protected:

@@ -32,7 +32,7 @@ void PrismaticJoint::evaluate(const BodyStates& bodies, bool withHessians, Const
 }
 
 VecX PrismaticJoint::reactions(const BodyStates& bodies, const VecX& lambda) const {
-  const double phiI = bodies[0].point(pointI(), false).phi;
+  const double phiI = bodies[0].point(pointI(), bodies.pointId(0), false).phi;
   const Vec2 n = rotation(phiI) * perp(axis_);
   const Vec2 f = -lambda[0] * n;
   return Eigen::Vector3d(f.x(), f.y(), -lambda[1]);

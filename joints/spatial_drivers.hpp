@@ -19,6 +19,9 @@ class FramePairConstraint : public Constraint {
   FramePairConstraint(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
                       const JointFrame& frameJ);
   const JointFrame& frameI() const { return frameI_; }
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
+  }
   const JointFrame& frameJ() const { return frameJ_; }
 
  protected:

@@ -34,6 +34,9 @@ class SpatialJoint final : public Constraint {
 
   SpatialJointType type() const { return type_; }
   const JointFrame& frameI() const { return frameI_; }
+  std::vector<Attachment> attachments() const override {
+    return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
+  }
   const JointFrame& frameJ() const { return frameJ_; }
   int numEquations() const override { return static_cast<int>(equations_.size()); }
   std::string typeName() const override { return toString(type_); }

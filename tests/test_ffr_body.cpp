@@ -27,6 +27,7 @@
 
 #include "bodies/ffr_beam_model.hpp"
 #include "bodies/ffr_body_2d.hpp"
+#include "ffr_test_models.hpp"
 #include "bodies/ffr_invariants.hpp"
 #include "core/errors.hpp"
 #include "elements/beam_element_2d.hpp"
@@ -492,7 +493,7 @@ TEST(FfrBody2d, DerivativesMatchFiniteDifferences) {
         expectMatrixNear(pk.r, Vec2(q.head<2>() + rotation(q[2]) * u), 1e-14, where + ": r", 1.0);
         EXPECT_NEAR(pk.phi, q[2] + nm.model->basis().row(3 * k + 2).dot(q.tail(nf)), 1e-14) << where;
         // over the node's support (what joints use): the same entries, none outside it
-        const std::vector<int> cols = body.pointSupport(node);
+        const std::vector<int> cols = body.pointSupport(lift(node), body.resolvePoint(lift(node), "test"));
         const PointKinematics pc = body.pointKinematics(q, node, cols, true);
         std::vector<bool> inSupport(n, false);
         for (size_t a = 0; a < cols.size(); ++a) {
@@ -893,15 +894,17 @@ TEST(FfrBody2d, RejectsInvalidInvariants) {
 TEST(FfrBody2d, AttachmentOnlyAtNodes) {
   const auto model = makeModel(lFrame(2), options(RC::Clamped));
   const FfrBody2d body("frame", model, FrameState2d{});
-  for (const FfrPoint& p : body.invariants().points) EXPECT_NO_THROW(body.checkAttachmentPoint(p.position, "joint 'j'"));
+  for (const FfrPoint& p : body.invariants().points) EXPECT_EQ(body.invariants().points[body.resolvePoint(lift(p.position), "joint 'j'")].position, p.position);
   // a point inside an element, and a point off the beam
   for (const Vec2& bad : {Vec2(0.1, 0.0), Vec2(0.2, 0.2)}) {
-    expectInputError([&] { body.checkAttachmentPoint(bad, "joint 'j'"); },
+    expectInputError([&] { body.resolvePoint(lift(bad), "joint 'j'"); },
                      {"joint 'j'", "flexible body 'frame'", "no node", "(0, 0)", "(0.15, 0)", "(0.3, 0.1)"});
     expectInputError([&] { body.pointKinematics(body.initialCoordinates(), bad); }, {"flexible body 'frame'", "no node"});
   }
   // a node found within the tolerance (1e-9 relative)
-  EXPECT_NO_THROW(body.checkAttachmentPoint(Vec2(0.3 + 1e-12, 0.1), "joint 'j'"));
+  EXPECT_NO_THROW(body.resolvePoint(Vec3(0.3 + 1e-12, 0.1, 0.0), "joint 'j'"));
+  // out of the plane: no node there
+  expectInputError([&] { body.resolvePoint(Vec3(0.3, 0.1, 0.01), "joint 'j'"); }, {"joint 'j'", "no node", "0.01"});
   // locate and materialPoint agree with the element geometry
   int e = -1;
   double xi = -1;
@@ -910,6 +913,40 @@ TEST(FfrBody2d, AttachmentOnlyAtNodes) {
   EXPECT_NEAR(xi, 0.5, 1e-14);
   EXPECT_FALSE(model->locate(Vec2(0.2, 0.2), e, xi));
   expectMatrixNear(model->materialPoint(2, 0.5).position, Vec2(0.3, 0.05), 1e-15, "material point", 1.0);
+}
+
+// Attachment points are resolved once, at finalize, into the bodies' identifiers (issue 13):
+// the joints of the elastic slider crank find the rod's nodes by index, and each index is
+// the node at the joint's point, with the same kinematics as the search by coordinates.
+TEST(FfrBody2d, AttachmentPointsResolvedAtFinalize) {
+  const Scene scene = testmodels::elasticSliderCrank(4, 1.0, 0, 0.1, 1e-6, 1e-6);
+  const System& sys = scene.system;
+  const VecX q = sys.initialCoordinates();
+  int resolvedNodes = 0;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const BodyStates states = sys.constraintStates(ci, q.data());
+    const std::vector<Attachment> att = sys.constraint(ci).attachments();
+    for (size_t k = 0; k < att.size(); ++k) {
+      const Body& body = sys.body(att[k].body);
+      const int id = states.pointId(static_cast<int>(k));
+      const auto* ffr = dynamic_cast<const FfrBody2d*>(&body);
+      if (!ffr) {
+        EXPECT_EQ(id, Body::kAnyPoint) << sys.constraint(ci).name();
+        continue;
+      }
+      ASSERT_GE(id, 0) << sys.constraint(ci).name();
+      EXPECT_EQ(lift(ffr->invariants().points[id].position), att[k].point) << sys.constraint(ci).name();
+      const auto qb = q.segment(sys.coordinateOffset(att[k].body), body.numCoordinates());
+      PointKinematics byId;
+      body.pointKinematics(qb, att[k].point.head<2>(), id, nullptr, true, byId);
+      const PointKinematics bySearch = body.pointKinematics(qb, Vec2(att[k].point.head<2>()), true);
+      EXPECT_EQ(byId.r, bySearch.r);
+      EXPECT_EQ(byId.Jr, bySearch.Jr);
+      ++resolvedNodes;
+    }
+  }
+  EXPECT_EQ(resolvedNodes, 2);  // the rod's two ends (crank pin and slider pin)
 }
 
 }  // namespace

@@ -119,12 +119,12 @@ TEST(RigidBody3d, FrameJacobiansCurvatureAndGyroscopicTermsMatchFiniteDifference
     const Vec3 u = rnd.vector(3, -1.0, 1.0), wr = rnd.vector(3, -2.0, 2.0), ww = rnd.vector(3, -2.0, 2.0);
     const std::string at = "sample " + std::to_string(s);
     FrameKinematics f;
-    body.frameKinematics(q, u, nullptr, nullptr, f);
+    body.frameKinematics(q, u, Body::kAnyPoint, nullptr, nullptr, f);
     EXPECT_NEAR((f.A - quaternionRotation(q.segment<4>(3))).norm(), 0.0, kRoundoffTol);
     // Jr: the point's velocity along each velocity direction
     expectMatrixNear(f.Jr, fdAlongVelocities(body, q, [&](const VecX& z) {
                        FrameKinematics g;
-                       body.frameKinematics(z, u, nullptr, nullptr, g);
+                       body.frameKinematics(z, u, Body::kAnyPoint, nullptr, nullptr, g);
                        return VecX(g.r);
                      }), kFdTol, "Jr, " + at, 1.0);
     // Jw: dA/d eps A^T = (Jw e_k)~
@@ -136,10 +136,10 @@ TEST(RigidBody3d, FrameJacobiansCurvatureAndGyroscopicTermsMatchFiniteDifference
     }
     // curvature d(Jr^T wr + Jw^T ww)/dq
     MatX C = MatX::Zero(6, 7);
-    body.addFrameCurvature(q, u, nullptr, nullptr, wr, ww, C);
+    body.addFrameCurvature(q, u, Body::kAnyPoint, nullptr, nullptr, wr, ww, C);
     expectMatrixNear(C, fdJacobian([&](const VecX& z) {
                        FrameKinematics g;
-                       body.frameKinematics(z, u, nullptr, nullptr, g);
+                       body.frameKinematics(z, u, Body::kAnyPoint, nullptr, nullptr, g);
                        return VecX(g.Jr.transpose() * wr + g.Jw.transpose() * ww);
                      }, q), kFdTol, "curvature, " + at, 1.0);
     // gyroscopic force and its Jacobian
