@@ -1,5 +1,6 @@
 #include "elements/beam_element_3d.hpp"
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -76,7 +77,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     secondMoment_(2, 2) += w * rIy;                       // int rho z^2 dV = rho Iy l
     sBar_ += (w * rhoA) * Sc;                             // int rho S dV (y, z terms vanish)
     for (int k = 0; k < 3; ++k) {
-      for (int m = 0; m < 3; ++m) {
+      for (int m = k; m < 3; ++m) {
         sKL_[3 * k + m] += (w * rhoA) * Sc.row(k).transpose() * Sc.row(m);  // rho A int Sc_k^T Sc_l dx
       }
     }
@@ -87,6 +88,11 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     xS_[2].row(1) -= (w * rIy) * phi;              // int rho z S_y dV = -int rho z^2 tx dV
     const Row12 by = slopeShapeY(xi, l), bz = slopeShapeZ(xi, l);
     G_ += w * (by.transpose() * by + bz.transpose() * bz);  // int (by^T by + bz^T bz) dx
+  }
+  // S_lk = S_kl^T and S_kk = S_kk^T exactly (the quadrature sums differ in the last bit)
+  for (int k = 0; k < 3; ++k) {
+    sKL_[4 * k] = (0.5 * (sKL_[4 * k] + sKL_[4 * k].transpose())).eval();
+    for (int m = k + 1; m < 3; ++m) sKL_[3 * m + k] = sKL_[3 * k + m].transpose();
   }
   massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz
   // x0 cross u = (y u_z - z u_y, z u_x - x u_z, x u_y - y u_x)
