@@ -1,4 +1,5 @@
-// Cross-section and material of a planar Euler-Bernoulli beam.
+// Cross-sections and materials of Euler-Bernoulli beams: planar (BeamSection) and
+// spatial (BeamSection3d).
 #pragma once
 
 #include <string>
@@ -23,5 +24,47 @@ struct BeamSection {
 /// Rectangular b x h section (bending about the axis parallel to b).
 BeamSection rectangularSection(double width, double height, double youngsModulus, double density,
                                double damping = 0.0);
+
+/// Cross-section and material of a spatial Euler-Bernoulli beam (elements/beam_element_3d).
+/// Section axes y, z: principal axes through the centroid (the element's y and z axes),
+/// so int y dA = int z dA = int y z dA = 0.
+struct BeamSection3d {
+  double area = 0.0;             ///< A, m^2
+  double inertiaY = 0.0;         ///< Iy = int z^2 dA, m^4: bending in the x-z plane
+  double inertiaZ = 0.0;         ///< Iz = int y^2 dA, m^4: bending in the x-y plane
+  double torsionConstant = 0.0;  ///< St Venant torsion constant J, m^4 (J = Ip for a circle only)
+  double youngsModulus = 0.0;    ///< E, Pa
+  double shearModulus = 0.0;     ///< G, Pa
+  double density = 0.0;          ///< rho, kg/m^3
+  /// Stiffness-proportional (Rayleigh) damping coefficient beta, s: D = beta K.
+  double damping = 0.0;
+
+  double massPerLength() const { return density * area; }         ///< rho A, kg/m
+  double polarMoment() const { return inertiaY + inertiaZ; }      ///< Ip = int (y^2 + z^2) dA, m^4
+  double axialStiffness() const { return youngsModulus * area; }  ///< EA, N
+  double bendingStiffnessY() const { return youngsModulus * inertiaY; }  ///< E Iy, N m^2 (x-z plane)
+  double bendingStiffnessZ() const { return youngsModulus * inertiaZ; }  ///< E Iz, N m^2 (x-y plane)
+  double torsionStiffness() const { return shearModulus * torsionConstant; }  ///< G J, N m^2
+  /// @throws InputError naming `owner` unless A, Iy, Iz, J, E, G, rho > 0 (and finite)
+  /// and damping >= 0 (and finite).
+  void validate(const std::string& owner) const;
+};
+
+/// Rectangular section, side `widthY` along the section's y axis and `heightZ` along z:
+/// A = b h, Iz = h b^3 / 12, Iy = b h^3 / 12, and the St Venant torsion constant of the
+/// rectangle by its exact series (Timoshenko & Goodier, Theory of Elasticity, 3rd ed.,
+/// sec. 109), with a >= b the longer and shorter sides:
+///   J = (a b^3 / 3) [1 - (192 / pi^5) (b / a) sum_{n = 1, 3, 5, ...} tanh(n pi a / (2b)) / n^5],
+/// summed to n = 101 (truncation < 1e-9 relative). J = 0.1406 a^4 for a square.
+/// The material is given by E and the shear modulus G (not Poisson's ratio: G = E / (2 (1 + nu))
+/// for an isotropic material; G directly covers orthotropic rods too), as circularSection3d.
+/// No checks here: BeamSection3d::validate (called by the element) rejects bad values.
+BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsModulus, double shearModulus,
+                                   double density, double damping = 0.0);
+
+/// Solid circular section of diameter d: A = pi d^2 / 4, Iy = Iz = pi d^4 / 64 and
+/// J = Ip = pi d^4 / 32 (a circle does not warp).
+BeamSection3d circularSection3d(double diameter, double youngsModulus, double shearModulus, double density,
+                                double damping = 0.0);
 
 }  // namespace flexmbd

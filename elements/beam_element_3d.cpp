@@ -1,0 +1,273 @@
+#include "elements/beam_element_3d.hpp"
+
+#include <Eigen/Geometry>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "core/errors.hpp"
+
+namespace flexmbd {
+namespace {
+
+// 5-point Gauss-Legendre rule mapped to [0, 1]: exact up to degree 9.
+constexpr std::array<double, 5> kGaussXi = {
+    0.5 - 0.5 * 0.9061798459386640, 0.5 - 0.5 * 0.5384693101056831, 0.5,
+    0.5 + 0.5 * 0.5384693101056831, 0.5 + 0.5 * 0.9061798459386640};
+constexpr std::array<double, 5> kGaussW = {0.5 * 0.2369268850561891, 0.5 * 0.4786286704993665,
+                                           0.5 * 0.5688888888888889, 0.5 * 0.4786286704993665,
+                                           0.5 * 0.2369268850561891};
+
+// A y hint within this angle (rad) of the element axis does not define the y axis.
+constexpr double kParallelHint = 1e-6;
+
+// Coordinate indices within e: per node (u, v, w, tx, ty, tz), node 2 at +6.
+constexpr int kU = 0, kV = 1, kW = 2, kTx = 3, kTy = 4, kTz = 5, kNode2 = 6;
+
+}  // namespace
+
+BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHint,
+                             const BeamSection3d& section, const std::string& owner)
+    : start_(start), end_(end), section_(section) {
+  section.validate(owner);
+  for (int k = 0; k < 3; ++k) {
+    requireFinite(start[k], owner + ": node coordinate");
+    requireFinite(end[k], owner + ": node coordinate");
+    requireFinite(yHint[k], owner + ": y axis hint");
+  }
+  const Vec3 d = end - start;
+  l_ = d.norm();
+  if (!(l_ > 1e-12 * (1.0 + start.norm()))) {
+    throw InputError(owner + ": element has zero length (its two nodes coincide); expected distinct nodes");
+  }
+  const Vec3 ex = d / l_;
+  const double hint = yHint.norm();
+  if (!(hint > 0.0)) {
+    throw InputError(owner + ": y axis hint is zero; expected a direction not parallel to the element axis");
+  }
+  const Vec3 yPerp = yHint - yHint.dot(ex) * ex;  // Gram-Schmidt: y = hint - (hint . x) x
+  if (!(yPerp.norm() > kParallelHint * hint)) {
+    throw InputError(owner + ": y axis hint is parallel to the element axis (end - start); expected a "
+                             "direction across the element");
+  }
+  const Vec3 ey = yPerp.normalized();
+  C_.col(0) = ex;
+  C_.col(1) = ey;
+  C_.col(2) = ex.cross(ey);  // z = x cross y
+  T_.setZero();
+  for (int n = 0; n < 4; ++n) T_.block<3, 3>(3 * n, 3 * n) = C_.transpose();  // e = T q (document 003, C^ij)
+
+  const double l = l_, rhoA = section.massPerLength();
+  const double rIy = section.density * section.inertiaY, rIz = section.density * section.inertiaZ;
+  mass_ = rhoA * l;
+  firstMoment_.setZero();
+  secondMoment_.setZero();
+  sBar_.setZero();
+  for (Mat12& s : sKL_) s.setZero();
+  for (Mat3x12& s : xS_) s.setZero();
+  G_.setZero();
+  for (size_t g = 0; g < kGaussXi.size(); ++g) {
+    const double xi = kGaussXi[g], w = kGaussW[g] * l, x = xi * l;  // dx = l dxi
+    const Mat3x12 Sc = shape(xi, l);
+    const Row12 phi = twistShape(xi);
+    firstMoment_.x() += w * rhoA * x;                     // int rho x dV
+    secondMoment_(0, 0) += w * rhoA * x * x;              // int rho x^2 dV
+    secondMoment_(1, 1) += w * rIz;                       // int rho y^2 dV = rho Iz l
+    secondMoment_(2, 2) += w * rIy;                       // int rho z^2 dV = rho Iy l
+    sBar_ += (w * rhoA) * Sc;                             // int rho S dV (y, z terms vanish)
+    for (int k = 0; k < 3; ++k) {
+      for (int m = k; m < 3; ++m) {
+        sKL_[3 * k + m] += (w * rhoA) * Sc.row(k).transpose() * Sc.row(m);  // rho A int Sc_k^T Sc_l dx
+      }
+    }
+    sKL_[4] += (w * rIy) * phi.transpose() * phi;  // S_yy += int rho z^2 tx^T tx dV
+    sKL_[8] += (w * rIz) * phi.transpose() * phi;  // S_zz += int rho y^2 tx^T tx dV
+    xS_[0] += (w * rhoA * x) * Sc;                 // int rho x S dV
+    xS_[1].row(2) += (w * rIz) * phi;              // int rho y S_z dV = int rho y^2 tx dV
+    xS_[2].row(1) -= (w * rIy) * phi;              // int rho z S_y dV = -int rho z^2 tx dV
+    const Row12 by = slopeShapeY(xi, l), bz = slopeShapeZ(xi, l);
+    G_ += w * (by.transpose() * by + bz.transpose() * bz);  // int (by^T by + bz^T bz) dx
+  }
+  // S_lk = S_kl^T and S_kk = S_kk^T exactly (the quadrature sums differ in the last bit)
+  for (int k = 0; k < 3; ++k) {
+    sKL_[4 * k] = (0.5 * (sKL_[4 * k] + sKL_[4 * k].transpose())).eval();
+    for (int m = k + 1; m < 3; ++m) sKL_[3 * m + k] = sKL_[3 * k + m].transpose();
+  }
+  massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz
+  // x0 cross u = (y u_z - z u_y, z u_x - x u_z, x u_y - y u_x)
+  skewXS_.row(0) = xS_[1].row(2) - xS_[2].row(1);
+  skewXS_.row(1) = xS_[2].row(0) - xS_[0].row(2);
+  skewXS_.row(2) = xS_[0].row(1) - xS_[1].row(0);
+  dotXS_ = xS_[0].row(0) + xS_[1].row(1) + xS_[2].row(2);  // x0 . u
+
+  // Euler-Bernoulli stiffness, closed form (Przemieniecki, Theory of Matrix Structural
+  // Analysis, sec. 5.6): axial EA/l, torsion GJ/l, Hermite bending EIz/l^3, EIy/l^3.
+  K_.setZero();
+  const double ea = section.axialStiffness() / l, gj = section.torsionStiffness() / l;
+  for (const auto& [dof, k] : {std::pair<int, double>{kU, ea}, std::pair<int, double>{kTx, gj}}) {
+    K_(dof, dof) = K_(dof + kNode2, dof + kNode2) = k;
+    K_(dof, dof + kNode2) = K_(dof + kNode2, dof) = -k;
+  }
+  const double kb[4][4] = {{12, 6 * l, -12, 6 * l},
+                           {6 * l, 4 * l * l, -6 * l, 2 * l * l},
+                           {-12, -6 * l, 12, -6 * l},
+                           {6 * l, 2 * l * l, -6 * l, 4 * l * l}};
+  // x-y plane (v, tz): the Hermite matrix as it is; x-z plane (w, ty): ty = -w', so the
+  // rotation rows and columns change sign.
+  const int bendY[4] = {kV, kTz, kV + kNode2, kTz + kNode2};
+  const int bendZ[4] = {kW, kTy, kW + kNode2, kTy + kNode2};
+  const double sign[4] = {1, -1, 1, -1};
+  const double eiz = section.bendingStiffnessZ() / (l * l * l), eiy = section.bendingStiffnessY() / (l * l * l);
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 4; ++j) {
+      K_(bendY[i], bendY[j]) = eiz * kb[i][j];
+      K_(bendZ[i], bendZ[j]) = eiy * sign[i] * sign[j] * kb[i][j];
+    }
+  }
+  Kb_ = K_;
+  Kb_(kU, kU) = Kb_(kU + kNode2, kU + kNode2) = Kb_(kU, kU + kNode2) = Kb_(kU + kNode2, kU) = 0.0;
+}
+
+const BeamElement3d::Mat12& BeamElement3d::sKL(int k, int l) const {
+  if (k < 0 || k > 2 || l < 0 || l > 2) throw std::out_of_range("BeamElement3d::sKL: k, l must be 0, 1 or 2");
+  return sKL_[3 * k + l];
+}
+
+const BeamElement3d::Mat3x12& BeamElement3d::positionShapeIntegral(int k) const {
+  if (k < 0 || k > 2) throw std::out_of_range("BeamElement3d::positionShapeIntegral: k must be 0, 1 or 2");
+  return xS_[k];
+}
+
+BeamElement3d::Mat3x12 BeamElement3d::shape(double xi, double l) {
+  const double x2 = xi * xi, x3 = x2 * xi;
+  const double h1 = 1 - 3 * x2 + 2 * x3, h2 = l * (xi - 2 * x2 + x3), h3 = 3 * x2 - 2 * x3, h4 = l * (x3 - x2);
+  Mat3x12 S = Mat3x12::Zero();
+  S(0, kU) = 1 - xi;  // w_x = (1-xi) u1 + xi u2
+  S(0, kU + kNode2) = xi;
+  S(1, kV) = h1;  // w_y = h1 v1 + h2 tz1 + h3 v2 + h4 tz2
+  S(1, kTz) = h2;
+  S(1, kV + kNode2) = h3;
+  S(1, kTz + kNode2) = h4;
+  S(2, kW) = h1;  // w_z = h1 w1 - h2 ty1 + h3 w2 - h4 ty2
+  S(2, kTy) = -h2;
+  S(2, kW + kNode2) = h3;
+  S(2, kTy + kNode2) = -h4;
+  return S;
+}
+
+BeamElement3d::Row12 BeamElement3d::twistShape(double xi) {
+  Row12 r = Row12::Zero();
+  r(kTx) = 1 - xi;  // tx = (1-xi) tx1 + xi tx2
+  r(kTx + kNode2) = xi;
+  return r;
+}
+
+BeamElement3d::Mat3x12 BeamElement3d::pointShape(double xi, double y, double z, double l) {
+  Mat3x12 S = shape(xi, l);
+  const Row12 phi = twistShape(xi);
+  S.row(1) -= z * phi;  // tx e_x cross (0, y, z) = (0, -z tx, y tx)
+  S.row(2) += y * phi;
+  return S;
+}
+
+BeamElement3d::Row12 BeamElement3d::axialStrainShape(double l) {
+  Row12 r = Row12::Zero();
+  r(kU) = -1 / l;  // u' = (u2 - u1) / l
+  r(kU + kNode2) = 1 / l;
+  return r;
+}
+
+BeamElement3d::Row12 BeamElement3d::twistRateShape(double l) {
+  Row12 r = Row12::Zero();
+  r(kTx) = -1 / l;  // tx' = (tx2 - tx1) / l
+  r(kTx + kNode2) = 1 / l;
+  return r;
+}
+
+BeamElement3d::Row12 BeamElement3d::slopeShapeY(double xi, double l) {
+  Row12 r = Row12::Zero();  // v' = h1' v1 + h2' tz1 + h3' v2 + h4' tz2 (d/dx)
+  r(kV) = (-6 * xi + 6 * xi * xi) / l;
+  r(kTz) = 1 - 4 * xi + 3 * xi * xi;
+  r(kV + kNode2) = (6 * xi - 6 * xi * xi) / l;
+  r(kTz + kNode2) = 3 * xi * xi - 2 * xi;
+  return r;
+}
+
+BeamElement3d::Row12 BeamElement3d::slopeShapeZ(double xi, double l) {
+  Row12 r = Row12::Zero();  // w' = h1' w1 - h2' ty1 + h3' w2 - h4' ty2
+  r(kW) = (-6 * xi + 6 * xi * xi) / l;
+  r(kTy) = -(1 - 4 * xi + 3 * xi * xi);
+  r(kW + kNode2) = (6 * xi - 6 * xi * xi) / l;
+  r(kTy + kNode2) = -(3 * xi * xi - 2 * xi);
+  return r;
+}
+
+BeamElement3d::Row12 BeamElement3d::curvatureShapeY(double xi, double l) {
+  Row12 r = Row12::Zero();  // v'' = h1'' v1 + h2'' tz1 + h3'' v2 + h4'' tz2
+  r(kV) = (-6 + 12 * xi) / (l * l);
+  r(kTz) = (-4 + 6 * xi) / l;
+  r(kV + kNode2) = (6 - 12 * xi) / (l * l);
+  r(kTz + kNode2) = (6 * xi - 2) / l;
+  return r;
+}
+
+BeamElement3d::Row12 BeamElement3d::curvatureShapeZ(double xi, double l) {
+  Row12 r = Row12::Zero();  // w'' = h1'' w1 - h2'' ty1 + h3'' w2 - h4'' ty2
+  r(kW) = (-6 + 12 * xi) / (l * l);
+  r(kTy) = -(-4 + 6 * xi) / l;
+  r(kW + kNode2) = (6 - 12 * xi) / (l * l);
+  r(kTy + kNode2) = -(6 * xi - 2) / l;
+  return r;
+}
+
+// Membrane locking and the averaged membrane strain: Stolarski & Belytschko, J. Appl.
+// Mech. 49 (1982); Crisfield, Non-linear FEA of Solids and Structures vol. 1 (1991);
+// as BeamElement2d, with both bending planes. With a = axialStrainShape,
+// G = int (by^T by + bz^T bz) dx and d = a^T + G e / l:
+
+double BeamElement3d::membraneStrain(const Vec12& e, bool stiffening) const {
+  const double du = axialStrainShape(l_).dot(e);
+  if (!stiffening) return du;
+  return du + 0.5 * e.dot(G_ * e) / l_;  // eps_m = a e + e^T G e / (2l)
+}
+
+double BeamElement3d::strainEnergy(const Vec12& e, bool stiffening) const {
+  if (!stiffening) return 0.5 * e.dot(K_ * e);  // U = e^T K e / 2
+  const double eps = membraneStrain(e, true);
+  // U = EA l eps_m^2 / 2 + e^T K_b e / 2 (bending and torsion)
+  return 0.5 * section_.axialStiffness() * l_ * eps * eps + 0.5 * e.dot(Kb_ * e);
+}
+
+BeamElement3d::Vec12 BeamElement3d::strainEnergyGradient(const Vec12& e, bool stiffening) const {
+  if (!stiffening) return K_ * e;
+  const double eps = membraneStrain(e, true);
+  const Vec12 d = axialStrainShape(l_).transpose() + G_ * e / l_;  // d eps_m / de
+  // dU/de = EA l eps_m d + K_b e
+  return (section_.axialStiffness() * l_ * eps) * d + Kb_ * e;
+}
+
+BeamElement3d::Mat12 BeamElement3d::strainEnergyHessian(const Vec12& e, bool stiffening) const {
+  if (!stiffening) return K_;
+  const double EA = section_.axialStiffness(), eps = membraneStrain(e, true);
+  const Vec12 d = axialStrainShape(l_).transpose() + G_ * e / l_;
+  // d2U/de2 = EA l d d^T + EA eps_m G (geometric stiffness, N = EA eps_m) + K_b
+  return (EA * l_) * d * d.transpose() + (EA * eps) * G_ + Kb_;
+}
+
+BeamSectionForces3d BeamElement3d::sectionForces(const Vec12& e, double xi, bool stiffening) const {
+  const BeamSection3d& s = section_;
+  BeamSectionForces3d f;
+  f.N = s.axialStiffness() * membraneStrain(e, stiffening);  // N = EA eps (constant, consistent with U)
+  f.Mx = s.torsionStiffness() * twistRateShape(l_).dot(e);    // Mx = GJ tx'
+  f.My = -s.bendingStiffnessY() * curvatureShapeZ(xi, l_).dot(e);  // My = EIy ty' = -EIy w''
+  f.Mz = s.bendingStiffnessZ() * curvatureShapeY(xi, l_).dot(e);   // Mz = EIz tz' = EIz v''
+  // the curvatures are linear in xi: v''' = (v''(1) - v''(0)) / l, likewise w'''
+  const double v3 = (curvatureShapeY(1.0, l_) - curvatureShapeY(0.0, l_)).dot(e) / l_;
+  const double w3 = (curvatureShapeZ(1.0, l_) - curvatureShapeZ(0.0, l_)).dot(e) / l_;
+  f.Qy = -s.bendingStiffnessZ() * v3;  // dMz/dx + Qy = 0 (moment balance of a slice)
+  f.Qz = -s.bendingStiffnessY() * w3;  // dMy/dx - Qz = 0
+  return f;
+}
+
+}  // namespace flexmbd
