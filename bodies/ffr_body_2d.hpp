@@ -62,6 +62,7 @@ class FfrBody2d final : public Body {
   bool isDissipative() const override { return inv_.dff.nonZeros() > 0 && inv_.dff.coeffs().cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
   /// phi = theta + Nphi q_f.
+  ElasticMatrices elasticMatrices() const override { return {&inv_.mff, &inv_.kff, &inv_.dff}; }
   using Body::pointKinematics;
   void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
                        bool withHessians,

@@ -113,6 +113,15 @@ class Body {
   /// Potential energy of gravity (zero at the world origin) and internal (elastic) energy.
   virtual double gravityPotential(const ConstVecRef& q, const Vec3& g) const = 0;
   virtual double internalPotential(const ConstVecRef& q) const { (void)q; return 0.0; }
+  /// The constant mass, stiffness and damping matrices of the body's elastic coordinates
+  /// (nf x nf, sparse, views valid as long as the body), for modal analyses (the BDF
+  /// order limit, linearisation); all null for a body without elastic coordinates.
+  struct ElasticMatrices {
+    const SpMat* mass = nullptr;
+    const SpMat* stiffness = nullptr;
+    const SpMat* damping = nullptr;
+  };
+  virtual ElasticMatrices elasticMatrices() const { return {}; }
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 

@@ -161,12 +161,15 @@ DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisat
   L.size = L.nq + L.nv + (formulation == Formulation::Ggl ? 2 : 1) * L.m;
 
   // The pattern is what the assembly writes, recorded once at the initial state.
-  std::vector<std::pair<int, int>> entries;
-  JacobianSink recorder = JacobianSink::recorder(&entries);
+  std::vector<Eigen::Triplet<double>> written;
+  JacobianSink recorder = JacobianSink::recorder(&written);
   VecX y, yp;
   const VecX q0 = sys.initialCoordinates();
   packState(q0, VecX::Zero(L.nv), VecX::Zero(L.nv), VecX::Zero(L.m), y, yp);
   jacobian(0.0, y.data(), yp.data(), 1.0, recorder);
+  std::vector<std::pair<int, int>> entries;
+  entries.reserve(written.size());
+  for (const auto& e : written) entries.emplace_back(e.row(), e.col());
   pattern_ = SparsePattern(L.size, std::move(entries));
 }
 

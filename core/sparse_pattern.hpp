@@ -2,6 +2,7 @@
 // and the sink the assembly writes entries into (dense or sparse storage).
 #pragma once
 
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <cstdint>
 #include <utility>
@@ -39,8 +40,9 @@ class JacobianSink {
   static JacobianSink sparse(double* values, const SparsePattern& p) {
     return JacobianSink(values, p.size(), &p);
   }
-  /// Records the positions written (to build the pattern); values are ignored.
-  static JacobianSink recorder(std::vector<std::pair<int, int>>* entries) {
+  /// Records the entries written with their values (duplicates kept): to build the
+  /// pattern, or a sparse matrix by setFromTriplets (which sums duplicates).
+  static JacobianSink recorder(std::vector<Eigen::Triplet<double>>* entries) {
     JacobianSink s(nullptr, 0, nullptr);
     s.entries_ = entries;
     return s;
@@ -49,7 +51,7 @@ class JacobianSink {
   /// pattern (an assembly bug, never a user error).
   void add(int row, int col, double value) {
     if (entries_) {
-      entries_->emplace_back(row, col);
+      entries_->emplace_back(row, col, value);
       return;
     }
     if (!pattern_) {
@@ -103,7 +105,7 @@ class JacobianSink {
   double* data_;
   int n_;
   const SparsePattern* pattern_;
-  std::vector<std::pair<int, int>>* entries_ = nullptr;
+  std::vector<Eigen::Triplet<double>>* entries_ = nullptr;
 };
 
 }  // namespace flexmbd

@@ -71,6 +71,35 @@ VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, 
   return out;
 }
 
+SpMat augmentedMatrix(const System& sys, const VecX& q) {
+  const int n = sys.numVelocities(), m = sys.numConstraintEquations();
+  std::vector<Eigen::Triplet<double>> entries;
+  JacobianSink sink = JacobianSink::recorder(&entries);
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    if (body.numCoordinates() == 0) continue;
+    const int voff = sys.velocityOffset(bi);
+    body.addMassMatrix(q.segment(sys.coordinateOffset(bi), body.numCoordinates()), MatrixSink(sink, voff, voff));
+  }
+  forEachConstraint(sys, q, 0.0, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
+                                            const VecX&, const VecX&, const VecX&) {
+    const auto& cols = sys.constraintColumns(ci);
+    const int row = n + sys.constraintOffset(ci);
+    for (size_t k = 0; k < cols.size(); ++k) {
+      for (int a = 0; a < con.numEquations(); ++a) {
+        const double g = ev.G(a, static_cast<Eigen::Index>(k));
+        if (g == 0.0) continue;
+        entries.emplace_back(row + a, cols[k], g);
+        entries.emplace_back(cols[k], row + a, g);
+      }
+    }
+  });
+  SpMat A(n + m, n + m);
+  A.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
+  return A;
+}
+
 MatX massMatrix(const System& sys, const VecX& q) {
   const int n = sys.numVelocities();
   MatX M = MatX::Zero(n, n);

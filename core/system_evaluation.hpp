@@ -16,7 +16,11 @@ void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, Ma
 VecX velocityConstraintResidual(const System& sys, const VecX& q, const VecX& v, double t);
 /// Acceleration right-hand side: G a = f''(t) - [v^T H_a v]_a (m).
 VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, double t);
-/// Block-diagonal mass matrix (nq x nq, dense).
+/// The augmented matrix [M G^T; G 0] (nv + m square, sparse) at q: each body writes its
+/// mass matrix's structural non-zeros through a sink, as in the DAE Jacobian, and each
+/// constraint its G block; no dense array (outputs of large flexible models).
+SpMat augmentedMatrix(const System& sys, const VecX& q);
+/// Block-diagonal mass matrix (nv x nv, dense; small systems and tests).
 MatX massMatrix(const System& sys, const VecX& q);
 /// All generalised forces except constraint forces: internal, gravity, force elements.
 VecX generalizedForces(const System& sys, double t, const VecX& q, const VecX& v);

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <sstream>
 
-#include "bodies/ffr_body_2d.hpp"
 
 namespace flexmbd {
 
@@ -28,15 +27,15 @@ BdfOrderLimit stableBdfOrder(const System& sys, int requested) {
   limit.order = requested;
   const double lightlyDamped = sectorDampingRatio(kLowestLimitedOrder);
   for (int b = 0; b < sys.numBodies() && limit.order > kLowestLimitedOrder; ++b) {
-    const auto* body = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex{b}));
-    if (!body) continue;
-    const FfrInvariants& inv = body->invariants();
-    const int nf = inv.numElastic();
-    if (nf == 0 || nf > kMaxModalAnalysisSize || inv.dff.nonZeros() == 0) continue;
-    const MatX D(inv.dff);
+    const Body& body = sys.body(BodyIndex{b});
+    const Body::ElasticMatrices em = body.elasticMatrices();
+    if (!em.mass || !em.stiffness || !em.damping) continue;
+    const int nf = static_cast<int>(em.mass->rows());
+    if (nf == 0 || nf > kMaxModalAnalysisSize || em.damping->nonZeros() == 0) continue;
+    const MatX D(*em.damping);
     if (D.cwiseAbs().maxCoeff() == 0.0) continue;
     // K phi = omega^2 M phi, phi^T M phi = 1 (M, K symmetric positive definite: validated)
-    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(inv.kff), MatX(inv.mff));
+    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(*em.stiffness), MatX(*em.mass));
     if (eig.info() != Eigen::Success) continue;
     for (int i = 0; i < nf; ++i) {
       const double omega = std::sqrt(std::max(eig.eigenvalues()[i], 0.0));
@@ -46,7 +45,7 @@ BdfOrderLimit stableBdfOrder(const System& sys, int requested) {
       if (zeta < lightlyDamped) continue;
       while (limit.order > kLowestLimitedOrder && zeta < sectorDampingRatio(limit.order)) {
         --limit.order;
-        limit.body = body->name();
+        limit.body = body.name();
         limit.dampingRatio = zeta;
         limit.frequency = omega;
       }

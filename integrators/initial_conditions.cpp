@@ -33,42 +33,43 @@ void throwIfRedundant(const System& sys, const MatX& G) {
 
 }  // namespace
 
-void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
-  const int n = static_cast<int>(M.rows()), m = static_cast<int>(G.rows());
-  VecX rhs(n + m), sol;
+void solveAugmented(const SpMat& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
+  const int size = static_cast<int>(A.rows()), m = size - n;
+  VecX rhs(size), sol;
   rhs << r1, r2;
   // The cause is named by the callers, from what they measured (computeAccelerations).
   const char* singular = "the augmented system [M G^T; G 0] is singular";
-  if (n + m <= kDenseAugmentedLimit) {
-    MatX A = MatX::Zero(n + m, n + m);
-    A.topLeftCorner(n, n) = M;
-    A.topRightCorner(n, m) = G.transpose();
-    A.bottomLeftCorner(m, n) = G;
-    const Eigen::FullPivLU<MatX> lu(A);
+  if (size <= kDenseAugmentedLimit) {  // small: a rank-revealing dense LU
+    const Eigen::FullPivLU<MatX> lu{MatX(A)};
     if (!lu.isInvertible()) throw ModelError(singular);
     sol = lu.solve(rhs);
   } else {
-    std::vector<Eigen::Triplet<double>> t;
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) {
-        if (M(i, j) != 0.0) t.emplace_back(i, j, M(i, j));
-      }
-      for (int i = 0; i < m; ++i) {
-        if (G(i, j) != 0.0) {
-          t.emplace_back(n + i, j, G(i, j));
-          t.emplace_back(j, n + i, G(i, j));
-        }
-      }
-    }
-    Eigen::SparseMatrix<double> A(n + m, n + m);
-    A.setFromTriplets(t.begin(), t.end());
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(A);
+    Eigen::SparseLU<SpMat> lu(A);
     if (lu.info() != Eigen::Success) throw ModelError(singular);
     sol = lu.solve(rhs);
   }
   if (!sol.allFinite()) throw ModelError(singular);
   x = sol.head(n);
   y = sol.tail(m);
+}
+
+void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
+  const int n = static_cast<int>(M.rows()), m = static_cast<int>(G.rows());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      if (M(i, j) != 0.0) t.emplace_back(i, j, M(i, j));
+    }
+    for (int i = 0; i < m; ++i) {
+      if (G(i, j) != 0.0) {
+        t.emplace_back(n + i, j, G(i, j));
+        t.emplace_back(j, n + i, G(i, j));
+      }
+    }
+  }
+  SpMat A(n + m, n + m);
+  A.setFromTriplets(t.begin(), t.end());
+  solveAugmented(A, n, r1, r2, x, y);
 }
 
 namespace {
@@ -95,13 +96,14 @@ std::string massDiagonalReport(const System& sys, const MatX& M) {
 
 void computeAccelerations(const System& sys, double t, const VecX& q, const VecX& v, VecX& a,
                           VecX& lambda) {
-  MatX G;
-  evaluateConstraints(sys, q, t, nullptr, &G);
-  const MatX M = massMatrix(sys, q);
   const VecX Q = generalizedForces(sys, t, q, v), rhs = accelerationConstraintRhs(sys, q, v, t);
   try {
-    solveAugmented(M, G, Q, rhs, a, lambda);
+    solveAugmented(augmentedMatrix(sys, q), sys.numVelocities(), Q, rhs, a, lambda);
   } catch (const ModelError& e) {
+    // singular: the dense arrays for the diagnosis (rank of G) and the projection
+    MatX G;
+    evaluateConstraints(sys, q, t, nullptr, &G);
+    const MatX M = massMatrix(sys, q);
     const std::vector<int> rows = dependentRows(G);
     // At a singular position the accelerations are still unique (M is regular) when the
     // constraint rows agree: a = M^-1 (Q - G^T lambda) with the minimum-norm multipliers of

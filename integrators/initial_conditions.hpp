@@ -21,7 +21,11 @@ struct ConsistentState {
 ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0,
                                        const VecX& v0);
 
-/// Solves [M G^T; G 0][x; y] = [r1; r2]. @throws ModelError if it is singular.
+/// Solves [M G^T; G 0][x; y] = [r1; r2] given the augmented matrix A (n + m square, n
+/// velocities): dense rank-revealing LU up to 200 unknowns, sparse LU above.
+/// @throws ModelError if it is singular.
+void solveAugmented(const SpMat& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
+/// The same from dense M (n x n) and G (m x n).
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
 
 /// Accelerations and multipliers of the state (q, v) at time t, from the augmented

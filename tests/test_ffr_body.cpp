@@ -30,6 +30,7 @@
 #include "ffr_test_models.hpp"
 #include "bodies/ffr_invariants.hpp"
 #include "core/errors.hpp"
+#include "core/system_evaluation.hpp"
 #include "elements/beam_element_2d.hpp"
 #include "tests/test_support.hpp"
 
@@ -947,6 +948,25 @@ TEST(FfrBody2d, AttachmentPointsResolvedAtFinalize) {
     }
   }
   EXPECT_EQ(resolvedNodes, 2);  // the rod's two ends (crank pin and slider pin)
+}
+
+// The outputs' augmented matrix [M G^T; G 0] is assembled sparsely through the bodies'
+// sinks (issue 13): equal to the dense blocks to round-off of the sums (1e-14 relative:
+// the same products, summed in another order), with only the structural non-zeros stored.
+TEST(FfrBody2d, SparseAugmentedMatrixEqualsTheDenseBlocks) {
+  const Scene scene = testmodels::elasticSliderCrank(16, 1.0, 0, 0.1, 1e-6, 1e-6);
+  const System& sys = scene.system;
+  const VecX q = sys.initialCoordinates();
+  const int n = sys.numVelocities(), m = sys.numConstraintEquations();
+  MatX G;
+  evaluateConstraints(sys, q, 0.0, nullptr, &G);
+  MatX dense = MatX::Zero(n + m, n + m);
+  dense.topLeftCorner(n, n) = massMatrix(sys, q);
+  dense.topRightCorner(n, m) = G.transpose();
+  dense.bottomLeftCorner(m, n) = G;
+  const SpMat A = augmentedMatrix(sys, q);
+  EXPECT_LE((MatX(A) - dense).cwiseAbs().maxCoeff(), 1e-14 * dense.cwiseAbs().maxCoeff());
+  EXPECT_LT(A.nonZeros(), (n + m) * (n + m) / 4);  // banded beam blocks: far from dense
 }
 
 }  // namespace

@@ -629,11 +629,12 @@ TEST_P(DaeJacobian, SparseSinkEqualsDenseSinkAndStaysInPattern) {
     const std::string at = toString(GetParam()) + ", sample " + std::to_string(s);
 
     // every entry the assembly writes at this state is in the pattern
-    std::vector<std::pair<int, int>> written;
+    std::vector<Eigen::Triplet<double>> written;
     JacobianSink recorder = JacobianSink::recorder(&written);
     dae.jacobian(t, y.data(), yp.data(), cj, recorder);
     EXPECT_FALSE(written.empty());
-    for (const auto& [r, c] : written) {
+    for (const auto& e : written) {
+      const int r = e.row(), c = e.col();
       EXPECT_GE(P.find(r, c), 0) << at << ": entry (" << r << ", " << c << ") not in the pattern";
     }
 
