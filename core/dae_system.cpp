@@ -1,5 +1,6 @@
 #include "core/dae_system.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -19,11 +20,50 @@ double columnDot(const MatX& G, int k, const double* x) {
   return s;
 }
 
-/// J(rowOffset + rows[i], colOffset + cols[j]) += B(i, j)
-void addBlock(JacobianSink& J, int rowOffset, const std::vector<int>& rows, int colOffset,
-              const std::vector<int>& cols, const MatX& B) {
-  for (size_t j = 0; j < cols.size(); ++j) {
-    for (size_t i = 0; i < rows.size(); ++i) J.add(rowOffset + rows[i], colOffset + cols[j], B(i, j));
+/// Global indices of a constraint's or force's columns in ascending order, with where
+/// each comes from: the rows of its blocks, written by one merge walk per column
+/// (a constraint's columns are ascending within a body, not across its bodies).
+struct SortedIndex {
+  std::vector<int> sorted;  ///< ascending
+  std::vector<int> from;    ///< sorted[i] = idx[from[i]]
+  explicit SortedIndex(const std::vector<int>& idx = {}) : sorted(idx.size()), from(idx.size()) {
+    for (size_t i = 0; i < idx.size(); ++i) from[i] = static_cast<int>(i);
+    std::sort(from.begin(), from.end(), [&](int a, int b) { return idx[a] < idx[b]; });
+    for (size_t i = 0; i < idx.size(); ++i) sorted[i] = idx[from[i]];
+  }
+  int size() const { return static_cast<int>(sorted.size()); }
+};
+
+/// J(rowOffset + rows[i], colOffset + cols[j]) += s B(i, j) (rows: the sorted rows), one
+/// merge walk per column; `buf` holds a column (rows.size()).
+template <class ColumnOf>
+void addBlockColumns(JacobianSink& J, int rowOffset, const SortedIndex& rows, ColumnOf&& columnOf, const MatX& B,
+                     VecX& buf, double s) {
+  const int n = rows.size();
+  for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    const double* b = B.data() + j * B.rows();
+    for (int i = 0; i < n; ++i) buf[i] = b[rows.from[i]];
+    J.addColumn(columnOf(static_cast<int>(j)), rowOffset, rows.sorted.data(), buf.data(), n, s);
+  }
+}
+void addBlock(JacobianSink& J, int rowOffset, const SortedIndex& rows, int colOffset, const std::vector<int>& cols,
+              const MatX& B, VecX& buf, double s = 1.0) {
+  addBlockColumns(J, rowOffset, rows, [&](int j) { return colOffset + cols[j]; }, B, buf, s);
+}
+/// The same with the columns col0, col0 + 1, ... (multiplier columns).
+void addBlock(JacobianSink& J, int rowOffset, const SortedIndex& rows, int col0, const MatX& B, VecX& buf,
+              double s = 1.0) {
+  addBlockColumns(J, rowOffset, rows, [&](int j) { return col0 + j; }, B, buf, s);
+}
+
+/// J(rowOffset + rows[i], col0 + a) += s B(a, i) for the rows a of B (m x rows): the
+/// transpose of a row block (G^T), one merge walk per column.
+void addTransposedBlock(JacobianSink& J, int rowOffset, const SortedIndex& rows, int col0, const MatX& B, VecX& buf,
+                        double s = 1.0) {
+  const int n = rows.size();
+  for (Eigen::Index a = 0; a < B.rows(); ++a) {
+    for (int i = 0; i < n; ++i) buf[i] = B(a, rows.from[i]);
+    J.addColumn(col0 + static_cast<int>(a), rowOffset, rows.sorted.data(), buf.data(), n, s);
   }
 }
 
@@ -43,6 +83,8 @@ struct ConstraintScratch {
   VecX vl, al, Hv, wl, wlMinus;          ///< local velocities, accelerations, H_a w, (T v) local (and at q - h e_k)
   MatX Hx, vH, dFdq, dFdv;               ///< sum_a x_a H_a, rows v^T H_a, index-1 d/dq and d/dv
   MatX Tl, Til, THx, TGt, TDG;           ///< T and T+ over the local columns (T != I only), products
+  SortedIndex vRows, qRows;              ///< the local velocity / coordinate columns, ascending
+  VecX column;                           ///< one column of a block being written
 };
 
 /// Working memory of one force element.
@@ -50,6 +92,8 @@ struct ForceScratch {
   KinematicsWork work;
   VecX vl, Q;
   MatX dQdq, dQdv;
+  SortedIndex vRows;  ///< the local velocity columns, ascending
+  VecX column;
 };
 
 /// DaeSystem's scratch: one per integrator, so that evaluations allocate nothing.
@@ -221,6 +265,9 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     cs.Hx.resize(nl, nql);
     cs.vH.resize(me, nql);
     cs.dFdq.resize(me, nql);
+    cs.vRows = SortedIndex(sys.constraintColumns(ci));
+    cs.qRows = SortedIndex(sys.constraintCoordinateColumns(ci));
+    cs.column.resize(std::max(nl, nql));
   }
   s->forces.resize(sys.numForces());
   for (int f = 0; f < sys.numForces(); ++f) {
@@ -231,6 +278,8 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     fs.Q.resize(nl);
     fs.dQdq.resize(nl, nql);
     fs.dQdv.resize(nl, nl);
+    fs.vRows = SortedIndex(sys.forceColumns(ForceIndex(f)));
+    fs.column.resize(nl);
   }
   s->qPlus.resize(sys.numCoordinates());
   s->qMinus.resize(sys.numCoordinates());
@@ -409,9 +458,7 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
       body.coordinateRateMatrix(qb, S.T[b]);
       body.coordinateRateInverse(qb, S.Tinv[b]);
       const MatX& T = S.T[b];
-      for (int j = 0; j < nvb; ++j) {
-        for (int i = 0; i < nqb; ++i) J.add(L.q + qoff + i, L.v + voff + j, -T(i, j));
-      }
+      for (int j = 0; j < nvb; ++j) J.addColumn(L.v + voff + j, L.q + qoff, nullptr, T.col(j).data(), nqb, -1.0);
     }
     // each body writes its structural non-zeros only (sparse for large flexible bodies)
     const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);
@@ -431,10 +478,8 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
     fs.dQdq.setZero();
     fs.dQdv.setZero();
     sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, &fs.dQdq, &fs.dQdv, fs.work);
-    fs.dQdq *= -1.0;
-    fs.dQdv *= -1.0;
-    addBlock(J, L.v, cols, L.q, qcols, fs.dQdq);
-    addBlock(J, L.v, cols, L.v, cols, fs.dQdv);
+    addBlock(J, L.v, fs.vRows, L.q, qcols, fs.dQdq, fs.column, -1.0);
+    addBlock(J, L.v, fs.vRows, L.v, cols, fs.dQdv, fs.column, -1.0);
   }
   if (!identityT) {
     S.DGtmu.setZero();
@@ -455,10 +500,8 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
     // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
     cs.Hx.setZero();
     for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];
-    addBlock(J, L.v, cols, L.q, qcols, cs.Hx);
-    for (int a = 0; a < me; ++a) {
-      for (int k = 0; k < nl; ++k) J.add(L.v + cols[k], L.lambda + row + a, ev.G(a, k));
-    }
+    addBlock(J, L.v, cs.vRows, L.q, qcols, cs.Hx, cs.column);
+    addTransposedBlock(J, L.v, cs.vRows, L.lambda + row, ev.G, cs.column);
     for (int a = 0; a < me; ++a) cs.vH.row(a).noalias() = cs.vl.transpose() * ev.H[a];  // d(G v)/dq
     switch (formulation_) {
       case Formulation::Ggl: {
@@ -466,12 +509,11 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
         cs.Hx.setZero();
         for (int a = 0; a < me; ++a) cs.Hx += y[L.mu + row + a] * ev.H[a];
         if (identityT) {
-          for (int j = 0; j < nl; ++j) {
-            for (int i = 0; i < nl; ++i) J.add(L.q + cols[i], L.q + cols[j], metric_[cols[i]] * cs.Hx(i, j));
-          }
-          for (int a = 0; a < me; ++a) {
-            for (int k = 0; k < nl; ++k) J.add(L.q + cols[k], L.mu + row + a, metric_[cols[k]] * ev.G(a, k));
-          }
+          for (int k = 0; k < nl; ++k) cs.Hx.row(k) *= metric_[cols[k]];  // D sum_a mu_a H_a
+          addBlock(J, L.q, cs.vRows, L.q, cols, cs.Hx, cs.column);
+          cs.TGt.resize(nl, me);  // (D G^T)
+          for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
+          addBlock(J, L.q, cs.vRows, L.mu + row, cs.TGt, cs.column);
           addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
         } else {
           const double* mu = y + L.mu + row;
@@ -480,13 +522,11 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
             S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
           }
           cs.THx.noalias() = cs.Tl * cs.Hx;
-          addBlock(J, L.q, qcols, L.q, qcols, cs.THx);
+          addBlock(J, L.q, cs.qRows, L.q, qcols, cs.THx, cs.column);
           cs.TGt.resize(nl, me);
           for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
           cs.TDG.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
-          for (int a = 0; a < me; ++a) {
-            for (int k = 0; k < nql; ++k) J.add(L.q + qcols[k], L.mu + row + a, cs.TDG(k, a));
-          }
+          addBlock(J, L.q, cs.qRows, L.mu + row, cs.TDG, cs.column);
           // F_g = h - f: dh/dq = G T+
           cs.dFdq.noalias() = ev.G * cs.Til;
           addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
