@@ -12,13 +12,15 @@ class MatrixSink {
  public:
   /// Into a dense matrix: M(i, j) += scale * value (implicit, so MatX arguments work).
   MatrixSink(MatX& M, double scale = 1.0) : dense_(&M), scale_(scale) {}
+  /// Into a dense matrix at an offset: M(row0 + i, col0 + j) += scale * value.
+  MatrixSink(MatX& M, int row0, int col0, double scale = 1.0) : dense_(&M), row0_(row0), col0_(col0), scale_(scale) {}
   /// Into the DAE Jacobian: J(row0 + i, col0 + j) += scale * value.
   MatrixSink(JacobianSink& J, int row0, int col0, double scale = 1.0)
       : jacobian_(&J), row0_(row0), col0_(col0), scale_(scale) {}
 
   void add(int i, int j, double value) const {
     if (dense_) {
-      (*dense_)(i, j) += scale_ * value;
+      (*dense_)(row0_ + i, col0_ + j) += scale_ * value;
     } else {
       jacobian_->add(row0_ + i, col0_ + j, scale_ * value);
     }
@@ -31,7 +33,7 @@ class MatrixSink {
     for (Eigen::Index j = 0; j < b.cols(); ++j) {
       const int rows = static_cast<int>(b.rows());
       if (dense_) {
-        dense_->block(i0, j0 + j, rows, 1) += scale_ * b.col(j);
+        dense_->block(row0_ + i0, col0_ + j0 + j, rows, 1) += scale_ * b.col(j);
       } else {
         jacobian_->addColumn(col0_ + j0 + static_cast<int>(j), row0_ + i0, nullptr, b.col(j).data(), rows, scale_);
       }
@@ -42,7 +44,7 @@ class MatrixSink {
   template <class Fn>
   void addColumn(int i0, int j, int n, Fn&& value) const {
     if (dense_) {
-      for (int k = 0; k < n; ++k) (*dense_)(i0 + k, j) += scale_ * value(k);
+      for (int k = 0; k < n; ++k) (*dense_)(row0_ + i0 + k, col0_ + j) += scale_ * value(k);
     } else {
       jacobian_->addColumnSegment(col0_ + j, row0_ + i0, n, value, scale_);
     }

@@ -71,17 +71,21 @@ VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, 
   return out;
 }
 
-SpMat augmentedMatrix(const System& sys, const VecX& q) {
-  const int n = sys.numVelocities(), m = sys.numConstraintEquations();
-  std::vector<Eigen::Triplet<double>> entries;
-  JacobianSink sink = JacobianSink::recorder(&entries);
+namespace {
+
+/// [M G^T; G 0] at q through `sinkAt(row0, col0)` (a MatrixSink at that offset): each body
+/// writes its mass matrix's structural non-zeros, each constraint its G block.
+template <class SinkAt>
+void addAugmentedMatrix(const System& sys, const VecX& q, SinkAt&& sinkAt) {
+  const int n = sys.numVelocities();
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
     const Body& body = sys.body(bi);
     if (body.numCoordinates() == 0) continue;
     const int voff = sys.velocityOffset(bi);
-    body.addMassMatrix(q.segment(sys.coordinateOffset(bi), body.numCoordinates()), MatrixSink(sink, voff, voff));
+    body.addMassMatrix(q.segment(sys.coordinateOffset(bi), body.numCoordinates()), sinkAt(voff, voff));
   }
+  const MatrixSink A = sinkAt(0, 0);
   forEachConstraint(sys, q, 0.0, false, [&](ConstraintIndex ci, const Constraint& con, const ConstraintEvaluation& ev,
                                             const VecX&, const VecX&, const VecX&) {
     const auto& cols = sys.constraintColumns(ci);
@@ -90,13 +94,29 @@ SpMat augmentedMatrix(const System& sys, const VecX& q) {
       for (int a = 0; a < con.numEquations(); ++a) {
         const double g = ev.G(a, static_cast<Eigen::Index>(k));
         if (g == 0.0) continue;
-        entries.emplace_back(row + a, cols[k], g);
-        entries.emplace_back(cols[k], row + a, g);
+        A.add(row + a, cols[k], g);
+        A.add(cols[k], row + a, g);
       }
     }
   });
-  SpMat A(n + m, n + m);
+}
+
+}  // namespace
+
+SpMat augmentedMatrix(const System& sys, const VecX& q) {
+  const int size = sys.numVelocities() + sys.numConstraintEquations();
+  std::vector<Eigen::Triplet<double>> entries;
+  JacobianSink sink = JacobianSink::recorder(&entries);
+  addAugmentedMatrix(sys, q, [&](int r, int c) { return MatrixSink(sink, r, c); });
+  SpMat A(size, size);
   A.setFromTriplets(entries.begin(), entries.end());  // duplicates summed
+  return A;
+}
+
+MatX denseAugmentedMatrix(const System& sys, const VecX& q) {
+  const int size = sys.numVelocities() + sys.numConstraintEquations();
+  MatX A = MatX::Zero(size, size);
+  addAugmentedMatrix(sys, q, [&](int r, int c) { return MatrixSink(A, r, c); });
   return A;
 }
 

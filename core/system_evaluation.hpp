@@ -20,6 +20,8 @@ VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, 
 /// mass matrix's structural non-zeros through a sink, as in the DAE Jacobian, and each
 /// constraint its G block; no dense array (outputs of large flexible models).
 SpMat augmentedMatrix(const System& sys, const VecX& q);
+/// The same, dense, from the same component loops (small systems: cheaper than triplets).
+MatX denseAugmentedMatrix(const System& sys, const VecX& q);
 /// Block-diagonal mass matrix (nv x nv, dense; small systems and tests).
 MatX massMatrix(const System& sys, const VecX& q);
 /// All generalised forces except constraint forces: internal, gravity, force elements.

@@ -33,28 +33,47 @@ void throwIfRedundant(const System& sys, const MatX& G) {
 
 }  // namespace
 
-void solveAugmented(const SpMat& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
-  const int size = static_cast<int>(A.rows()), m = size - n;
-  VecX rhs(size), sol;
-  rhs << r1, r2;
+namespace {
+
+[[noreturn]] void throwSingular() {
   // The cause is named by the callers, from what they measured (computeAccelerations).
-  const char* singular = "the augmented system [M G^T; G 0] is singular";
-  if (size <= kDenseAugmentedLimit) {  // small: a rank-revealing dense LU
-    const Eigen::FullPivLU<MatX> lu{MatX(A)};
-    if (!lu.isInvertible()) throw ModelError(singular);
-    sol = lu.solve(rhs);
-  } else {
-    Eigen::SparseLU<SpMat> lu(A);
-    if (lu.info() != Eigen::Success) throw ModelError(singular);
-    sol = lu.solve(rhs);
-  }
-  if (!sol.allFinite()) throw ModelError(singular);
+  throw ModelError("the augmented system [M G^T; G 0] is singular");
+}
+
+void split(const VecX& sol, int n, VecX& x, VecX& y) {
+  if (!sol.allFinite()) throwSingular();
   x = sol.head(n);
-  y = sol.tail(m);
+  y = sol.tail(sol.size() - n);
+}
+
+}  // namespace
+
+void solveAugmented(const MatX& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
+  VecX rhs(A.rows());
+  rhs << r1, r2;
+  const Eigen::FullPivLU<MatX> lu(A);  // rank-revealing
+  if (!lu.isInvertible()) throwSingular();
+  split(lu.solve(rhs), n, x, y);
+}
+
+void solveAugmented(const SpMat& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
+  if (A.rows() <= kDenseAugmentedLimit) return solveAugmented(MatX(A), n, r1, r2, x, y);
+  VecX rhs(A.rows());
+  rhs << r1, r2;
+  Eigen::SparseLU<SpMat> lu(A);
+  if (lu.info() != Eigen::Success) throwSingular();
+  split(lu.solve(rhs), n, x, y);
 }
 
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y) {
   const int n = static_cast<int>(M.rows()), m = static_cast<int>(G.rows());
+  if (n + m <= kDenseAugmentedLimit) {
+    MatX A = MatX::Zero(n + m, n + m);
+    A.topLeftCorner(n, n) = M;
+    A.topRightCorner(n, m) = G.transpose();
+    A.bottomLeftCorner(m, n) = G;
+    return solveAugmented(A, n, r1, r2, x, y);
+  }
   std::vector<Eigen::Triplet<double>> t;
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
@@ -98,7 +117,13 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
                           VecX& lambda) {
   const VecX Q = generalizedForces(sys, t, q, v), rhs = accelerationConstraintRhs(sys, q, v, t);
   try {
-    solveAugmented(augmentedMatrix(sys, q), sys.numVelocities(), Q, rhs, a, lambda);
+    // the same component loops into a dense array for small systems, sparse triplets above
+    const int n = sys.numVelocities();
+    if (n + sys.numConstraintEquations() <= kDenseAugmentedLimit) {
+      solveAugmented(denseAugmentedMatrix(sys, q), n, Q, rhs, a, lambda);
+    } else {
+      solveAugmented(augmentedMatrix(sys, q), n, Q, rhs, a, lambda);
+    }
   } catch (const ModelError& e) {
     // singular: the dense arrays for the diagnosis (rank of G) and the projection
     MatX G;

@@ -25,6 +25,8 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
 /// velocities): dense rank-revealing LU up to 200 unknowns, sparse LU above.
 /// @throws ModelError if it is singular.
 void solveAugmented(const SpMat& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
+/// The same from a dense augmented matrix (rank-revealing LU).
+void solveAugmented(const MatX& A, int n, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
 /// The same from dense M (n x n) and G (m x n).
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
 
