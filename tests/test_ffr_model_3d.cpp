@@ -30,6 +30,7 @@
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_invariants_3d.hpp"
 #include "core/errors.hpp"
+#include "elements/beam_element_2d.hpp"
 #include "elements/beam_element_3d.hpp"
 #include "tests/test_support.hpp"
 
@@ -549,7 +550,8 @@ TEST(FfrBeamModel3d, MeshInAPlaneReproducesThePlanarModel) {
   // A bent frame in the x-y plane (three members), clamped at node 0, each element's y
   // hint the +90 degree rotation of its axis in the plane (element z = body z). The
   // planar coordinates (ux, uy, psi) of each node are the 3D (ux, uy, thz): mass, S-bar
-  // rows x, y, m_ff (S_xx + S_yy + S_zz, with S_zz = 0 there), S~ = S_xy - S_yx, K_ff,
+  // rows x, y, m_ff (S_xx + S_yy + S_zz, with S_zz = 0 there), S_xx, S_yy, S_xy (from the
+  // planar elements), S~ = S_xy - S_yx, K_ff,
   // D_ff, I1 and J0 agree to round-off. The second moment differs by the section term:
   // J_xx + J_yy = I0 (planar, centre line) + rho Iz L (the section's depth in the plane).
   const std::vector<Vec2> nodes2 = {Vec2(0.1, -0.2), Vec2(0.4, 0.1), Vec2(0.7, 0.4), Vec2(0.9, 0.0), Vec2(1.1, -0.4),
@@ -616,6 +618,34 @@ TEST(FfrBeamModel3d, MeshInAPlaneReproducesThePlanarModel) {
   worst = std::max(worst, expectMatrixNear(block(MatX(i3.sKL[0][1] - i3.sKL[1][0])), MatX(i2.sTilde), kQuadTol,
                                            "S_xy - S_yx block", MatX(i2.mff).cwiseAbs().maxCoeff()));
   EXPECT_LE(block(MatX(i3.sKL[2][2])).cwiseAbs().maxCoeff(), 1e-14 * MatX(i2.mff).cwiseAbs().maxCoeff()) << "S_zz";
+  // S_xx, S_yy, S_xy one by one: the planar model keeps only their sums, so they are
+  // rebuilt from its elements, S_kl = B2^T sum T^T (sum_ab R_ka R_lb S_ab) T B2, with
+  // the planar elements' element-frame S_xx, S_yy, S_xy (S_yx = S_xy^T).
+  std::array<std::array<MatX, 2>, 2> s2kl;
+  for (int k = 0; k < 2; ++k)
+    for (int l = 0; l < 2; ++l) s2kl[k][l] = MatX::Zero(B2.rows(), B2.rows());
+  for (size_t e = 0; e < p.elements().size(); ++e) {
+    const BeamElement2d& el = p.elements()[e];
+    const Mat2 R = rotation(el.angle());
+    const BeamElement2d::Mat6 Se[2][2] = {{el.sXX(), el.sXY()}, {el.sXY().transpose(), el.sYY()}};
+    const int nodes[2] = {m2.elements[e].node1, m2.elements[e].node2};
+    for (int k = 0; k < 2; ++k)
+      for (int l = 0; l < 2; ++l) {
+        BeamElement2d::Mat6 acc = BeamElement2d::Mat6::Zero();
+        for (int a = 0; a < 2; ++a)
+          for (int b = 0; b < 2; ++b) acc += R(k, a) * R(l, b) * Se[a][b];
+        acc = el.transformation().transpose() * acc * el.transformation();
+        for (int i = 0; i < 6; ++i)
+          for (int j = 0; j < 6; ++j) s2kl[k][l](3 * nodes[i / 3] + i % 3, 3 * nodes[j / 3] + j % 3) += acc(i, j);
+      }
+  }
+  const double mScale = MatX(i2.mff).cwiseAbs().maxCoeff();
+  for (int k = 0; k < 2; ++k)
+    for (int l = 0; l < 2; ++l) {
+      const MatX ref = B2.transpose() * s2kl[k][l] * B2;
+      worst = std::max(worst, expectMatrixNear(block(MatX(i3.sKL[k][l])), ref, kQuadTol,
+                                               "S_" + std::to_string(k) + std::to_string(l) + " block", mScale));
+    }
   worst = std::max(worst, expectRowsNear(block(MatX(i3.kff)), MatX(i2.kff), kQuadTol, "K_ff block"));
   worst = std::max(worst, expectRowsNear(block(MatX(i3.dff)), MatX(i2.dff), kQuadTol, "D_ff block"));
   // I1 = int rho N^T u0 = sum_k (row k of positionShape[k])^T, J0 = int rho N^T S u0 with
