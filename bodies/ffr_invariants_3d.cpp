@@ -129,6 +129,9 @@ void FfrInvariants3d::validate(const std::string& owner) const {
   for (size_t k = 0; k < points.size(); ++k) {
     requireSize(points[k].shape.cols() == n && points[k].rotationShape.cols() == n, owner,
                 "shape of point " + std::to_string(k), "3 x " + sz + " (shape and rotation shape)");
+    if (!points[k].position.allFinite() || !points[k].shape.allFinite() || !points[k].rotationShape.allFinite()) {
+      throw InputError(owner + ": invariant point " + std::to_string(k) + " has entries that are not finite");
+    }
   }
 }
 

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/dae_system.hpp"
@@ -21,6 +22,7 @@
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 #include "core/time_law.hpp"
+#include "ffr3d_test_models.hpp"
 #include "ffr_test_models.hpp"
 #include "io/scene.hpp"
 
@@ -234,6 +236,39 @@ TEST(Allocations, EverySpatialJointDriverAndForceType) {
   sys.setGravity(Vec3(0.0, 0.0, -9.81));
   sys.finalize();
   expectAllocationFree(sys, "every spatial component type");
+}
+
+TEST(Allocations, SpatialFlexibleBodyWithJointsAndForces) {
+  // A spatial FFR body (three bent beam elements, invariants from BeamElement3d) on a
+  // spherical joint at its clamped node, a rigid body on a revolute joint at its tip, a
+  // spring to its middle node and a bushing, with gravity and damping.
+  using namespace flexmbd::test3d;
+  const std::vector<Vec3> nodes = bentNodes();
+  BeamChain3d chain = makeBeamChain(nodes, rectangularSection3d(0.03, 0.018, 2.1e11, 8.1e10, 7850.0, 1e-4),
+                                    Vec3(1.0, -1.0, 0.3));
+  System sys;
+  FrameState3d s;
+  s.orientation = quaternionRotation(Vec4(0.9, 0.1, -0.2, 0.3));
+  const BodyIndex flex = sys.addBody(std::make_unique<FfrBody3d>("flex", chain.inv, s));
+  RigidBody3dProperties p;
+  p.mass = 0.5;
+  p.inertia = Vec3(0.01, 0.02, 0.025).asDiagonal();
+  FrameState3d sr;
+  sr.position = s.orientation * nodes[3] + Vec3(0.1, 0.0, 0.0);
+  const BodyIndex tip = sys.addBody(std::make_unique<RigidBody3d>("tip", p, sr));
+  JointFrame g0, f0, f3, t0;
+  g0.point = s.orientation * nodes[0];
+  f0.point = nodes[0];
+  f3.point = nodes[3];
+  t0.point = Vec3(-0.1, 0.0, 0.0);
+  sys.addConstraint(std::make_unique<SpatialJoint>("ball", SpatialJointType::Spherical, kGround, g0, flex, f0));
+  sys.addConstraint(std::make_unique<SpatialJoint>("hinge", SpatialJointType::Revolute, flex, f3, tip, t0));
+  sys.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), flex, nodes[2], 100.0, 2.0, 0.5));
+  sys.addForce(std::make_unique<SpatialBushing>("bushing", flex, f3, tip, t0, std::array<double, 6>{1, 2, 3, 4, 5, 6},
+                                                std::array<double, 6>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
+  sys.setGravity(Vec3(0.0, 0.0, -9.81));
+  sys.finalize();
+  expectAllocationFree(sys, "spatial flexible body");
 }
 
 }  // namespace

@@ -1,0 +1,123 @@
+// Spatial flexible body in the floating frame of reference formulation (issue 14).
+#pragma once
+
+#include <array>
+#include <string>
+
+#include "bodies/ffr_invariants_3d.hpp"
+#include "bodies/rigid_body_3d.hpp"
+#include "core/body.hpp"
+
+namespace flexmbd {
+
+/// Coordinates q = (R (3), p (4), q_f (nf)): frame origin (world), Euler parameters of the
+/// frame, elastic coordinates. Velocities v = (R' (3, world axes), w (3, body axes), q_f').
+/// A material point at u = u0 + N q_f (body axes) is at r = R + A(p) u and moves with
+/// r' = R' - A u~ w + A N q_f'.
+///
+/// Choice: R' in WORLD axes, as RigidBody3d. Then the translational rows of a point's
+/// Jacobian are the identity, gravity is m g, and T = diag(I, 1/2 L(p)^T, I) as for the
+/// rigid body; the price is that the R-w and R-f mass blocks carry A(p) (Shabana ch. 5:
+/// m_RR = m I, m_Rtheta = -A s~, m_Rf = A S-bar), so the mass matrix depends on p. Body-axis
+/// R' would make M independent of p but put A into every point Jacobian and into gravity.
+///
+/// Mass matrix (docs/spatial-flexible.md, "Spatial FFR body"; Shabana ch. 5):
+///   M = [ m I    -A s~        A S-bar  ]   s = int rho u dV = first moment + S-bar q_f
+///       [        I(q_f)       Y(q_f)   ]   I = int rho u~^T u~ dV = tr(J) 1 - J, J = int rho u u^T dV
+///       [ sym.                m_ff     ]   Y = int rho u~ N dV
+/// Quadratic velocity forces, elastic K_ff q_f and damping D_ff q_f' are in
+/// addInternalForces. The length of p is a gauge, as for RigidBody3d.
+///
+/// Nodes: a node's section frame is A_node = A (I + skew(Ntheta q_f)), first order in the
+/// small nodal rotations theta = Ntheta q_f like the linear element (not exactly
+/// orthonormal: the error is O(|theta|^2)); its world angular velocity is taken as
+/// A (w + Ntheta q_f'), which equals that of A_node up to O(|theta| |theta'|).
+class FfrBody3d final : public Body {
+ public:
+  /// @param initial frame ORIGIN (not the centre of mass), orientation, origin velocity
+  ///        (world) and angular velocity (body axes).
+  /// @param qf0, qf0dot initial elastic coordinates and rates (empty: zero).
+  /// @throws InputError naming the body if the invariants' sizes are inconsistent, an
+  ///         entry is not finite, S_lk != S_kl^T, the mass is not positive, or the initial
+  ///         state is invalid.
+  FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameState3d& initial, VecX qf0 = {},
+            VecX qf0dot = {});
+
+  const FfrInvariants3d& invariants() const { return inv_; }
+  int numElastic() const { return nf_; }
+
+  int numCoordinates() const override { return 7 + nf_; }
+  int numVelocities() const override { return 6 + nf_; }
+  int numFrameCoordinates() const override { return 7; }
+  int numFrameVelocities() const override { return 6; }
+  std::vector<std::string> coordinateNames() const override;
+  std::vector<std::string> velocityNames() const override;
+  std::vector<CoordinateKind> coordinateKinds() const override;
+  std::vector<CoordinateKind> velocityKinds() const override;
+  VecX initialCoordinates() const override;
+  VecX initialVelocities() const override;
+  double mass() const override { return inv_.mass; }
+
+  bool velocitiesAreCoordinateRates() const override { return false; }
+  void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const override;
+  void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const override;
+  void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const override;
+  void addCoordinateRateJacobian(const ConstVecRef& q, const ConstVecRef& w, const MatrixSink& K) const override;
+  void applyIncrement(const ConstVecRef& q, const ConstVecRef& dv, Eigen::Ref<VecX> out) const override;
+  std::vector<int> coordinatesOfVelocities(const std::vector<int>& vcols) const override;
+
+  void addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const override;
+  void addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::Ref<VecX> out) const override;
+  void addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef& a, const MatrixSink& K) const override;
+  void addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const override;
+  void addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
+                                 const MatrixSink& dQdv) const override;
+  void addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) const override;
+  void addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const override;
+  double gravityPotential(const ConstVecRef& q, const Vec3& g) const override;
+  double internalPotential(const ConstVecRef& q) const override;
+  bool isDissipative() const override;
+
+  using Body::pointKinematics;
+  /// @throws InputError: a spatial body has no planar point kinematics.
+  void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,
+                       bool withHessians, PointKinematics& out) const override;
+  /// The index of the node at `point` in invariants().points (1e-9 relative tolerance).
+  int resolvePoint(const Vec3& point, const std::string& user) const override;
+  /// Frame velocities 0..5 and 6 + the elastic coordinates the node's N and Ntheta use.
+  std::vector<int> pointSupport(const Vec3& point, int pointId) const override;
+  using Body::frameKinematics;
+  void frameKinematics(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
+                       const std::vector<int>* qcols, FrameKinematics& out) const override;
+  void addFrameCurvature(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
+                         const std::vector<int>* qcols, const Vec3& wr, const Vec3& ww,
+                         Eigen::Ref<MatX> out) const override;
+  Vec3 centreOfMass(const ConstVecRef& q) const override;
+
+  // ----- helpers for outputs and tests (own coordinates q) --------------------------
+  /// A(p / |p|).
+  static Mat3 rotationOf(const ConstVecRef& q) { return quaternionRotation(q.segment<4>(3)); }
+  /// int rho u dV (body axes).
+  Vec3 firstMomentAt(const ConstVecRef& q) const;
+  /// I(q_f) = int rho u~^T u~ dV about the frame origin, body axes.
+  Mat3 inertiaAt(const ConstVecRef& q) const;
+
+ private:
+  const FfrPoint3d& node(const Vec3& point, int pointId) const;
+  /// J(q_f) = int rho u u^T dV.
+  Mat3 secondMomentAt(const ConstVecRef& qf) const;
+  /// dJ/dq_f,k.
+  Mat3 secondMomentDerivative(const ConstVecRef& qf, int k) const;
+  /// Column k of Y(q_f) = int rho u~ N dV.
+  Vec3 skewShapeColumn(const ConstVecRef& qf, int k) const;
+
+  FfrInvariants3d inv_;
+  int nf_ = 0;
+  FrameState3d initial_;
+  VecX qf0_, qf0dot_;
+  Mat3X x0_;                 // int rho u0~ N dV (3 x nf), constant
+  std::array<SpMat, 3> w_;   // W_x = S_yz - S_zy, W_y = S_zx - S_xz, W_z = S_xy - S_yx (skew):
+                             // int rho (N a) x (N b) dV = (a^T W_i b)_i
+};
+
+}  // namespace flexmbd
