@@ -453,6 +453,21 @@ double FfrBody3d::internalPotential(const ConstVecRef& q) const {
   return model_ ? model_->strainEnergy(VecX(qf)) : 0.5 * bilinear(inv_.kff, qf, qf);
 }
 
+FfrBody3d::BeamDeflection FfrBody3d::beamDeflection(const ConstVecRef& q, int element, double xi) const {
+  if (!model_) {
+    throw InputError("body '" + name() + "': not made from a beam mesh; its deflection and section forces are unknown");
+  }
+  const VecX qf = q.tail(nf_);
+  const FfrPoint3d p = model_->materialPoint(element, xi);
+  BeamDeflection d;
+  d.displacement = p.shape * qf;
+  const Mat3 A = rotationOf(q);
+  d.position = q.head<3>() + A * (p.position + d.displacement);  // r = R + A (u0 + N q_f)
+  d.worldDisplacement = A * d.displacement;
+  d.sectionForces = model_->sectionForces(qf, element, xi);
+  return d;
+}
+
 Vec3 FfrBody3d::centreOfMass(const ConstVecRef& q) const {
   return q.head<3>() + rotationOf(q) * firstMomentAt(q) / inv_.mass;
 }

@@ -106,6 +106,17 @@ class FfrBody3d final : public Body {
   Vec3 centreOfMass(const ConstVecRef& q) const override;
 
   // ----- helpers for outputs and tests (own coordinates q) --------------------------
+  /// The deformation at a point of the generating beam mesh's axis.
+  struct BeamDeflection {
+    Vec3 displacement = Vec3::Zero();       ///< elastic displacement u = N q_f, body axes
+    Vec3 position = Vec3::Zero();           ///< deformed position, world axes: R + A (u0 + u)
+    Vec3 worldDisplacement = Vec3::Zero();  ///< A u
+    BeamSectionForces3d sectionForces;      ///< element axes (BeamElement3d)
+  };
+  /// At `xi` in [0, 1] along element `element` of model() (FfrBeamModel3d::locate finds
+  /// them for a point of the undeformed axis).
+  /// @throws InputError naming the body if it was not made from a beam mesh.
+  BeamDeflection beamDeflection(const ConstVecRef& q, int element, double xi) const;
   /// A(p / |p|).
   static Mat3 rotationOf(const ConstVecRef& q) { return quaternionRotation(q.segment<4>(3)); }
   /// int rho u dV (body axes).

@@ -25,15 +25,17 @@ struct OutputRequest {
   std::string bodyName;        ///< Point: the body the point belongs to
   BodyIndex body;              ///< Point: index of that body in the System
   Vec2 point = Vec2::Zero();   ///< Point, Deflection: body-frame coordinates of the point
-  bool spatial = false;        ///< Point in a spatial scene: point3, columns x, y, z, vx, vy, vz
-  Vec3 point3 = Vec3::Zero();  ///< Point (spatial): body-frame coordinates
+  bool spatial = false;        ///< Point or Deflection in a spatial scene (point3)
+  Vec3 point3 = Vec3::Zero();  ///< Point, Deflection (spatial): body-frame coordinates
   int pointId = Body::kAnyPoint;  ///< Point: the body's identifier of the point (Body::resolvePoint)
   int element = 0;             ///< Deflection: element of the beam mesh holding the point
   double xi = 0.0;             ///< Deflection: its local coordinate in [0, 1]
 
   /// Point: "<name>.x", "<name>.y", "<name>.vx", "<name>.vy";
   /// Deflection: "<name>.ux", "<name>.uy" (elastic displacement in the body frame),
-  /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there);
+  /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there); spatial:
+  /// "<name>.x", ".y", ".z", ".vx", ".vy", ".vz" and "<name>.ux", ".uy", ".uz", ".N", ".Qy",
+  /// ".Qz", ".Mx", ".My", ".Mz" (section forces and moments in element axes);
   /// Energy: "energy.kinetic", "energy.potential", "energy.total".
   std::vector<std::string> columnNames() const;
   /// Values matching columnNames() at global coordinates q and velocities v (size nq).

@@ -1,0 +1,16 @@
+// Reader of the beam-model keys that planar and spatial flexible bodies share
+// (docs/scene-format.md): "reference" (conditions B2), "modes" (modal reduction) and
+// "geometric_stiffening". Called by io/scene.cpp and io/spatial_scene.cpp.
+#pragma once
+
+#include "io/json_reader.hpp"
+
+namespace flexmbd::scenereaders {
+
+/// Fills options.reference, .modes / .modeSet and .geometricStiffening from the body
+/// object `r` (a mesh of `numNodes` nodes); FfrBeamOptions or FfrBeamOptions3d.
+/// @throws InputError naming the key.
+template <class Options>
+void readBeamModelOptions(const jsonread::ObjectReader& r, int numNodes, Options& options);
+
+}  // namespace flexmbd::scenereaders
