@@ -367,75 +367,6 @@ void parseForce(const json& j, const std::string& where, System& sys) {
   }
 }
 
-OutputRequest parseOutput(const json& j, const std::string& where, const System& sys,
-                          const std::vector<OutputRequest>& earlier, bool spatial) {
-  ObjectReader r(j, where);
-  r.peekName();
-  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
-  OutputRequest out;
-  if (type == "energy") {
-    r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
-    for (const auto& o : earlier) {
-      if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
-    }
-    out.type = OutputRequest::Type::Energy;
-    return out;
-  }
-  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
-  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
-  out.name = r.name("name");
-  // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
-  // "<joint>.fx" or with another output's columns.
-  if (out.name == "energy") r.fail("the name \"energy\" is reserved for the energy output columns");
-  for (int i = 0; i < sys.numBodies(); ++i) {
-    if (sys.body(BodyIndex(i)).name() == out.name) {
-      r.fail("name " + inQuotes(out.name) + " is already used by a body; give the output its own name");
-    }
-  }
-  for (int i = 0; i < sys.numConstraints(); ++i) {
-    if (sys.constraint(ConstraintIndex(i)).name() == out.name) {
-      r.fail("name " + inQuotes(out.name) + " is already used by a joint or driver; give the output its own name");
-    }
-  }
-  for (const auto& o : earlier) {
-    if (o.type != OutputRequest::Type::Energy && o.name == out.name) {
-      r.fail("duplicate output name " + inQuotes(out.name));
-    }
-  }
-  out.bodyName = r.name("body");
-  out.body = lookupBody(sys, out.bodyName, r);
-  if (spatial) {
-    out.spatial = true;
-    out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
-    if (out.type == OutputRequest::Type::Deflection) {
-      const auto* fb = dynamic_cast<const FfrBody3d*>(&sys.body(out.body));
-      if (!fb || !fb->model()) {
-        r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
-      }
-      if (!fb->model()->locate(out.point3, out.element, out.xi)) {
-        r.fail("point [" + fmt(out.point3.x()) + ", " + fmt(out.point3.y()) + ", " + fmt(out.point3.z()) +
-               "] is not on the axis of any element of body " + inQuotes(out.bodyName) + " (undeformed, body frame)");
-      }
-      return out;
-    }
-    located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
-    return out;
-  }
-  out.point = r.vec2("point", Vec2::Zero());
-  if (out.type == OutputRequest::Type::Deflection) {
-    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
-    if (!fb || !fb->beamModel()) {
-      r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
-    }
-    if (!fb->beamModel()->locate(out.point, out.element, out.xi)) {
-      r.fail("point [" + fmt(out.point.x()) + ", " + fmt(out.point.y()) + "] is not on the axis of any element of body " +
-             inQuotes(out.bodyName) + " (undeformed, body frame)");
-    }
-    return out;
-  }
-  located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(lift(out.point), "output " + inQuotes(out.name)); });
-  return out;
-}
 
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
@@ -549,6 +480,76 @@ class PathTracker {
 }  // namespace
 
 // ----- public API ------------------------------------------------------------------------------
+
+OutputRequest parseOutputRequest(const json& j, const std::string& where, const System& sys,
+                          const std::vector<OutputRequest>& earlier, bool spatial) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
+  OutputRequest out;
+  if (type == "energy") {
+    r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
+    for (const auto& o : earlier) {
+      if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
+    }
+    out.type = OutputRequest::Type::Energy;
+    return out;
+  }
+  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
+  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
+  out.name = r.name("name");
+  // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
+  // "<joint>.fx" or with another output's columns.
+  if (out.name == "energy") r.fail("the name \"energy\" is reserved for the energy output columns");
+  for (int i = 0; i < sys.numBodies(); ++i) {
+    if (sys.body(BodyIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a body; give the output its own name");
+    }
+  }
+  for (int i = 0; i < sys.numConstraints(); ++i) {
+    if (sys.constraint(ConstraintIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a joint or driver; give the output its own name");
+    }
+  }
+  for (const auto& o : earlier) {
+    if (o.type != OutputRequest::Type::Energy && o.name == out.name) {
+      r.fail("duplicate output name " + inQuotes(out.name));
+    }
+  }
+  out.bodyName = r.name("body");
+  out.body = lookupBody(sys, out.bodyName, r);
+  if (spatial) {
+    out.spatial = true;
+    out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
+    if (out.type == OutputRequest::Type::Deflection) {
+      const auto* fb = dynamic_cast<const FfrBody3d*>(&sys.body(out.body));
+      if (!fb || !fb->model()) {
+        r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
+      }
+      if (!fb->model()->locate(out.point3, out.element, out.xi)) {
+        r.fail("point [" + fmt(out.point3.x()) + ", " + fmt(out.point3.y()) + ", " + fmt(out.point3.z()) +
+               "] is not on the axis of any element of body " + inQuotes(out.bodyName) + " (undeformed, body frame)");
+      }
+      return out;
+    }
+    located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
+    return out;
+  }
+  out.point = r.vec2("point", Vec2::Zero());
+  if (out.type == OutputRequest::Type::Deflection) {
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
+    if (!fb || !fb->beamModel()) {
+      r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
+    }
+    if (!fb->beamModel()->locate(out.point, out.element, out.xi)) {
+      r.fail("point [" + fmt(out.point.x()) + ", " + fmt(out.point.y()) + "] is not on the axis of any element of body " +
+             inQuotes(out.bodyName) + " (undeformed, body frame)");
+    }
+    return out;
+  }
+  located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(lift(out.point), "output " + inQuotes(out.name)); });
+  return out;
+}
 
 std::vector<std::string> OutputRequest::columnNames() const {
   if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
@@ -667,7 +668,7 @@ Scene parseScene(const json& j) {
   const json& outputs = top.array("outputs");
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     scene.outputs.push_back(
-        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
+        parseOutputRequest(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
   }
 
   scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};

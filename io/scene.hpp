@@ -67,6 +67,13 @@ Scene parseSceneText(const std::string& text, const std::string& source = "<scen
 ///         `bodies[1] ("rod"): key "mass" must be > 0, got -1`) on any invalid input.
 Scene parseScene(const nlohmann::json& j);
 
+/// One output object of the scene format ("point", "deflection", "energy"; the keys of
+/// docs/scene-format.md, "Outputs") for `sys` (finalized or not); `earlier`: the outputs
+/// already requested (names must differ); `spatial`: a "dimension": 3 model.
+/// @throws InputError starting with `where`.
+OutputRequest parseOutputRequest(const nlohmann::json& j, const std::string& where, const System& sys,
+                                 const std::vector<OutputRequest>& earlier, bool spatial);
+
 /// Range checks of solver settings with the scene's key names (rtol > 0, t_end >
 /// t_start, ...), then SolverSettings::validate(). Used after command-line overrides.
 /// @throws InputError starting with "solver: ".
