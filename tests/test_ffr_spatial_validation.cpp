@@ -1,0 +1,289 @@
+// Validation of spatial flexible bodies (issue 14, C++ API): FfrBody3d from FfrBeamModel3d
+// in mechanisms.
+//  1. The planar elastic slider crank (examples/slider_crank_elastic.json: nodal 8
+//     elements and 2 modes) rebuilt in space in the x-y plane against the planar engine:
+//     the equations at the same states to round-off, and the runs at the example's solver
+//     settings (and tighter) to the integration error.
+//  2. A spatial slider crank with the crank axis inclined to the slider's line and a
+//     flexible connecting rod (spherical + universal joints): energy conserved with a free
+//     crank; with a driver, the driver's work equals the change of energy; with E x 1e3
+//     the rod's frame and the slider follow the rigid model (RigidBody3d rod).
+//  3. Geometric stiffening in space: a cantilever clamped to a hub spinning at Omega about
+//     an axis perpendicular to it; first flapwise and chordwise frequencies measured from
+//     the time response (zero crossings) against the Southwell relation and the
+//     linearisation of the body's own equations.
+// Longer variants (more spin speeds, E x 1e4): label slow, test_ffr_spatial_validation_slow.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bodies/ffr_beam_model_3d.hpp"
+#include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
+#include "bodies/rigid_body_3d.hpp"
+#include "core/system_evaluation.hpp"
+#include "integrators/initial_conditions.hpp"
+#include "integrators/simulation.hpp"
+#include "joints/spatial_drivers.hpp"
+#include "joints/spatial_joint.hpp"
+#include "tests/ffr3d_crank_models.hpp"
+#include "tests/ffr_test_models.hpp"
+
+using namespace flexmbd;
+using namespace flexmbd::test3d;
+
+namespace {
+
+Vec4 quaternionZ(double theta) { return Vec4(std::cos(theta / 2), 0.0, 0.0, std::sin(theta / 2)); }
+Mat3 rotY(double a) { return Eigen::AngleAxisd(a, Vec3::UnitY()).toRotationMatrix(); }
+Mat3 rotZ(double a) { return Eigen::AngleAxisd(a, Vec3::UnitZ()).toRotationMatrix(); }
+
+// =====================================================================================
+// 1. The planar elastic slider crank in space
+// =====================================================================================
+
+/// The map of the planar model's states (q, v, a) onto the spatial one's.
+struct PlanarToSpatial {
+  const Scene* planar = nullptr;
+  const ElasticCrank3d* spatial = nullptr;
+  BodyIndex crank2, rod2, slider2;
+  MatX P;                    // q_f (3D) = P q_f (planar)
+  double shapeResidual = 0;  // |B3_in-plane P - B2| / |B2|: the elastic fields agree
+  int nf2 = 0, nf3 = 0;
+
+  PlanarToSpatial(const Scene& s2, const ElasticCrank3d& s3) : planar(&s2), spatial(&s3) {
+    const System& sys = s2.system;
+    crank2 = sys.findBody("crank");
+    rod2 = sys.findBody("rod");
+    slider2 = sys.findBody("slider");
+    const auto& rod = dynamic_cast<const FfrBody2d&>(sys.body(rod2));
+    const MatX B2(rod.beamModel()->basis());
+    const MatX B3(s3.model->basis());
+    const int nodes = static_cast<int>(B2.rows()) / 3;
+    MatX B3in(3 * nodes, B3.cols());
+    const int map[3] = {0, 1, 5};  // (ux, uy, psi) -> (ux, uy, thz)
+    for (int n = 0; n < nodes; ++n)
+      for (int k = 0; k < 3; ++k) B3in.row(3 * n + k) = B3.row(6 * n + map[k]);
+    // least squares, minimum norm: the out-of-plane columns (zero in-plane rows) get zero
+    P = B3in.completeOrthogonalDecomposition().solve(B2);
+    shapeResidual = (B3in * P - B2).norm() / B2.norm();
+    nf2 = static_cast<int>(B2.cols());
+    nf3 = static_cast<int>(B3.cols());
+  }
+
+  /// Velocity-space map of a planar vector (v or a; `acceleration` adds the crank's
+  /// centripetal term). The crank's 3D reference point is its centre of mass.
+  void velocities(const VecX& q2, const VecX& v2, const VecX* a2, VecX& out) const {
+    const System& s2 = planar->system;
+    const System& s3 = spatial->sys;
+    out = VecX::Zero(s3.numVelocities());
+    const VecX& x = a2 ? *a2 : v2;
+    const Vec2 c(0.075, 0.0);
+    {
+      const int oq = s2.coordinateOffset(crank2), ov = s2.velocityOffset(crank2), o3 = s3.velocityOffset(spatial->crank);
+      const double th = q2[oq + 2], w = v2[ov + 2];
+      const Vec2 rc = rotation(th) * c, perp(-rc.y(), rc.x());
+      Vec2 lin = x.segment<2>(ov) + x[ov + 2] * perp;
+      if (a2) lin -= w * w * rc;
+      out.segment<2>(o3) = lin;
+      out[o3 + 5] = x[ov + 2];
+    }
+    for (BodyIndex b2 : {rod2, slider2}) {
+      const BodyIndex b3 = b2 == rod2 ? spatial->rod : spatial->slider;
+      const int ov = s2.velocityOffset(b2), o3 = s3.velocityOffset(b3);
+      out.segment<2>(o3) = x.segment<2>(ov);
+      out[o3 + 5] = x[ov + 2];
+    }
+    const int ov = s2.velocityOffset(rod2) + 3, o3 = s3.velocityOffset(spatial->rod) + 6;
+    out.segment(o3, nf3) = P * x.segment(ov, nf2);
+  }
+
+  void coordinates(const VecX& q2, VecX& q3) const {
+    const System& s2 = planar->system;
+    const System& s3 = spatial->sys;
+    q3 = VecX::Zero(s3.numCoordinates());
+    {
+      const int oq = s2.coordinateOffset(crank2), o3 = s3.coordinateOffset(spatial->crank);
+      const double th = q2[oq + 2];
+      q3.segment<2>(o3) = q2.segment<2>(oq) + rotation(th) * Vec2(0.075, 0.0);
+      q3.segment<4>(o3 + 3) = quaternionZ(th);
+    }
+    for (BodyIndex b2 : {rod2, slider2}) {
+      const BodyIndex b3 = b2 == rod2 ? spatial->rod : spatial->slider;
+      const int oq = s2.coordinateOffset(b2), o3 = s3.coordinateOffset(b3);
+      q3.segment<2>(o3) = q2.segment<2>(oq);
+      q3.segment<4>(o3 + 3) = quaternionZ(q2[oq + 2]);
+    }
+    const int oq = s2.coordinateOffset(rod2) + 3, o3 = s3.coordinateOffset(spatial->rod) + 7;
+    q3.segment(o3, nf3) = P * q2.segment(oq, nf2);
+  }
+};
+
+struct ReproductionFigures {
+  double shape = 0;         // mode / basis agreement
+  double acceleration = 0;  // max |a3 - map(a2)| / max |map(a2)| over the states
+  double torque = 0;        // max |tau3 - tau2| / max |tau2|
+  double outOfPlane = 0;    // max |a3| on the out-of-plane velocities / max |a|
+  // runs at the same settings
+  double slider = 0, deflection = 0, elastic = 0, peakDeflection = 0, maxOutOfPlane = 0;
+  long steps2 = 0, steps3 = 0;
+  double cpu2 = 0, cpu3 = 0;
+  bool ok = false;
+};
+
+/// Both models at rtol (the example's settings: 1e-6, atol 1e-8, one revolution, its
+/// output step), with the equations compared at every planar output state.
+ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double atol, double revolutions = 1.0) {
+  ReproductionFigures f;
+  Scene s2 = testmodels::elasticSliderCrank(8, 1.0, modes, revolutions, rtol, atol);
+  const auto c3 = planarElasticCrank3d(planarCrankRod3d(8, modes), planarInertia);
+  const System& sys3 = c3->sys;
+  const PlanarToSpatial map(s2, *c3);
+  f.shape = map.shapeResidual;
+  const int x2 = s2.system.coordinateOffset(map.slider2), x3 = sys3.coordinateOffset(c3->slider);
+  const int f2 = s2.system.coordinateOffset(map.rod2) + 3, f3 = sys3.coordinateOffset(c3->rod) + 7;
+  const int m2 = s2.system.constraintOffset(s2.system.findConstraint("motor")), m3 = sys3.constraintOffset(c3->motor);
+  const auto& B2 = dynamic_cast<const FfrBody2d&>(s2.system.body(map.rod2)).beamModel()->basis();
+  const auto& B3 = c3->model->basis();
+  const int mid = c3->midNode;
+  // out-of-plane velocity components of the spatial model: z, wx, wy of each body and the
+  // out-of-plane nodal fields (uz, thx, thy) of the rod
+  std::vector<OutputSample> run2, run3;
+  const SimulationSummary r2 = simulate(s2.system, s2.solver, [&](const OutputSample& o) { run2.push_back(o); });
+  const SimulationSummary r3 = simulate(sys3, s2.solver, [&](const OutputSample& o) { run3.push_back(o); });
+  f.ok = r2.ok && r3.ok && run2.size() == run3.size();
+  if (!f.ok) {
+    ADD_FAILURE() << r2.message << " / " << r3.message << " (" << run2.size() << " and " << run3.size() << " outputs)";
+    return f;
+  }
+  f.steps2 = r2.stats.steps;
+  f.steps3 = r3.stats.steps;
+  f.cpu2 = r2.cpuSeconds;
+  f.cpu3 = r3.cpuSeconds;
+  double aScale = 0, aErr = 0, tScale = 0, tErr = 0, oop = 0;
+  double dScale = 0, eScale = 0;
+  for (size_t k = 0; k < run2.size(); ++k) {
+    const OutputSample& o2 = run2[k];
+    const OutputSample& o3 = run3[k];
+    // (a) the equations at the planar state, mapped: accelerations and motor torque
+    VecX a2, l2, q3, v3, a3, l3, a2m;
+    computeAccelerations(s2.system, o2.t, o2.q, o2.v, a2, l2);
+    map.coordinates(o2.q, q3);
+    map.velocities(o2.q, o2.v, nullptr, v3);
+    computeAccelerations(sys3, o2.t, q3, v3, a3, l3);
+    map.velocities(o2.q, o2.v, &a2, a2m);
+    aScale = std::max(aScale, a2m.lpNorm<Eigen::Infinity>());
+    VecX d = a3 - a2m;
+    aErr = std::max(aErr, d.lpNorm<Eigen::Infinity>());
+    tScale = std::max(tScale, std::abs(l2[m2]));
+    tErr = std::max(tErr, std::abs(l3[m3] - l2[m2]));
+    for (BodyIndex b : {c3->crank, c3->rod, c3->slider}) {
+      const int o = sys3.velocityOffset(b);
+      oop = std::max({oop, std::abs(a3[o + 2]), std::abs(a3[o + 3]), std::abs(a3[o + 4])});
+    }
+    const VecX un = B3 * a3.segment(sys3.velocityOffset(c3->rod) + 6, map.nf3);
+    for (int n = 0; n < un.size() / 6; ++n) oop = std::max({oop, std::abs(un[6 * n + 2]), std::abs(un[6 * n + 3]), std::abs(un[6 * n + 4])});
+    // (b) the runs at the same settings
+    const VecX u2 = B2 * o2.q.segment(f2, map.nf2), u3 = B3 * o3.q.segment(f3, map.nf3);
+    const double y2 = u2[3 * mid + 1], y3 = u3[6 * mid + 1];
+    f.peakDeflection = std::max(f.peakDeflection, std::abs(y2));
+    f.deflection = std::max(f.deflection, std::abs(y3 - y2));
+    f.slider = std::max(f.slider, std::abs(o3.q[x3] - o2.q[x2]));
+    const VecX qf3in = map.P * o2.q.segment(f2, map.nf2);
+    f.elastic = std::max(f.elastic, (o3.q.segment(f3, map.nf3) - qf3in).lpNorm<Eigen::Infinity>());
+    eScale = std::max(eScale, qf3in.lpNorm<Eigen::Infinity>());
+    dScale = std::max(dScale, std::abs(y2));
+    for (int n = 0; n < u3.size() / 6; ++n) f.maxOutOfPlane = std::max(f.maxOutOfPlane, std::abs(u3[6 * n + 2]));
+    for (BodyIndex b : {c3->crank, c3->rod, c3->slider}) f.maxOutOfPlane = std::max(f.maxOutOfPlane, std::abs(o3.q[sys3.coordinateOffset(b) + 2]));
+  }
+  f.acceleration = aErr / aScale;
+  f.torque = tErr / tScale;
+  f.outOfPlane = oop / aScale;
+  f.elastic /= eScale;
+  return f;
+}
+
+}  // namespace
+
+TEST(SpatialFlexibleInPlane, ElasticSliderCrankGivesThePlanarResults) {
+  // Tolerances.
+  //  - kRoundOff: the same equations at the same state, assembled by other code (3D
+  //    invariants, quaternions, spatial joints) and solved by another factorisation: the
+  //    accelerations carry round-off of the elastic forces, K_ff q_f ~ 1e11 x 1e-3, over
+  //    the largest acceleration ~1e4: eps * cond ~ 1e-16 x 1e6; bound 1e-9 relative.
+  //  - The runs: the two integrations take different steps (other unknowns, other error
+  //    norms), so they agree to the integration error, not to round-off: at the example's
+  //    rtol 1e-6 the slider to kSliderRun (the planar run's own error against the rigid
+  //    closed form is ~1e-5 relative; the slider moves 0.3 m), the midpoint deflection
+  //    (~2 mm) to kDeflectionRun of its peak.
+  //  - Out of the plane, nothing is excited: the out-of-plane accelerations at in-plane
+  //    states are round-off (kRoundOff of the scale), the coordinates stay at round-off
+  //    level through the runs (kOutOfPlane, m).
+  constexpr double kRoundOff = 1e-9, kSliderRun = 1e-6, kDeflectionRun = 1e-3, kOutOfPlane = 1e-12;
+  for (int modes : {0, 2}) {
+    const ReproductionFigures f = reproduce(modes, true, 1e-6, 1e-8);
+    ASSERT_TRUE(f.ok);
+    const char* what = modes ? "2 modes" : "8 nodal elements";
+    std::printf("[ figures ] in plane, %s: elastic fields (B3 P vs B2) %.1e; equations at the %s states: accelerations "
+                "%.1e, motor torque %.1e, out-of-plane accelerations %.1e (relative)\n",
+                what, f.shape, what, f.acceleration, f.torque, f.outOfPlane);
+    std::printf("[ figures ] in plane, %s, rtol 1e-6 (the example): |dx slider| %.2e m, |d mid deflection| %.2e m "
+                "(%.1e of the peak %.3e m), in-plane q_f %.1e (relative), max out-of-plane %.1e m; steps %ld planar, %ld "
+                "spatial; CPU %.3f s planar, %.3f s spatial\n",
+                what, f.slider, f.deflection, f.deflection / f.peakDeflection, f.peakDeflection, f.elastic,
+                f.maxOutOfPlane, f.steps2, f.steps3, f.cpu2, f.cpu3);
+    EXPECT_LT(f.shape, kRoundOff);
+    EXPECT_LT(f.acceleration, kRoundOff);
+    EXPECT_LT(f.torque, kRoundOff);
+    EXPECT_LT(f.outOfPlane, kRoundOff);
+    EXPECT_LT(f.slider, kSliderRun);
+    EXPECT_LT(f.deflection, kDeflectionRun * f.peakDeflection);
+    EXPECT_LT(f.maxOutOfPlane, kOutOfPlane);
+  }
+}
+
+TEST(SpatialFlexibleInPlane, RunsConvergeToEachOtherWithTheTolerance) {
+  // The difference of the runs is integration error: 2 modes at rtol 1e-6, 1e-8, 1e-10
+  // (atol = rtol / 100); it falls with the tolerance, to kTight at rtol 1e-10.
+  constexpr double kTightSlider = 1e-9, kTightDeflection = 1e-6;  // m; relative to the peak
+  double previous = INFINITY;
+  for (double rtol : {1e-6, 1e-8, 1e-10}) {
+    const ReproductionFigures f = reproduce(2, true, rtol, rtol * 1e-2);
+    ASSERT_TRUE(f.ok);
+    std::printf("[ figures ] in plane, 2 modes, rtol %.0e: |dx slider| %.2e m, |d mid deflection| %.2e of the peak, "
+                "in-plane q_f %.1e\n", rtol, f.slider, f.deflection / f.peakDeflection, f.elastic);
+    EXPECT_LT(f.slider, previous);
+    previous = f.slider;
+    if (rtol == 1e-10) {
+      EXPECT_LT(f.slider, kTightSlider);
+      EXPECT_LT(f.deflection, kTightDeflection * f.peakDeflection);
+    }
+  }
+}
+
+TEST(SpatialFlexibleInPlane, SectionRotaryInertiaIsTheOnlyDifferenceOfTheBeamModelBody) {
+  // The body made from FfrBeamModel3d as it is keeps the section's rotary inertia in the
+  // plane, rho Iz L = 3 Iz / (A L^2) = 1.8e-4 of the rod's moment of inertia about its
+  // end, which the planar element leaves out. The crank is driven and the rigid motion is
+  // fixed by the joints, and that term (in the frame's rotational inertia only, not in
+  // the frame-elastic coupling) does not enter the elastic equations: the accelerations
+  // stay equal to round-off (kRoundOff), the motor torque carries the extra inertia
+  // torque rho Iz L theta_rod'' (between kSectionTermLow and kSectionTermHigh of the
+  // largest torque).
+  constexpr double kRoundOff = 1e-9, kSectionTermLow = 1e-6, kSectionTermHigh = 1e-3;
+  const ReproductionFigures f = reproduce(2, false, 1e-6, 1e-8);
+  ASSERT_TRUE(f.ok);
+  std::printf("[ figures ] in plane, 2 modes, FfrBody3d(model) with the section's rho Iz L: accelerations %.2e, motor "
+              "torque %.2e (relative); run: |d mid deflection| %.2e of the peak\n",
+              f.acceleration, f.torque, f.deflection / f.peakDeflection);
+  EXPECT_LT(f.acceleration, kRoundOff);
+  EXPECT_GT(f.torque, kSectionTermLow);
+  EXPECT_LT(f.torque, kSectionTermHigh);
+}
