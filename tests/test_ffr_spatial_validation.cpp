@@ -212,6 +212,8 @@ ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double
 
 }  // namespace
 
+#ifndef FLEXMBD_SPATIAL_VALIDATION_SLOW
+
 TEST(SpatialFlexibleInPlane, ElasticSliderCrankGivesThePlanarResults) {
   // Tolerances.
   //  - kRoundOff: the same equations at the same state, assembled by other code (3D
@@ -287,6 +289,8 @@ TEST(SpatialFlexibleInPlane, SectionRotaryInertiaIsTheOnlyDifferenceOfTheBeamMod
   EXPECT_GT(f.torque, kSectionTermLow);
   EXPECT_LT(f.torque, kSectionTermHigh);
 }
+
+#endif
 
 // =====================================================================================
 // 2. A spatial slider crank with a flexible rod
