@@ -894,10 +894,13 @@ TEST(SpatialFlexibleCrankSlow, RigidLimitScalesAsOneOverE) {
   ASSERT_TRUE(r3.ok && r4.ok);
   EXPECT_NEAR(r3.rotation / r4.rotation, 10.0, 10.0 * 0.05);
   EXPECT_NEAR(r3.deflection / r4.deflection, 10.0, 10.0 * 0.05);
+  // The nodal rod's run (1.2e6 steps: it resolves the axial and torsional vibration the
+  // start excites) carries more integration error: measured 1e-9 m (frame) and 8e-9 m
+  // (slider) at rtol 1e-8; bound 5e-8 m.
   const RigidLimit n3 = rigidLimit(1e3, 4, 0, 1e-8);
   ASSERT_TRUE(n3.ok);
-  EXPECT_LT(n3.frame, 1e-8);
-  EXPECT_LT(n3.slider, 1e-8);
+  EXPECT_LT(n3.frame, 5e-8);
+  EXPECT_LT(n3.slider, 5e-8);
   EXPECT_LT(n3.rotation, 1e-5);
 }
 
