@@ -12,13 +12,15 @@
 //     an axis perpendicular to it; first flapwise and chordwise frequencies measured from
 //     the time response (zero crossings) against the Southwell relation and the
 //     linearisation of the body's own equations.
-// Longer variants (more spin speeds, E x 1e4): label slow, test_ffr_spatial_validation_slow.
+// Longer variants (nodal rods, E x 1e4, more spin speeds and periods): label slow, the
+// binary test_ffr_spatial_validation_slow (this source with FLEXMBD_SPATIAL_VALIDATION_SLOW).
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <complex>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -153,8 +155,6 @@ ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double
   const auto& B2 = dynamic_cast<const FfrBody2d&>(s2.system.body(map.rod2)).beamModel()->basis();
   const auto& B3 = c3->model->basis();
   const int mid = c3->midNode;
-  // out-of-plane velocity components of the spatial model: z, wx, wy of each body and the
-  // out-of-plane nodal fields (uz, thx, thy) of the rod
   std::vector<OutputSample> run2, run3;
   const SimulationSummary r2 = simulate(s2.system, s2.solver, [&](const OutputSample& o) { run2.push_back(o); });
   const SimulationSummary r3 = simulate(sys3, s2.solver, [&](const OutputSample& o) { run3.push_back(o); });
@@ -168,7 +168,7 @@ ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double
   f.cpu2 = r2.cpuSeconds;
   f.cpu3 = r3.cpuSeconds;
   double aScale = 0, aErr = 0, tScale = 0, tErr = 0, oop = 0;
-  double dScale = 0, eScale = 0;
+  double eScale = 0;
   for (size_t k = 0; k < run2.size(); ++k) {
     const OutputSample& o2 = run2[k];
     const OutputSample& o3 = run3[k];
@@ -184,6 +184,7 @@ ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double
     aErr = std::max(aErr, d.lpNorm<Eigen::Infinity>());
     tScale = std::max(tScale, std::abs(l2[m2]));
     tErr = std::max(tErr, std::abs(l3[m3] - l2[m2]));
+    // out of the plane: z, wx, wy of each body and the rod's nodal uz, thx, thy
     for (BodyIndex b : {c3->crank, c3->rod, c3->slider}) {
       const int o = sys3.velocityOffset(b);
       oop = std::max({oop, std::abs(a3[o + 2]), std::abs(a3[o + 3]), std::abs(a3[o + 4])});
@@ -199,7 +200,6 @@ ReproductionFigures reproduce(int modes, bool planarInertia, double rtol, double
     const VecX qf3in = map.P * o2.q.segment(f2, map.nf2);
     f.elastic = std::max(f.elastic, (o3.q.segment(f3, map.nf3) - qf3in).lpNorm<Eigen::Infinity>());
     eScale = std::max(eScale, qf3in.lpNorm<Eigen::Infinity>());
-    dScale = std::max(dScale, std::abs(y2));
     for (int n = 0; n < u3.size() / 6; ++n) f.maxOutOfPlane = std::max(f.maxOutOfPlane, std::abs(u3[6 * n + 2]));
     for (BodyIndex b : {c3->crank, c3->rod, c3->slider}) f.maxOutOfPlane = std::max(f.maxOutOfPlane, std::abs(o3.q[sys3.coordinateOffset(b) + 2]));
   }
