@@ -1,0 +1,373 @@
+#include "integrators/linearization.hpp"
+
+#include <Eigen/Dense>
+#include <Eigen/SparseLU>
+#include <Spectra/GenEigsRealShiftSolver.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/dae_system.hpp"
+#include "core/errors.hpp"
+#include "core/system_evaluation.hpp"
+#include "integrators/initial_conditions.hpp"
+#include "integrators/static_equilibrium.hpp"
+
+namespace flexmbd {
+namespace {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+SpMat fromTriplets(int rows, int cols, const Triplets& t) {
+  SpMat S(rows, cols);
+  S.setFromTriplets(t.begin(), t.end());  // duplicates summed
+  return S;
+}
+
+/// The entries of `all` in rows [r0, r0 + rows) and columns [c0, c0 + cols), shifted to (0, 0).
+Triplets blockOf(const Triplets& all, int r0, int rows, int c0, int cols, double scale = 1.0) {
+  Triplets out;
+  for (const auto& e : all) {
+    const int r = e.row() - r0, c = e.col() - c0;
+    if (r >= 0 && r < rows && c >= 0 && c < cols) out.emplace_back(r, c, scale * e.value());
+  }
+  return out;
+}
+
+/// T(q) (nq x nv) or T+(q) (nv x nq), body by body (Body::coordinateRateMatrix / Inverse).
+SpMat rateMatrix(const System& sys, const VecX& q, bool inverse) {
+  Triplets t;
+  MatX Tb;
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates();
+    if (nqb == 0) continue;
+    const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
+    if (body.velocitiesAreCoordinateRates()) {
+      for (int k = 0; k < nqb; ++k) t.emplace_back(inverse ? voff + k : qoff + k, inverse ? qoff + k : voff + k, 1.0);
+      continue;
+    }
+    const auto qb = q.segment(qoff, nqb);
+    if (inverse) {
+      body.coordinateRateInverse(qb, Tb);
+    } else {
+      body.coordinateRateMatrix(qb, Tb);
+    }
+    const int r0 = inverse ? voff : qoff, c0 = inverse ? qoff : voff;
+    for (int j = 0; j < Tb.cols(); ++j) {
+      for (int i = 0; i < Tb.rows(); ++i) {
+        if (Tb(i, j) != 0.0) t.emplace_back(r0 + i, c0 + j, Tb(i, j));
+      }
+    }
+  }
+  return inverse ? fromTriplets(sys.numVelocities(), sys.numCoordinates(), t)
+                 : fromTriplets(sys.numCoordinates(), sys.numVelocities(), t);
+}
+
+/// B = T+ (d(T v)/dq T - [d(T e_j)/dq T v]_j) (nv x nv): dx' = dv + B dx for the increment
+/// dx of q = q_ref(t) (+) dx carried along the reference motion (derivation: docs/modes.md,
+/// "Kinematic term"). Only bodies with T != I contribute, and of them only the frame
+/// velocities (elastic velocities are their coordinates' rates: d(T e_j)/dq = 0).
+SpMat kinematicTerm(const System& sys, const VecX& q, const VecX& v, const SpMat& T, const SpMat& Tinv) {
+  const int nq = sys.numCoordinates(), nv = sys.numVelocities();
+  Triplets dTv, bracket;  // d(T v)/dq (nq x nq) and [d(T e_j)/dq T v]_j (nq x nv)
+  JacobianSink dTvSink = JacobianSink::recorder(&dTv);
+  const VecX Tv = T * v;
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    const int nqb = body.numCoordinates(), nvb = body.numVelocities();
+    if (nqb == 0 || body.velocitiesAreCoordinateRates()) continue;
+    const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
+    const auto qb = q.segment(qoff, nqb);
+    body.addCoordinateRateJacobian(qb, v.segment(voff, nvb), MatrixSink(dTvSink, qoff, qoff));
+    VecX ej = VecX::Zero(nvb);
+    for (int j = 0; j < body.numFrameVelocities(); ++j) {
+      ej.setZero();
+      ej[j] = 1.0;
+      MatX dTe = MatX::Zero(nqb, nqb);
+      body.addCoordinateRateJacobian(qb, ej, dTe);
+      const VecX col = dTe * Tv.segment(qoff, nqb);
+      for (int i = 0; i < nqb; ++i) {
+        if (col[i] != 0.0) bracket.emplace_back(qoff + i, voff + j, col[i]);
+      }
+    }
+  }
+  if (dTv.empty() && bracket.empty()) return SpMat(nv, nv);
+  const SpMat inner = fromTriplets(nq, nq, dTv) * T - fromTriplets(nq, nv, bracket);
+  SpMat B = Tinv * inner;
+  B.prune(0.0);
+  return B;
+}
+
+void checkState(const System& sys, const ReferenceState& s) {
+  if (!sys.isFinalized()) throw InputError("linearize: the system must be finalized first");
+  const auto bad = [](const VecX& x, int n) { return x.size() != n || !x.allFinite(); };
+  if (bad(s.q, sys.numCoordinates()) || bad(s.v, sys.numVelocities()) || bad(s.a, sys.numVelocities()) ||
+      bad(s.lambda, sys.numConstraintEquations())) {
+    throw InputError("linearize: the reference state needs finite q (" + std::to_string(sys.numCoordinates()) +
+                     "), v and a (" + std::to_string(sys.numVelocities()) + ") and lambda (" +
+                     std::to_string(sys.numConstraintEquations()) + ")");
+  }
+}
+
+/// Numerical rank tolerance of G, relative to its largest singular value / pivot.
+constexpr double kRankTolerance = 1e-10;
+/// Weight of elastic velocities when choosing the dependent coordinates of coordinate
+/// partitioning: frame velocities are taken as dependent first (pivoted QR of G W).
+constexpr double kElasticPivotWeight = 1e-3;
+
+SpMat svdBasis(const MatX& G, int& rank) {
+  const int nv = static_cast<int>(G.cols());
+  if (G.rows() == 0) {
+    rank = 0;
+    SpMat I(nv, nv);
+    I.setIdentity();
+    return I;
+  }
+  Eigen::BDCSVD<MatX> svd(G, Eigen::ComputeFullV);
+  const VecX& s = svd.singularValues();
+  rank = 0;
+  for (Eigen::Index k = 0; k < s.size(); ++k) rank += s[k] > kRankTolerance * std::max(s[0], 1e-300) ? 1 : 0;
+  const MatX N = svd.matrixV().rightCols(nv - rank);
+  return N.sparseView();
+}
+
+SpMat partitioningBasis(const MatX& G, const std::vector<CoordinateKind>& kinds, int& rank) {
+  const int nv = static_cast<int>(G.cols());
+  MatX GW = G;
+  for (int k = 0; k < nv; ++k) {
+    if (kinds[k] == CoordinateKind::Elastic) GW.col(k) *= kElasticPivotWeight;
+  }
+  Eigen::ColPivHouseholderQR<MatX> qr(GW);
+  qr.setThreshold(kRankTolerance);
+  rank = G.rows() == 0 ? 0 : static_cast<int>(qr.rank());
+  const auto& perm = qr.colsPermutation().indices();
+  std::vector<int> dep(perm.data(), perm.data() + rank), indep(perm.data() + rank, perm.data() + nv);
+  std::sort(dep.begin(), dep.end());
+  std::sort(indep.begin(), indep.end());
+  MatX Gd(G.rows(), rank), Gi(G.rows(), nv - rank);
+  for (int k = 0; k < rank; ++k) Gd.col(k) = G.col(dep[k]);
+  for (int k = 0; k < nv - rank; ++k) Gi.col(k) = G.col(indep[k]);
+  // G_d dx_d + G_i x = 0: dx_d = -G_d^+ G_i x (G_d has full column rank; redundant rows agree)
+  const MatX X = rank > 0 ? MatX(-Gd.colPivHouseholderQr().solve(Gi)) : MatX(0, nv - rank);
+  Triplets t;
+  for (int k = 0; k < nv - rank; ++k) t.emplace_back(indep[k], k, 1.0);
+  for (int k = 0; k < nv - rank; ++k) {
+    for (int i = 0; i < rank; ++i) {
+      if (std::abs(X(i, k)) > 1e-14) t.emplace_back(dep[i], k, X(i, k));
+    }
+  }
+  return fromTriplets(nv, nv - rank, t);
+}
+
+/// Mode from an eigenvalue and the displacement part x of its eigenvector: shape N x
+/// scaled so that its largest entry is 1.
+Mode makeMode(std::complex<double> s, const Eigen::VectorXcd& x, const SpMat& N) {
+  Mode m;
+  m.eigenvalue = s;
+  m.omega = std::abs(s);
+  m.frequencyHz = m.omega / (2.0 * M_PI);
+  m.dampingRatio = m.omega > 0.0 ? -s.real() / m.omega : 0.0;
+  m.shape = N.cast<std::complex<double>>() * x;
+  Eigen::Index k = 0;
+  if (m.shape.size() > 0 && m.shape.cwiseAbs().maxCoeff(&k) > 0.0) m.shape /= m.shape[k];
+  return m;
+}
+
+/// Sorted selection: Im s >= 0 (one of each complex pair, every real eigenvalue), the
+/// zero eigenvalues (|s| <= zeroTol, two per rigid-body degree of freedom) halved, by
+/// increasing |s| then Im s; at most `count`.
+std::vector<Mode> selectModes(std::vector<Mode> all, int count, double zeroTol) {
+  std::vector<Mode> zeros, others;
+  for (auto& m : all) {
+    if (m.omega <= zeroTol) {
+      m.eigenvalue = 0.0;
+      m.omega = m.frequencyHz = m.dampingRatio = 0.0;
+      zeros.push_back(std::move(m));
+    } else if (m.eigenvalue.imag() >= -1e-12 * m.omega) {
+      others.push_back(std::move(m));
+    }
+  }
+  zeros.resize((zeros.size() + 1) / 2);
+  std::sort(others.begin(), others.end(), [](const Mode& a, const Mode& b) {
+    if (a.omega != b.omega) return a.omega < b.omega;
+    return a.eigenvalue.imag() < b.eigenvalue.imag();
+  });
+  zeros.insert(zeros.end(), others.begin(), others.end());
+  if (static_cast<int>(zeros.size()) > count) zeros.resize(count);
+  return zeros;
+}
+
+/// Zero eigenvalues: |s| below this fraction of the largest |s| found (the rigid-body
+/// eigenvalues of a Jordan pair come out of a dense solver near sqrt(eps) |s|_max).
+constexpr double kZeroEigenvalueFraction = 1e-6;
+
+std::vector<Mode> denseModes(const ReducedSystem& red, int count) {
+  const int n = static_cast<int>(red.M.rows());
+  const MatX M = red.M, C = red.C, K = red.K;
+  Eigen::LLT<MatX> llt(M);
+  if (llt.info() != Eigen::Success) throw ModelError("modes: the reduced mass matrix is not positive definite");
+  MatX A = MatX::Zero(2 * n, 2 * n);  // first-order form z = [x; x']: z' = A z
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -llt.solve(K);
+  A.bottomRightCorner(n, n) = -llt.solve(C);
+  Eigen::EigenSolver<MatX> es(A, true);
+  if (es.info() != Eigen::Success) throw ModelError("modes: the dense eigensolver did not converge");
+  std::vector<Mode> all;
+  double largest = 0.0;
+  for (int k = 0; k < 2 * n; ++k) {
+    all.push_back(makeMode(es.eigenvalues()[k], es.eigenvectors().col(k).head(n), red.N));
+    largest = std::max(largest, std::abs(es.eigenvalues()[k]));
+  }
+  return selectModes(std::move(all), count, kZeroEigenvalueFraction * largest);
+}
+
+/// Spectra operator of the shift-invert of the pencil (A, E), A = [0 I; -K -C], E = [I 0; 0 M]:
+/// y = (A - sigma E)^-1 E x, whose largest eigenvalues 1 / (s - sigma) are the s nearest sigma.
+class ShiftInvertPencil {
+ public:
+  using Scalar = double;
+  ShiftInvertPencil(const SpMat& M, const SpMat& C, const SpMat& K) : n_(static_cast<int>(M.rows())) {
+    Triplets a, e;
+    for (int k = 0; k < n_; ++k) {
+      a.emplace_back(k, n_ + k, 1.0);
+      e.emplace_back(k, k, 1.0);
+    }
+    const auto put = [](Triplets& t, const SpMat& S, int r0, int c0, double s) {
+      for (int j = 0; j < S.outerSize(); ++j) {
+        for (SpMat::InnerIterator it(S, j); it; ++it) t.emplace_back(r0 + it.row(), c0 + j, s * it.value());
+      }
+    };
+    put(a, K, n_, 0, -1.0);
+    put(a, C, n_, n_, -1.0);
+    put(e, M, n_, n_, 1.0);
+    A_ = fromTriplets(2 * n_, 2 * n_, a);
+    E_ = fromTriplets(2 * n_, 2 * n_, e);
+  }
+  Eigen::Index rows() const { return 2 * n_; }
+  Eigen::Index cols() const { return 2 * n_; }
+  void set_shift(double sigma) {
+    const SpMat S = A_ - sigma * E_;
+    lu_.compute(S);
+    if (lu_.info() != Eigen::Success) throw ModelError("modes: the shifted pencil is singular at the shift");
+  }
+  void perform_op(const double* x, double* y) const {
+    Eigen::Map<const VecX> xv(x, 2 * n_);
+    Eigen::Map<VecX>(y, 2 * n_) = lu_.solve(E_ * xv);
+  }
+
+ private:
+  int n_;
+  SpMat A_, E_;
+  mutable Eigen::SparseLU<SpMat> lu_;  // solve() is const in Eigen; factorised in set_shift
+};
+
+std::vector<Mode> sparseModes(const ReducedSystem& red, int count, double shift) {
+  const int n = static_cast<int>(red.M.rows());
+  ShiftInvertPencil op(red.M, red.C, red.K);
+  // two eigenvalues per mode (a conjugate pair), two spare; Arnoldi basis 2 nev + 1 (Spectra's advice)
+  const int nev = std::min(2 * count + 2, 2 * n - 3);
+  const int ncv = std::min(2 * n, std::max(2 * nev + 1, 20));
+  Spectra::GenEigsRealShiftSolver<ShiftInvertPencil> eigs(op, nev, ncv, shift);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw ModelError("modes: the sparse eigensolver (Spectra, shift-invert about " + std::to_string(shift) +
+                     ") did not converge");
+  }
+  const Eigen::VectorXcd s = eigs.eigenvalues();
+  const Eigen::MatrixXcd Z = eigs.eigenvectors();
+  std::vector<Mode> all;
+  double largest = 0.0;
+  for (Eigen::Index k = 0; k < s.size(); ++k) {
+    all.push_back(makeMode(s[k], Z.col(k).head(n), red.N));
+    largest = std::max(largest, std::abs(s[k]));
+  }
+  return selectModes(std::move(all), count, kZeroEigenvalueFraction * largest);
+}
+
+/// A state at rest is taken as an equilibrium when no acceleration exceeds this (SI units:
+/// 1e-9 of the acceleration of gravity, rounding of the augmented solve).
+constexpr double kEquilibriumAcceleration = 1e-8;
+
+}  // namespace
+
+ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0) {
+  const ConsistentState c = computeConsistentState(sys, t0, q0, v0);
+  ReferenceState s;
+  s.t = t0;
+  s.q = c.q;
+  s.v = c.v;
+  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
+  // at rest but accelerating: not an equilibrium yet, solve for it (a free body at rest
+  // without load is one already, and its static tangent would be singular)
+  if (c.v.lpNorm<Eigen::Infinity>() == 0.0 && s.a.lpNorm<Eigen::Infinity>() > kEquilibriumAcceleration) {
+    const StaticEquilibrium eq = solveStaticEquilibrium(sys, t0, c.q);
+    s.q = eq.q;
+    s.lambda = eq.lambda;
+    s.a = VecX::Zero(sys.numVelocities());
+  }
+  return s;
+}
+
+LinearizedSystem linearize(const System& sys, const ReferenceState& state) {
+  checkState(sys, state);
+  const int nq = sys.numCoordinates(), nv = sys.numVelocities(), m = sys.numConstraintEquations();
+  // The DAE Jacobian (index-3 form, y = [q, v, lambda]) at cj = 0 and 1: its F_v rows hold
+  // d(M a)/dq - dQ/dq + sum lambda_a H_a (q columns), -dQ/dv + cj M (v columns).
+  const DaeSystem dae(sys, Formulation::Index3);
+  const DaeLayout& L = dae.layout();
+  VecX y, yp;
+  dae.packState(state.q, state.v, state.a, state.lambda, y, yp);
+  Triplets J0, J1;
+  JacobianSink s0 = JacobianSink::recorder(&J0), s1 = JacobianSink::recorder(&J1);
+  dae.jacobian(state.t, y.data(), yp.data(), 0.0, s0);
+  dae.jacobian(state.t, y.data(), yp.data(), 1.0, s1);
+  const SpMat Kq = fromTriplets(nv, nq, blockOf(J0, L.v, nv, L.q, nq));
+  const SpMat Cv = fromTriplets(nv, nv, blockOf(J0, L.v, nv, L.v, nv));
+  Triplets mass = blockOf(J1, L.v, nv, L.v, nv);
+  const Triplets minusJ0 = blockOf(J0, L.v, nv, L.v, nv, -1.0);
+  mass.insert(mass.end(), minusJ0.begin(), minusJ0.end());
+
+  LinearizedSystem lin;
+  lin.M = fromTriplets(nv, nv, mass);
+  lin.M.prune(0.0);
+  const SpMat T = rateMatrix(sys, state.q, false), Tinv = rateMatrix(sys, state.q, true);
+  lin.B = kinematicTerm(sys, state.q, state.v, T, Tinv);
+  lin.C = Cv - lin.M * lin.B;  // dv = dx' - B dx
+  lin.K = Kq * T - Cv * lin.B;
+  const SpMat A = augmentedMatrix(sys, state.q);
+  lin.G = A.block(nv, 0, m, nv);
+  lin.velocityNames = sys.velocityNames();
+  lin.velocityKinds = sys.velocityKinds();
+  return lin;
+}
+
+ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
+  ReducedSystem red;
+  const MatX G = lin.G;
+  red.N = basis == BasisKind::Svd ? svdBasis(G, red.rank) : partitioningBasis(G, lin.velocityKinds, red.rank);
+  if (red.N.cols() == 0) throw ModelError("modes: every velocity is constrained (the model has no degree of freedom)");
+  const SpMat Nt = red.N.transpose();
+  red.M = Nt * lin.M * red.N;
+  red.C = Nt * lin.C * red.N;
+  red.K = Nt * lin.K * red.N;
+  return red;
+}
+
+std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& options) {
+  if (options.count < 1) throw InputError("modes: the number of modes must be >= 1, got " + std::to_string(options.count));
+  const int n = static_cast<int>(red.M.rows());
+  const bool dense = options.solver == EigenSolverKind::Dense ||
+                     (options.solver == EigenSolverKind::Automatic && n <= kDenseModesLimit) || 2 * n < 8;
+  return dense ? denseModes(red, options.count) : sparseModes(red, options.count, options.shift);
+}
+
+std::vector<Mode> modesAbout(const System& sys, const ReferenceState& state, const ModesOptions& options,
+                             BasisKind basis) {
+  return computeModes(reduce(linearize(sys, state), basis), options);
+}
+
+}  // namespace flexmbd
