@@ -204,14 +204,36 @@ std::vector<Mode> selectModes(std::vector<Mode> all, int count, double zeroTol) 
 /// eigenvalues of a Jordan pair come out of a dense solver near sqrt(eps) |s|_max).
 constexpr double kZeroEigenvalueFraction = 1e-6;
 
+/// max(sqrt(|Kr| / |Mr|), |Cr| / |Mr|) (1-norms), or 1 if zero: the scale of the
+/// first-order form.
+double frequencyScale(const ReducedSystem& red) {
+  const auto norm1 = [](const SpMat& S) {
+    double best = 0.0;
+    for (int j = 0; j < S.outerSize(); ++j) {
+      double c = 0.0;
+      for (SpMat::InnerIterator it(S, j); it; ++it) c += std::abs(it.value());
+      best = std::max(best, c);
+    }
+    return best;
+  };
+  const double m = norm1(red.M);
+  const double w = std::max(std::sqrt(norm1(red.K) / m), norm1(red.C) / m);
+  return w > 0.0 && std::isfinite(w) ? w : 1.0;
+}
+
 std::vector<Mode> denseModes(const ReducedSystem& red, int count) {
   const int n = static_cast<int>(red.M.rows());
   const MatX M = red.M, C = red.C, K = red.K;
   Eigen::LLT<MatX> llt(M);
   if (llt.info() != Eigen::Success) throw ModelError("modes: the reduced mass matrix is not positive definite");
-  MatX A = MatX::Zero(2 * n, 2 * n);  // first-order form z = [x; x']: z' = A z
+  // first-order form z = [x; x' / w], z' = A z, scaled by a frequency w of the model's
+  // top range so that both block rows have norms ~ w: unscaled, |M^-1 K| ~ w_max^2
+  // against 1 costs the low eigenvalues digits (eps w_max^2 instead of eps w_max)
+  const double w = frequencyScale(red);
+  MatX A = MatX::Zero(2 * n, 2 * n);
   A.topRightCorner(n, n).setIdentity();
-  A.bottomLeftCorner(n, n) = -llt.solve(K);
+  A.topRightCorner(n, n) *= w;
+  A.bottomLeftCorner(n, n) = -llt.solve(K) / w;
   A.bottomRightCorner(n, n) = -llt.solve(C);
   Eigen::EigenSolver<MatX> es(A, true);
   if (es.info() != Eigen::Success) throw ModelError("modes: the dense eigensolver did not converge");

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "core/errors.hpp"
 #include "integrators/linearization.hpp"
 #include "io/scene.hpp"
 
