@@ -51,6 +51,7 @@ struct ModesCommandOptions {
   int count = 10;
   std::optional<Sweep> sweep;
   bool quiet = false;
+  bool steady = false;  ///< --steady: solveSteadyMotion instead of the consistent state
 };
 
 int parseCount(const std::string& text) {
@@ -89,9 +90,11 @@ Sweep parseSweep(const std::string& text) {
 
 ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
   const cli::SplitArguments split = cli::splitArguments(
-      args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep"}), cli::kCommonFlags, "modes: ");
+      args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep"}),
+      cli::withCommon(cli::kCommonFlags, {{"--steady", "--steady"}}), "modes: ");
   ModesCommandOptions o;
   o.quiet = split.flags.count("--quiet") > 0;
+  o.steady = split.flags.count("--steady") > 0;
   for (const auto& [name, value] : split.values) {
     if (name == "--out") {
       if (value.empty()) throw cli::UsageError("option --out needs a directory");
@@ -112,6 +115,7 @@ ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
   o.scenePath = split.positional[0];
   if (o.outDir.empty()) throw cli::UsageError("modes: missing --out DIR (the output directory)");
   if (o.at && o.sweep) throw cli::UsageError("modes: --at and --sweep cannot be combined (a sweep linearises at t_start)");
+  if (o.at && o.steady) throw cli::UsageError("modes: --at and --steady cannot be combined (--steady solves for the state)");
   return o;
 }
 
@@ -131,12 +135,19 @@ std::string number(double x) {
   return buf;
 }
 
-/// The state to linearise about: the consistent state at t_start (an equilibrium if at
-/// rest), or the state reached by simulating to `at`.
-/// @throws SolverError if that simulation fails.
-ReferenceState findReference(const Scene& scene, std::optional<double> at, bool quiet) {
+/// The state at t_start: the consistent state (an equilibrium if at rest), or with
+/// `steady` the steady motion at the initial velocities.
+ReferenceState initialReference(const Scene& scene, bool steady) {
   const System& sys = scene.system;
-  if (!at) return referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
+  return steady ? solveSteadyMotion(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities())
+                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
+}
+
+/// The state to linearise about: initialReference, or the state reached by simulating to `at`.
+/// @throws SolverError if that simulation fails.
+ReferenceState findReference(const Scene& scene, std::optional<double> at, bool steady, bool quiet) {
+  const System& sys = scene.system;
+  if (!at) return initialReference(scene, steady);
   if (!(*at > scene.solver.tStart)) {
     throw InputError("option --at must be > t_start (" + fmt(scene.solver.tStart, 6) + ") of the scene, got " +
                      fmt(*at, 6));
@@ -284,8 +295,7 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
     const double speed = sw.points == 1 ? sw.from : sw.from + (sw.to - sw.from) * i / (sw.points - 1);
     const Scene scene = parseSceneText(withSpeed(base, sw.name, speed).dump(), o.scenePath);
     const System& sys = scene.system;
-    const ReferenceState ref = referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
-    const std::vector<Mode> modes = modesAbout(sys, ref, mo);
+    const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo);
     csv << number(speed);
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].frequencyHz) : "");
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].dampingRatio) : "");
@@ -332,7 +342,7 @@ int runModesCommand(const std::vector<std::string>& args) {
       return runSweep(o, base, out);
     }
     const System& sys = scene->system;
-    const ReferenceState ref = findReference(*scene, o.at, o.quiet);
+    const ReferenceState ref = findReference(*scene, o.at, o.steady, o.quiet);
     const LinearizedSystem lin = linearize(sys, ref);
     const ReducedSystem red = reduce(lin);
     ModesOptions mo;
@@ -343,7 +353,7 @@ int runModesCommand(const std::vector<std::string>& args) {
     writeShapesVtk(out / "vtk", sys, ref, modes);
     const double aMax = ref.a.size() ? ref.a.lpNorm<Eigen::Infinity>() : 0.0;
     std::printf("flexmbd: modes of %s about t = %g (%s; max |a| = %.3g): %d velocities, %d independent\n",
-                o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : "in motion", aMax,
+                o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : o.steady ? "steady motion" : "in motion", aMax,
                 sys.numVelocities(), static_cast<int>(red.N.cols()));
     printTable(modes);
     printBeamFrequencies(sys, o.count);

@@ -334,6 +334,65 @@ ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, co
   return s;
 }
 
+ReferenceState solveSteadyMotion(const System& sys, double t0, const VecX& q0, const VecX& v0) {
+  // Newton iteration limit and tolerance on max |dx| relative to 1 + max |q| (as the static solve)
+  constexpr int kMaxIterations = 50;
+  constexpr double kTolerance = 1e-10;
+  const ConsistentState c = computeConsistentState(sys, t0, q0, v0);
+  const DaeSystem dae(sys, Formulation::Index3);
+  const DaeLayout& L = dae.layout();
+  const int nv = L.nv, m = L.m;
+  VecX q = c.q, lambda = VecX::Zero(m), y, yp, F(L.size);
+  const VecX zero = VecX::Zero(nv);
+  double step = 0.0;
+  for (int it = 0; it < kMaxIterations; ++it) {
+    dae.packState(q, c.v, zero, lambda, y, yp);
+    dae.residual(t0, y.data(), yp.data(), F.data());
+    Triplets J;
+    JacobianSink sink = JacobianSink::recorder(&J);
+    dae.jacobian(t0, y.data(), yp.data(), 0.0, sink);
+    const SpMat T = rateMatrix(sys, q, false);
+    // [Kq T, G^T; Gq T, 0]: the F_v and F_g rows of the index-3 Jacobian, q columns times T
+    const SpMat Kq = fromTriplets(nv, L.nq, blockOf(J, L.v, nv, L.q, L.nq));
+    const SpMat Gt = fromTriplets(nv, m, blockOf(J, L.v, nv, L.lambda, m));
+    const SpMat Gq = fromTriplets(m, L.nq, blockOf(J, L.lambda, m, L.q, L.nq));
+    const SpMat KT = Kq * T, GT = Gq * T;
+    Triplets a;
+    const auto put = [&](const SpMat& S, int r0, int c0) {
+      for (int j = 0; j < S.outerSize(); ++j) {
+        for (SpMat::InnerIterator e(S, j); e; ++e) a.emplace_back(r0 + e.row(), c0 + j, e.value());
+      }
+    };
+    put(KT, 0, 0);
+    put(Gt, 0, nv);
+    put(GT, nv, 0);
+    const SpMat A = fromTriplets(nv + m, nv + m, a);
+    Eigen::SparseLU<SpMat> lu(A);
+    if (lu.info() != Eigen::Success) {
+      throw ModelError("steady motion: the tangent [K G^T; G 0] is singular (no stiffness holds the state: a free "
+                       "body, or a mechanism without restoring force)");
+    }
+    VecX r(nv + m);
+    r << F.segment(L.v, nv), F.segment(L.lambda, m);
+    const VecX d = lu.solve(-r);
+    if (!d.allFinite()) throw ModelError("steady motion: the Newton correction is not finite");
+    q = sys.applyIncrement(q, d.head(nv));
+    lambda += d.tail(m);
+    step = d.head(nv).lpNorm<Eigen::Infinity>();
+    if (step <= kTolerance * (1.0 + q.lpNorm<Eigen::Infinity>())) {
+      ReferenceState s;
+      s.t = t0;
+      const ConsistentState v = computeConsistentState(sys, t0, q, c.v);
+      s.q = v.q;
+      s.v = v.v;
+      computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
+      return s;
+    }
+  }
+  throw ModelError("steady motion: Newton did not converge in " + std::to_string(kMaxIterations) +
+                   " iterations (last correction " + std::to_string(step) + ")");
+}
+
 LinearizedSystem linearize(const System& sys, const ReferenceState& state) {
   checkState(sys, state);
   const int nq = sys.numCoordinates(), nv = sys.numVelocities(), m = sys.numConstraintEquations();

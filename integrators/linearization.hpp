@@ -27,6 +27,16 @@ struct ReferenceState {
 /// @throws ModelError if the model cannot be assembled or has no equilibrium.
 ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0);
 
+/// A steady motion with constant velocities and zero accelerations (a rotor at constant
+/// speed with its frame origin on the axis, stretched by the centrifugal load): from the
+/// consistent state at t0, Newton iterations on [M 0 - Q(t, q, v) + G^T lambda; g(q, t)] = 0
+/// for q (velocity-space increments, q (+) dx) and lambda at the fixed velocities v, with
+/// the tangent [Kq T, G^T; G, 0] of the DAE Jacobian; then the velocities projected on
+/// the constraints again and a, lambda recomputed (a ~ 0 when the motion is steady).
+/// @throws ModelError naming the residual if it does not converge or the tangent is singular
+/// (a free body: no stiffness holds its position; use referenceStateAt).
+ReferenceState solveSteadyMotion(const System& sys, double t0, const VecX& q0, const VecX& v0);
+
 /// The linearised equations in velocity space (nv unknowns; increments dq = T(q) dx,
 /// q = q_ref (+) dx, Body::applyIncrement), frozen at the reference state:
 ///   M dx'' + C dx' + K dx + G^T dlambda = 0,   G dx = 0,
