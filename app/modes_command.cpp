@@ -52,7 +52,15 @@ struct ModesCommandOptions {
   std::optional<Sweep> sweep;
   bool quiet = false;
   bool steady = false;  ///< --steady: solveSteadyMotion instead of the consistent state
+  EigenSolverKind solver = EigenSolverKind::Automatic;  ///< --solver
 };
+
+EigenSolverKind parseSolver(const std::string& text) {
+  if (text == "auto") return EigenSolverKind::Automatic;
+  if (text == "dense") return EigenSolverKind::Dense;
+  if (text == "sparse") return EigenSolverKind::Sparse;
+  throw cli::UsageError("option --solver expects auto, dense or sparse, got '" + text + "'");
+}
 
 int parseCount(const std::string& text) {
   const double x = cli::parseNumberOption("--count", text);
@@ -90,7 +98,7 @@ Sweep parseSweep(const std::string& text) {
 
 ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
   const cli::SplitArguments split = cli::splitArguments(
-      args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep"}),
+      args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep", "--solver"}),
       cli::withCommon(cli::kCommonFlags, {{"--steady", "--steady"}}), "modes: ");
   ModesCommandOptions o;
   o.quiet = split.flags.count("--quiet") > 0;
@@ -103,6 +111,8 @@ ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
       o.at = cli::parseNumberOption(name, value);
     } else if (name == "--count") {
       o.count = parseCount(value);
+    } else if (name == "--solver") {
+      o.solver = parseSolver(value);
     } else {
       o.sweep = parseSweep(value);
     }
@@ -133,6 +143,14 @@ std::string number(double x) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.12g", x);
   return buf;
+}
+
+/// The sparse solver, and any model too large for the dense one, takes the sparse
+/// (coordinate-partitioning) basis; the others the orthonormal one.
+BasisKind basisFor(const System& sys, EigenSolverKind solver) {
+  const bool sparse = solver == EigenSolverKind::Sparse ||
+                      (solver == EigenSolverKind::Automatic && sys.numVelocities() > kDenseModesLimit);
+  return sparse ? BasisKind::CoordinatePartitioning : BasisKind::Svd;
 }
 
 /// The state at t_start: the consistent state (an equilibrium if at rest), or with
@@ -289,13 +307,14 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
   csv << '\n';
   ModesOptions mo;
   mo.count = o.count;
+  mo.solver = o.solver;
   std::printf("Campbell sweep of \"%s\": %d speeds from %g to %g rad/s\n", cli::oneLine(sw.name).c_str(), sw.points,
               sw.from, sw.to);
   for (int i = 0; i < sw.points; ++i) {
     const double speed = sw.points == 1 ? sw.from : sw.from + (sw.to - sw.from) * i / (sw.points - 1);
     const Scene scene = parseSceneText(withSpeed(base, sw.name, speed).dump(), o.scenePath);
     const System& sys = scene.system;
-    const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo);
+    const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo, basisFor(sys, o.solver));
     csv << number(speed);
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].frequencyHz) : "");
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].dampingRatio) : "");
@@ -344,9 +363,10 @@ int runModesCommand(const std::vector<std::string>& args) {
     const System& sys = scene->system;
     const ReferenceState ref = findReference(*scene, o.at, o.steady, o.quiet);
     const LinearizedSystem lin = linearize(sys, ref);
-    const ReducedSystem red = reduce(lin);
+    const ReducedSystem red = reduce(lin, basisFor(sys, o.solver));
     ModesOptions mo;
     mo.count = o.count;
+    mo.solver = o.solver;
     const std::vector<Mode> modes = computeModes(red, mo);
     writeModesCsv(out / "modes.csv", modes);
     writeShapesCsv(out / "mode_shapes.csv", modes, lin.velocityNames);
