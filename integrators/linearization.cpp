@@ -2,6 +2,11 @@
 
 #include <Eigen/Dense>
 #include <Eigen/SparseLU>
+// GCC 12 warns -Wuse-after-free inside Spectra's UpperHessenbergEigen (Eigen temporaries
+// freed and reallocated by resize): a false positive of its inlining analysis.
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
 #include <Spectra/GenEigsRealShiftSolver.h>
 
 #include <algorithm>
