@@ -14,6 +14,7 @@
 
 #include "core/dae_system.hpp"
 #include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/static_equilibrium.hpp"
@@ -106,6 +107,33 @@ SpMat kinematicTerm(const System& sys, const VecX& q, const VecX& v, const SpMat
   return B;
 }
 
+/// G' = dG/dq [T v] (m x nv, dense): the rate of the constraint Jacobian along the
+/// motion with velocities v, from the analytic curvature H_a = d(G_a^T)/dq of every
+/// constraint: G'_a^T = H_a (T v).
+MatX constraintJacobianRate(const System& sys, const VecX& q, const VecX& v) {
+  MatX out = MatX::Zero(sys.numConstraintEquations(), sys.numVelocities());
+  const VecX Tv = sys.coordinateRates(q, v);
+  ConstraintEvaluation ev;
+  VecX w;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    con.evaluate(sys.constraintStates(ci, q.data()), true, ev);
+    gather(sys.constraintCoordinateColumns(ci), Tv.data(), w);
+    const auto& cols = sys.constraintColumns(ci);
+    const int row = sys.constraintOffset(ci);
+    for (int a = 0; a < con.numEquations(); ++a) {
+      const VecX col = ev.H[a] * w;
+      for (size_t k = 0; k < cols.size(); ++k) out(row + a, cols[k]) += col[static_cast<Eigen::Index>(k)];
+    }
+  }
+  return out;
+}
+
+/// Step of the central difference of G' along the motion, as the angle or length the
+/// fastest velocity covers in it (truncation ~1e-8, rounding ~1e-12 relative).
+constexpr double kRateDifferenceStep = 1e-4;
+
 void checkState(const System& sys, const ReferenceState& s) {
   if (!sys.isFinalized()) throw InputError("linearize: the system must be finalized first");
   const auto bad = [](const VecX& x, int n) { return x.size() != n || !x.allFinite(); };
@@ -139,7 +167,7 @@ SpMat svdBasis(const MatX& G, int& rank) {
   return N.sparseView();
 }
 
-SpMat partitioningBasis(const MatX& G, const std::vector<CoordinateKind>& kinds, int& rank) {
+SpMat partitioningBasis(const MatX& G, const std::vector<CoordinateKind>& kinds, int& rank, std::vector<int>& dep) {
   const int nv = static_cast<int>(G.cols());
   MatX GW = G;
   for (int k = 0; k < nv; ++k) {
@@ -149,7 +177,8 @@ SpMat partitioningBasis(const MatX& G, const std::vector<CoordinateKind>& kinds,
   qr.setThreshold(kRankTolerance);
   rank = G.rows() == 0 ? 0 : static_cast<int>(qr.rank());
   const auto& perm = qr.colsPermutation().indices();
-  std::vector<int> dep(perm.data(), perm.data() + rank), indep(perm.data() + rank, perm.data() + nv);
+  dep.assign(perm.data(), perm.data() + rank);
+  std::vector<int> indep(perm.data() + rank, perm.data() + nv);
   std::sort(dep.begin(), dep.end());
   std::sort(indep.begin(), indep.end());
   MatX Gd(G.rows(), rank), Gi(G.rows(), nv - rank);
@@ -428,18 +457,65 @@ LinearizedSystem linearize(const System& sys, const ReferenceState& state) {
   lin.G = A.block(nv, 0, m, nv);
   lin.velocityNames = sys.velocityNames();
   lin.velocityKinds = sys.velocityKinds();
+  // the rates of G along the reference motion q(t) = q (+) t v (exact for constant v):
+  // G' analytic, G'' by a central difference of G' along it (the one numerical
+  // derivative, a third derivative of the constraints, as in the index-1 Jacobian)
+  const double speed = state.v.lpNorm<Eigen::Infinity>();
+  if (m > 0 && speed > 0.0) {
+    const double h = kRateDifferenceStep / speed;
+    const MatX rate = constraintJacobianRate(sys, state.q, state.v);
+    const MatX plus = constraintJacobianRate(sys, sys.applyIncrement(state.q, h * state.v), state.v);
+    const MatX minus = constraintJacobianRate(sys, sys.applyIncrement(state.q, -h * state.v), state.v);
+    lin.Gdot = rate.sparseView(1e-300);
+    lin.Gddot = ((plus - minus) / (2.0 * h)).sparseView(1e-300);
+  } else {
+    lin.Gdot = SpMat(m, nv);
+    lin.Gddot = SpMat(m, nv);
+  }
   return lin;
 }
 
 ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
   ReducedSystem red;
   const MatX G = lin.G;
-  red.N = basis == BasisKind::Svd ? svdBasis(G, red.rank) : partitioningBasis(G, lin.velocityKinds, red.rank);
+  std::vector<int> dep;
+  red.N = basis == BasisKind::Svd ? svdBasis(G, red.rank) : partitioningBasis(G, lin.velocityKinds, red.rank, dep);
   if (red.N.cols() == 0) throw ModelError("modes: every velocity is constrained (the model has no degree of freedom)");
   const SpMat Nt = red.N.transpose();
   red.M = Nt * lin.M * red.N;
-  red.C = Nt * lin.C * red.N;
-  red.K = Nt * lin.K * red.N;
+  if (lin.Gdot.nonZeros() == 0 && lin.Gddot.nonZeros() == 0) {  // G constant along the reference: N constant
+    red.C = Nt * lin.C * red.N;
+    red.K = Nt * lin.K * red.N;
+    return red;
+  }
+  // G changes along the reference motion: dx = N(t) x with G N = 0 at all times, so
+  // N' = -R G' N and N'' = -R (2 G' N' + G'' N), R a right inverse of G (the dependent rows
+  // of coordinate partitioning, or the pseudo-inverse); then (docs/modes.md)
+  //   Mr x'' + N^T (2 M N' + C N) x' + N^T (M N'' + C N' + K N) x = 0.
+  // R: the dependent rows of coordinate partitioning for either basis. The family N(t) it
+  // defines is N_p(t) C (N_p the partitioning basis, C = const): its independent
+  // coordinates are velocity-space increments of the bodies (body-axes rotations, elastic
+  // coordinates), in which a steady motion's coefficients do not change with time. A
+  // pseudo-inverse would mix world-axes translations into them, turning with the motion.
+  if (dep.empty() && red.rank > 0) {
+    int rank = 0;
+    partitioningBasis(G, lin.velocityKinds, rank, dep);
+  }
+  const auto solveG = [&](const MatX& Y) -> MatX {  // Z with G Z = Y, zero on the independent rows
+    MatX Gd(G.rows(), static_cast<Eigen::Index>(dep.size()));
+    for (size_t k = 0; k < dep.size(); ++k) Gd.col(static_cast<Eigen::Index>(k)) = G.col(dep[k]);
+    const MatX Zd = Gd.colPivHouseholderQr().solve(Y);
+    MatX Z = MatX::Zero(G.cols(), Y.cols());
+    for (size_t k = 0; k < dep.size(); ++k) Z.row(dep[k]) = Zd.row(static_cast<Eigen::Index>(k));
+    return Z;
+  };
+  const MatX N = red.N, Gd1 = lin.Gdot, Gd2 = lin.Gddot;
+  const MatX N1 = -solveG(Gd1 * N);
+  const MatX N2 = -solveG(2.0 * Gd1 * N1 + Gd2 * N);
+  const MatX M = lin.M, C = lin.C, K = lin.K;
+  const MatX NtD = N.transpose();
+  red.C = (NtD * (2.0 * M * N1 + C * N)).sparseView();
+  red.K = (NtD * (M * N2 + C * N1 + K * N)).sparseView();
   return red;
 }
 

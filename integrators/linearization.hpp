@@ -51,6 +51,9 @@ struct LinearizedSystem {
   SpMat M, C, K;  ///< nv x nv
   SpMat G;        ///< m x nv, the velocity Jacobian of the constraints at q
   SpMat B;        ///< nv x nv, the kinematic term (zero for planar models)
+  /// G' and G'' (m x nv): the rates of G along the reference motion q (+) t v (zero at
+  /// rest); reduce() keeps the basis N(t) in the null space of G(t) with them.
+  SpMat Gdot, Gddot;
   std::vector<std::string> velocityNames;
   std::vector<CoordinateKind> velocityKinds;
 };
@@ -65,7 +68,11 @@ enum class BasisKind {
   CoordinatePartitioning  ///< dx = [x; -G_d^-1 G_i x] (rows permuted): sparse, frame coordinates dependent first
 };
 
-/// The reduced equations Mr x'' + Cr x' + Kr x = 0 (Mr = N^T M N, ...) and N.
+/// The reduced equations Mr x'' + Cr x' + Kr x = 0 and N: Mr = N^T M N, Cr = N^T C N,
+/// Kr = N^T K N when G is constant along the reference; otherwise dx = N(t) x with
+/// N' = -R G' N, N'' = -R (2 G' N' + G'' N) (R the right inverse of G of coordinate
+/// partitioning: body-axes increments stay the independent coordinates) and
+/// Cr = N^T (2 M N' + C N), Kr = N^T (M N'' + C N' + K N) (docs/modes.md).
 struct ReducedSystem {
   SpMat M, C, K;  ///< nx x nx
   SpMat N;        ///< nv x nx
