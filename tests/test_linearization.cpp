@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
 #include "integrators/linearization.hpp"
 #include "io/scene.hpp"
@@ -358,4 +360,37 @@ TEST(Linearization, SleepingTopIsStableAboveTheMaxwellKleinSpeedWithItsPrecessio
   record("omega_fast_precession", modes[1].omega, fast);
   EXPECT_NEAR(modes[0].omega / slowPrecession - 1, 0.0, kTopTolerance);
   EXPECT_NEAR(modes[1].omega / fast - 1, 0.0, kTopTolerance);
+}
+
+TEST(Linearization, SpatialFreeFreeBeamHasSixRigidModesAndTheModelsElasticFrequencies) {
+  // FfrBody3d (quaternion frame, T != I) from a free-free (mean-axis) beam model, free in
+  // space: six zero eigenvalues, then the model's frequencies with its frame held fixed
+  BeamSection3d sec;
+  sec.area = kWidth * kHeight;
+  sec.inertiaY = kWidth * kHeight * kHeight * kHeight / 12;
+  sec.inertiaZ = kHeight * kWidth * kWidth * kWidth / 12;
+  sec.torsionConstant = 0.229 * kWidth * kHeight * kHeight * kHeight;  // b/h = 2 (Roark)
+  sec.youngsModulus = kE;
+  sec.shearModulus = kE / 2.6;
+  sec.density = kRho;
+  FfrBeamOptions3d options;
+  options.reference.type = ReferenceConditions3d::Type::FreeFree;
+  const FfrBeamModel3d model(BeamMesh3d::straight(kBeamLength, 6, sec), options, "beam");
+  System sys;
+  FrameState3d frame;
+  frame.orientation = Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+  sys.addBody(std::make_unique<FfrBody3d>("beam", model.invariants(), frame));
+  sys.finalize();
+  ModesOptions o;
+  o.count = 12;
+  const std::vector<Mode> modes = modesAbout(sys, initialReference(sys), o);
+  ASSERT_EQ(modes.size(), 12u);
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(modes[k].omega, 0.0) << "rigid mode " << k;
+  const VecX w = model.naturalFrequencies();
+  // as the planar free-free beam: rounding relative to the highest frequency (~1e4 x the lowest)
+  constexpr double kModelTolerance = 1e-9;
+  for (int k = 0; k < 6; ++k) {
+    record("omega_elastic_" + std::to_string(k + 1), modes[6 + k].omega, w[k]);
+    EXPECT_NEAR(modes[6 + k].omega / w[k] - 1, 0.0, kModelTolerance) << k;
+  }
 }
