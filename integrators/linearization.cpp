@@ -501,21 +501,25 @@ ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
     int rank = 0;
     partitioningBasis(G, lin.velocityKinds, rank, dep);
   }
-  const auto solveG = [&](const MatX& Y) -> MatX {  // Z with G Z = Y, zero on the independent rows
-    MatX Gd(G.rows(), static_cast<Eigen::Index>(dep.size()));
-    for (size_t k = 0; k < dep.size(); ++k) Gd.col(static_cast<Eigen::Index>(k)) = G.col(dep[k]);
-    const MatX Zd = Gd.colPivHouseholderQr().solve(Y);
-    MatX Z = MatX::Zero(G.cols(), Y.cols());
-    for (size_t k = 0; k < dep.size(); ++k) Z.row(dep[k]) = Zd.row(static_cast<Eigen::Index>(k));
-    return Z;
+  MatX Gd(G.rows(), static_cast<Eigen::Index>(dep.size()));
+  for (size_t k = 0; k < dep.size(); ++k) Gd.col(static_cast<Eigen::Index>(k)) = G.col(dep[k]);
+  const Eigen::ColPivHouseholderQR<MatX> GdQr(Gd);
+  // Z with G Z = Y (m x nx), zero on the independent rows: sparse, its m dependent rows dense
+  const auto solveG = [&](const MatX& Y) -> SpMat {
+    const MatX Zd = GdQr.solve(Y);
+    Triplets t;
+    for (size_t k = 0; k < dep.size(); ++k) {
+      for (Eigen::Index j = 0; j < Zd.cols(); ++j) {
+        if (Zd(static_cast<Eigen::Index>(k), j) != 0.0) t.emplace_back(dep[k], j, Zd(static_cast<Eigen::Index>(k), j));
+      }
+    }
+    return fromTriplets(static_cast<int>(G.cols()), static_cast<int>(Y.cols()), t);
   };
-  const MatX N = red.N, Gd1 = lin.Gdot, Gd2 = lin.Gddot;
-  const MatX N1 = -solveG(Gd1 * N);
-  const MatX N2 = -solveG(2.0 * Gd1 * N1 + Gd2 * N);
-  const MatX M = lin.M, C = lin.C, K = lin.K;
-  const MatX NtD = N.transpose();
-  red.C = (NtD * (2.0 * M * N1 + C * N)).sparseView();
-  red.K = (NtD * (M * N2 + C * N1 + K * N)).sparseView();
+  const SpMat& N = red.N;
+  const SpMat N1 = -solveG(MatX(lin.Gdot * N));
+  const SpMat N2 = -solveG(MatX(2.0 * (lin.Gdot * N1) + lin.Gddot * N));
+  red.C = Nt * (2.0 * (lin.M * N1) + lin.C * N);
+  red.K = Nt * (lin.M * N2 + lin.C * N1 + lin.K * N);
   return red;
 }
 
