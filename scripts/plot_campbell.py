@@ -71,6 +71,9 @@ def main():
     for h in zetas:
         az.plot(speed, data[h], "o-", ms=3)
     az.axhline(0.0, color="k", lw=0.8)
+    # at least +-0.05: the rounding noise (~1e-13) of undamped models reads as zero
+    lo, hi = az.get_ylim()
+    az.set_ylim(min(lo, -0.05), max(hi, 0.05))
     az.set_ylabel("damping ratio")
     az.set_xlabel("speed (rad/s)")
     az.grid(True, alpha=0.3)
