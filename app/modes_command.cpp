@@ -16,6 +16,7 @@
 #include "app/command_line.hpp"
 #include "app/plot_command.hpp"
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/linearization.hpp"
@@ -251,11 +252,17 @@ void printTable(const std::vector<Mode>& modes) {
 /// (frame held fixed; FfrBeamModel::naturalFrequencies).
 void printBeamFrequencies(const System& sys, int count) {
   for (int b = 0; b < sys.numBodies(); ++b) {
-    const auto* ffr = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex(b)));
-    if (!ffr || !ffr->beamModel()) continue;
-    const VecX w = ffr->beamModel()->naturalFrequencies();
+    const Body& body = sys.body(BodyIndex(b));
+    VecX w;
+    if (const auto* f2 = dynamic_cast<const FfrBody2d*>(&body); f2 && f2->beamModel()) {
+      w = f2->beamModel()->naturalFrequencies();
+    } else if (const auto* f3 = dynamic_cast<const FfrBody3d*>(&body); f3 && f3->model()) {
+      w = f3->model()->naturalFrequencies();
+    } else {
+      continue;
+    }
     std::printf("beam \"%s\": natural frequencies of its model on its reference conditions (frame fixed), Hz:",
-                cli::oneLine(ffr->name()).c_str());
+                cli::oneLine(body.name()).c_str());
     for (int k = 0; k < std::min<int>(count, static_cast<int>(w.size())); ++k) std::printf(" %.6g", w[k] / (2 * M_PI));
     std::printf("\n");
   }
