@@ -19,6 +19,7 @@
 #include "bodies/ffr_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
+#include "integrators/linearization.hpp"
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
@@ -351,6 +352,42 @@ PYBIND11_MODULE(_flexmbd, m) {
           c.insert(c.end(), n.begin(), n.end());
         }
         return c;
+      })
+      .def(
+          "modes",
+          [](Scene& s, int count, bool steady) {
+            std::vector<Mode> modes;
+            {
+              py::gil_scoped_release release;
+              if (!s.system.isFinalized()) s.system.finalize();
+              const System& sys = s.system;
+              const double t0 = s.solver.tStart;
+              const ReferenceState state =
+                  steady ? solveSteadyMotion(sys, t0, sys.initialCoordinates(), sys.initialVelocities())
+                         : referenceStateAt(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
+              ModesOptions o;
+              o.count = count;
+              modes = modesAbout(sys, state, o);
+            }
+            py::list out;
+            for (const Mode& m : modes) {
+              py::dict d;
+              d["eigenvalue"] = m.eigenvalue;
+              d["omega"] = m.omega;
+              d["frequency_hz"] = m.frequencyHz;
+              d["damping_ratio"] = m.dampingRatio;
+              d["shape"] = Eigen::VectorXcd(m.shape);
+              out.append(d);
+            }
+            return out;
+          },
+          py::arg("count") = 10, py::arg("steady") = false,
+          "Modes of the model linearised about its consistent initial state (static equilibrium if at rest) "
+          "or, steady=True, about the steady motion at its initial velocities (integrators/linearization.hpp): "
+          "dicts of eigenvalue, omega (rad/s), frequency_hz, damping_ratio, shape (velocity space)")
+      .def_property_readonly("velocity_names", [](Scene& s) {
+        if (!s.system.isFinalized()) s.system.finalize();
+        return s.system.velocityNames();
       })
       .def(
           "_run",

@@ -138,6 +138,18 @@ class Scene:
         "deflection" or "energy"): extra result columns."""
         self._native.add_output_json(json.dumps(output), spatial)
 
+    def modes(self, count=10, steady=False):
+        """The model's lowest modes, linearised about its consistent initial state (the static
+        equilibrium if it starts at rest) or, ``steady=True``, about the steady motion at its
+        initial velocities (docs/modes.md): a list of dicts with ``eigenvalue``, ``omega``
+        (rad/s), ``frequency_hz``, ``damping_ratio`` and ``shape`` (complex, one entry per
+        ``velocity_names``)."""
+        return self._native.modes(count, steady)
+
+    @property
+    def velocity_names(self):
+        return self._native.velocity_names
+
     def run(self, progress=False, raise_on_failure=True):
         """Runs the model (the GIL is released: runs in threads go on in parallel).
 

@@ -177,3 +177,19 @@ def test_flexible_body_built_in_python():
     scene.solver.t_end, scene.solver.output_step = 0.01, 0.005
     res = scene.run()
     assert res.ok and "beam.q3" in res and "mid.M" in res
+
+
+def test_modes_of_a_pendulum_built_in_python():
+    # A rigid bar of length L hinged at one end: small oscillations at sqrt(3 g / (2 L)),
+    # the closed form, to the linearisation's round-off (1e-10).
+    L, g = 0.8, 9.81
+    scene = flexmbd.Scene("pendulum")
+    sys = scene.system
+    bar = sys.add_rigid_body("bar", flexmbd.RigidBodyProperties(mass=2.0, inertia=2.0 * L * L / 12, com=(L / 2, 0)),
+                             flexmbd.FrameState2d(angle=-math.pi / 2))
+    sys.add_revolute_joint("pin", "ground", (0, 0), bar, (0, 0))
+    sys.set_gravity((0, -g))
+    modes = scene.modes(count=1)
+    assert len(modes) == 1
+    assert abs(modes[0]["omega"] / math.sqrt(3 * g / (2 * L)) - 1) < 1e-10
+    assert len(modes[0]["shape"]) == len(scene.velocity_names) == 3
