@@ -368,4 +368,38 @@ KinematicSummary analyzeKinematics(const Linkage2d& linkage, const KinematicSett
   return KinematicAnalysis(linkage, settings).run(onStep);
 }
 
+std::vector<std::string> kinematicsColumns(const Linkage2d& linkage) {
+  std::vector<std::string> c = {"step", "alpha", "iterations", "residual", "rcond"};
+  for (int i = 0; i < linkage.numInputs(); ++i) c.push_back(linkage.input(InputIndex(i)).name);
+  for (int i = 0; i < linkage.numNodes(); ++i) {
+    const std::string& n = linkage.node(NodeIndex(i)).name;
+    for (const char* k : {".x", ".y", ".dx_da", ".dy_da", ".d2x_da2", ".d2y_da2", ".vx", ".vy", ".ax", ".ay"}) {
+      c.push_back(n + k);
+    }
+  }
+  for (int k = 0; k < linkage.numLinks(); ++k) {
+    const std::string& n = linkage.link(LinkIndex(k)).name;
+    for (const char* e : {".angle", ".dangle_da", ".d2angle_da2", ".omega", ".omega_dot"}) c.push_back(n + e);
+  }
+  return c;
+}
+
+void kinematicsRow(const Linkage2d& linkage, const KinematicState& s, std::vector<double>& values) {
+  values.clear();
+  values.insert(values.end(), {static_cast<double>(s.step), s.alpha, static_cast<double>(s.iterations), s.residual,
+                               s.rcond});
+  for (int i = 0; i < linkage.numInputs(); ++i) values.push_back(s.x[linkage.input(InputIndex(i)).coordinate]);
+  for (int i = 0; i < linkage.numNodes(); ++i) {
+    const NodeIndex n(i);
+    const Vec2 r = linkage.nodePosition(n, s.x), rp = linkage.nodeDerivative(n, s.xp),
+               rpp = linkage.nodeDerivative(n, s.xpp), v = linkage.nodeDerivative(n, s.v),
+               a = linkage.nodeDerivative(n, s.a);
+    for (const Vec2* p : {&r, &rp, &rpp, &v, &a}) values.insert(values.end(), {p->x(), p->y()});
+  }
+  for (int k = 0; k < linkage.numLinks(); ++k) {
+    const int c = linkage.link(LinkIndex(k)).offset;  // beta1: the link's angle when rigid
+    values.insert(values.end(), {s.x[c], s.xp[c], s.xpp[c], s.v[c], s.a[c]});
+  }
+}
+
 }  // namespace flexmbd

@@ -136,6 +136,13 @@ class KinematicAnalysis {
   int assemblyIterations_ = 0;
 };
 
+/// The columns of a kinematic analysis's table (kinematics.csv): step, alpha, iterations,
+/// residual, rcond; each input; per node x, y, dx_da, dy_da, d2x_da2, d2y_da2, vx, vy,
+/// ax, ay; per link angle, dangle_da, d2angle_da2, omega, omega_dot.
+std::vector<std::string> kinematicsColumns(const Linkage2d& linkage);
+/// One state's row in kinematicsColumns' order, into `values` (cleared).
+void kinematicsRow(const Linkage2d& linkage, const KinematicState& s, std::vector<double>& values);
+
 /// Convenience: KinematicAnalysis(linkage, settings).run(onStep).
 KinematicSummary analyzeKinematics(const Linkage2d& linkage, const KinematicSettings& settings,
                                    const std::function<void(const KinematicState&)>& onStep);

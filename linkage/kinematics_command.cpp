@@ -77,39 +77,23 @@ Options parseOptions(const std::vector<std::string>& args) {
 class KinematicsWriter {
  public:
   KinematicsWriter(const fs::path& path, const Linkage2d& linkage) : linkage_(linkage) {
-    std::ostringstream out_;
-    out_ << "step,alpha,iterations,residual,rcond";
-    for (int i = 0; i < linkage.numInputs(); ++i) out_ << ',' << linkage.input(InputIndex(i)).name;
-    for (int i = 0; i < linkage.numNodes(); ++i) {
-      const std::string& n = linkage.node(NodeIndex(i)).name;
-      for (const char* c : {".x", ".y", ".dx_da", ".dy_da", ".d2x_da2", ".d2y_da2", ".vx", ".vy", ".ax", ".ay"}) {
-        out_ << ',' << n << c;
-      }
-    }
-    for (int k = 0; k < linkage.numLinks(); ++k) {
-      const std::string& n = linkage.link(LinkIndex(k)).name;
-      for (const char* c : {".angle", ".dangle_da", ".d2angle_da2", ".omega", ".omega_dot"}) out_ << ',' << n << c;
-    }
-    out_ << '\n';
-    file_.open(path, out_.str());
+    std::string header;
+    for (const std::string& c : kinematicsColumns(linkage)) header += (header.empty() ? "" : ",") + c;
+    file_.open(path, header + "\n");
   }
 
   /// One row, written whole or not at all (RowFile).
   void write(const KinematicState& s) {
+    kinematicsRow(linkage_, s, values_);
     std::ostringstream out_;
     out_.precision(17);
-    out_ << s.step << ',' << s.alpha << ',' << s.iterations << ',' << s.residual << ',' << s.rcond;
-    for (int i = 0; i < linkage_.numInputs(); ++i) out_ << ',' << s.x[linkage_.input(InputIndex(i)).coordinate];
-    for (int i = 0; i < linkage_.numNodes(); ++i) {
-      const NodeIndex n(i);
-      const Vec2 r = linkage_.nodePosition(n, s.x), rp = linkage_.nodeDerivative(n, s.xp),
-                 rpp = linkage_.nodeDerivative(n, s.xpp), v = linkage_.nodeDerivative(n, s.v),
-                 a = linkage_.nodeDerivative(n, s.a);
-      for (const Vec2* p : {&r, &rp, &rpp, &v, &a}) out_ << ',' << p->x() << ',' << p->y();
-    }
-    for (int k = 0; k < linkage_.numLinks(); ++k) {
-      const int c = linkage_.link(LinkIndex(k)).offset;  // beta1: the link's angle when rigid
-      out_ << ',' << s.x[c] << ',' << s.xp[c] << ',' << s.xpp[c] << ',' << s.v[c] << ',' << s.a[c];
+    for (std::size_t k = 0; k < values_.size(); ++k) {
+      if (k) out_ << ',';
+      if (k == 0 || k == 2) {
+        out_ << static_cast<long>(values_[k]);  // step, iterations: integers
+      } else {
+        out_ << values_[k];
+      }
     }
     out_ << '\n';
     file_.append(out_.str(), s.alpha, "alpha");
@@ -118,6 +102,7 @@ class KinematicsWriter {
  private:
   const Linkage2d& linkage_;
   RowFile file_;
+  std::vector<double> values_;
 };
 
 void writeJson(const fs::path& dir, const nlohmann::json& j) {

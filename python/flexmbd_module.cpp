@@ -23,6 +23,7 @@
 #include "integrators/simulation.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "linkage/kinematics_scene.hpp"
 
 namespace py = pybind11;
 using namespace flexmbd;
@@ -400,6 +401,52 @@ PYBIND11_MODULE(_flexmbd, m) {
             return py::make_tuple(r.columns, table(r), r.summary, r.ok);
           },
           py::arg("progress") = false);
+  // ----- kinematic analysis of linkages (linkage/, document 000) -------------------------
+  m.def(
+      "run_kinematics_text",
+      [](const std::string& text, const std::string& source) {
+        const KinematicsScene scene = parseKinematicsSceneText(text, source);
+        std::vector<std::string> columns = kinematicsColumns(scene.linkage);
+        std::vector<double> data, row;
+        long rows = 0;
+        KinematicSummary sum;
+        {
+          py::gil_scoped_release release;
+          sum = analyzeKinematics(scene.linkage, scene.settings, [&](const KinematicState& st) {
+            kinematicsRow(scene.linkage, st, row);
+            data.insert(data.end(), row.begin(), row.end());
+            ++rows;
+          });
+        }
+        RunOutput r;
+        r.columns = std::move(columns);
+        r.data = std::move(data);
+        r.rows = rows;
+        py::dict summary;
+        summary["status"] = sum.ok ? "ok" : "failed";
+        summary["message"] = sum.message;
+        summary["scene"] = scene.name;
+        summary["steps_completed"] = sum.stepsCompleted;
+        summary["alpha_reached"] = sum.alphaReached;
+        summary["assembly_iterations"] = sum.assemblyIterations;
+        summary["mean_iterations"] = sum.meanIterations;
+        summary["max_residual"] = sum.maxResidual;
+        summary["wall_seconds"] = sum.wallSeconds;
+        if (sum.singular) {
+          py::dict sp;
+          sp["alpha"] = sum.singular->alpha;
+          sp["alpha_regular"] = sum.singular->alphaRegular;
+          sp["kind"] = sum.singular->kind;
+          sp["nodes"] = sum.singular->nodes;
+          sp["links"] = sum.singular->links;
+          summary["singular"] = sp;
+        } else {
+          summary["singular"] = py::none();
+        }
+        return py::make_tuple(r.columns, table(r), summary);
+      },
+      py::arg("text"), py::arg("source") = "<scene>",
+      "A kinematics scene (docs/kinematics.md) analysed: (columns, table, summary dict)");
   m.def(
       "parse_scene_text",
       [](const std::string& text, const std::string& source) {

@@ -44,7 +44,7 @@ from . import _flexmbd
 
 __all__ = [
     "Scene", "Results", "SolverFailure", "InputError", "ModelError", "load_scene", "scene_from_dict",
-    "apply_overrides",
+    "apply_overrides", "run_kinematics",
 ]
 
 
@@ -253,3 +253,26 @@ def load_scene(path, overrides=None):
     except json.JSONDecodeError as e:
         raise InputError(f"{path}: not valid JSON: {e}") from None
     return scene_from_dict(scene_dict, overrides, source=path)
+
+
+def run_kinematics(scene, overrides=None):
+    """The kinematic analysis of a linkage (a kinematics scene file or dict,
+    docs/kinematics.md, with overrides as for load_scene): Results whose columns are those
+    of kinematics.csv (step, alpha, node positions, transfer functions, velocities, ...)
+    and whose summary holds status, message, steps_completed, alpha_reached, singular
+    (the singular position met, or None). A singular position ends the analysis there:
+    status "failed", the rows up to it kept (no exception)."""
+    if isinstance(scene, dict):
+        text, source = json.dumps(apply_overrides(scene, overrides)), "<scene>"
+    else:
+        path = os.fspath(scene)
+        try:
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+        except OSError as e:
+            raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
+        if overrides:
+            text = json.dumps(apply_overrides(json.loads(text), overrides))
+        source = path
+    columns, data, summary = _flexmbd.run_kinematics_text(text, source)
+    return Results(columns, data, summary)

@@ -193,3 +193,20 @@ def test_modes_of_a_pendulum_built_in_python():
     assert len(modes) == 1
     assert abs(modes[0]["omega"] / math.sqrt(3 * g / (2 * L)) - 1) < 1e-10
     assert len(modes[0]["shape"]) == len(scene.velocity_names) == 3
+
+
+def test_kinematics_from_python_equals_the_command_line(tmp_path):
+    # The four-bar's kinematics table: the same columns and numbers as kinematics.csv
+    # (17 significant digits read back exactly).
+    scene = example("kinematics_four_bar.json")
+    out = tmp_path / "kin"
+    r = subprocess.run([CLI, "kinematics", scene, "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    columns, data = read_csv(out / "kinematics.csv")
+    res = flexmbd.run_kinematics(scene)
+    assert res.columns == columns
+    assert np.array_equal(res.data, data)
+    assert res.ok and res.summary["singular"] is None
+    # the locking four-bar stops at its singular position, rows kept
+    lock = flexmbd.run_kinematics(example("kinematics_four_bar_lock.json"))
+    assert not lock.ok and lock.summary["singular"]["kind"] == "lock" and len(lock) > 1
