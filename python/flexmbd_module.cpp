@@ -21,9 +21,11 @@
 #include "core/errors.hpp"
 #include "integrators/linearization.hpp"
 #include "integrators/simulation.hpp"
+#include "io/json_reader.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "linkage/kinematics_scene.hpp"
+#include "tensegrity/tensegrity_scene.hpp"
 
 namespace py = pybind11;
 using namespace flexmbd;
@@ -447,6 +449,75 @@ PYBIND11_MODULE(_flexmbd, m) {
       },
       py::arg("text"), py::arg("source") = "<scene>",
       "A kinematics scene (docs/kinematics.md) analysed: (columns, table, summary dict)");
+  // ----- tensegrity structures (tensegrity/, document 001) --------------------------------
+  m.def(
+      "run_tensegrity_text",
+      [](const std::string& text, const std::string& source) {
+        nlohmann::json j;
+        try {
+          j = nlohmann::json::parse(text);
+        } catch (const nlohmann::json::exception& e) {
+          throw InputError(source + ": not valid JSON: " + e.what());
+        }
+        TensegrityScene scene = jsonread::located(source, [&] { return parseTensegrityScene(j); });
+        RunOutput r;
+        r.columns = tensegrityColumns(*scene.structure);
+        std::vector<double> row;
+        std::vector<TensegrityEvent> events;
+        TensegrityRunSummary sum;
+        {
+          py::gil_scoped_release release;
+          const TensegrityObserver observer{[&](const TensegritySample& smp) {
+                                              tensegrityRow(*scene.structure, smp, row);
+                                              r.data.insert(r.data.end(), row.begin(), row.end());
+                                              ++r.rows;
+                                            },
+                                            [&](const TensegrityEvent& e) { events.push_back(e); }};
+          try {
+            sum = scene.method == TensegrityScene::Method::TimeStepping
+                      ? TensegrityTimeStepper(*scene.structure, scene.timeStepping).run(observer)
+                      : MasslessCableIntegrator(*scene.structure, scene.massless).run(observer);
+          } catch (const InputError&) {
+            throw;
+          } catch (const std::exception& e) {  // a non-finite value, ...: the rows so far are kept
+            sum.ok = false;
+            sum.message = e.what();
+            sum.tReached = r.rows > 0 ? r.data[(r.rows - 1) * r.columns.size()] : 0.0;
+          }
+        }
+        py::dict summary;
+        summary["status"] = sum.ok ? "ok" : "failed";
+        summary["message"] = sum.message;
+        summary["scene"] = scene.name;
+        summary["method"] = sum.method;
+        summary["t_reached"] = sum.tReached;
+        summary["steps"] = sum.steps;
+        summary["cpu_seconds"] = sum.cpuSeconds;
+        summary["snaps"] = sum.snaps;
+        summary["slack_transitions"] = sum.slackTransitions;
+        summary["taut_transitions"] = sum.tautTransitions;
+        summary["contacts"] = sum.contacts;
+        summary["energy_start"] = sum.energyStart;
+        summary["energy_end"] = sum.energyEnd;
+        py::list ev;
+        for (const TensegrityEvent& e : events) {
+          py::dict d;
+          d["t"] = e.t;
+          d["step"] = e.step;
+          d["type"] = toString(e.type);
+          d["member"] = e.member;
+          d["other"] = e.other;
+          d["impulse"] = e.impulse;
+          d["elongation_rate"] = e.elongationRate;
+          d["energy_change"] = e.energyChange;
+          d["point"] = Vec3(e.point);
+          ev.append(d);
+        }
+        summary["events"] = ev;
+        return py::make_tuple(r.columns, table(r), summary);
+      },
+      py::arg("text"), py::arg("source") = "<scene>",
+      "A tensegrity scene (docs/tensegrity.md) run: (columns, table, summary dict with its events)");
   m.def(
       "parse_scene_text",
       [](const std::string& text, const std::string& source) {

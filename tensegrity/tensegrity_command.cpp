@@ -38,59 +38,19 @@ std::string num(double x) {
 class TensegrityResults {
  public:
   TensegrityResults(const std::filesystem::path& dir, const TensegrityStructure& s) : s_(s) {
-    const char* axes[3] = {"x", "y", "z"};
-    std::ostringstream h;
-    h << "t";
-    for (int i = 0; i < s.numNodes(); ++i) {
-      for (int a = 0; a < s.dimension(); ++a) h << "," << s.node(i).name << "." << axes[a];
-    }
-    for (int i = 0; i < s.numNodes(); ++i) {
-      for (int a = 0; a < s.dimension(); ++a) h << "," << s.node(i).name << ".v" << axes[a];
-    }
-    for (int i = 0; i < s.numStruts(); ++i) {
-      const std::string& n = s.strut(i).name;
-      h << "," << n << ".force," << n << ".length";
-    }
-    for (int c = 0; c < s.numCables(); ++c) {
-      const std::string& n = s.cable(c).name;
-      h << "," << n << ".tension," << n << ".slack," << n << ".impulse," << n << ".length";
-    }
-    h << ",energy.kinetic,energy.potential,energy.total\n";
-    results_.open(dir / "results.csv", h.str());
+    std::string header;
+    for (const std::string& c : tensegrityColumns(s)) header += (header.empty() ? "" : ",") + c;
+    results_.open(dir / "results.csv", header + "\n");
     events_.open(dir / "events.csv", "t,step,type,member,other,impulse,elongation_rate,energy_change,x,y,z\n");
   }
   void sample(const TensegritySample& smp) {
-    // A row with a non-finite value is not written: the run stops there (issue 11).
-    const auto check = [&](bool finite, const std::string& what) {
-      if (!finite) throw NonFiniteResult("non-finite " + what + " at t = " + num(smp.t));
-    };
-    check(std::isfinite(smp.t), "time");
-    check(smp.x.allFinite(), "node positions");
-    check(smp.v.allFinite(), "node velocities");
-    for (int c = 0; c < s_.numCables(); ++c) {
-      check(std::isfinite(smp.cableTension[c]) && std::isfinite(smp.cableImpulse[c]) &&
-                std::isfinite(smp.cableLength[c]),
-            "tension, impulse or length of cable \"" + s_.cable(c).name + "\"");
-    }
-    check(std::isfinite(smp.kineticEnergy) && std::isfinite(smp.potentialEnergy) &&
-              std::isfinite(smp.kineticEnergy + smp.potentialEnergy),
-          "energy");
+    tensegrityRow(s_, smp, values_);  // throws NonFiniteResult: the run stops before this row
     std::ostringstream row;
-    row << num(smp.t);
-    for (int k = 0; k < smp.x.size(); ++k) row << "," << num(smp.x[k]);
-    for (int k = 0; k < smp.v.size(); ++k) row << "," << num(smp.v[k]);
-    for (int i = 0; i < s_.numStruts(); ++i) {
-      // N = EA (l - l0) / l0, tension positive (TensegrityStructure::strutForce)
-      const double force = s_.strutForce(smp.x, i), length = s_.strutLength(smp.x, i);
-      check(std::isfinite(force) && std::isfinite(length), "force or length of strut \"" + s_.strut(i).name + "\"");
-      row << "," << num(force) << "," << num(length);
+    for (std::size_t k = 0; k < values_.size(); ++k) {
+      if (k) row << ",";
+      row << num(values_[k]);  // 17 digits; the 0/1 of the slack columns print as 0 and 1
     }
-    for (int c = 0; c < s_.numCables(); ++c) {
-      row << "," << num(smp.cableTension[c]) << "," << (smp.slack[c] ? 1 : 0) << "," << num(smp.cableImpulse[c])
-          << "," << num(smp.cableLength[c]);
-    }
-    row << "," << num(smp.kineticEnergy) << "," << num(smp.potentialEnergy) << ","
-        << num(smp.kineticEnergy + smp.potentialEnergy) << "\n";
+    row << "\n";
     results_.append(row.str(), smp.t);
     ++rows_;
     lastTime_ = smp.t;
@@ -108,6 +68,7 @@ class TensegrityResults {
  private:
   const TensegrityStructure& s_;
   RowFile results_, events_;
+  std::vector<double> values_;
   long rows_ = 0;
   double lastTime_ = NAN;
 };

@@ -74,6 +74,17 @@ struct TensegrityRunSummary {
   long rhsEvals = 0, rootEvals = 0, errorTestFailures = 0, nonlinearConvFailures = 0;
 };
 
+class TensegrityStructure;
+
+/// The columns of a tensegrity run's results table (results.csv): t; every node's
+/// coordinates "<node>.x", ".y" (".z"); their velocities "<node>.vx", ...; per strut
+/// ".force" (N = EA (l - l0) / l0, tension positive), ".length"; per cable ".tension",
+/// ".slack" (0/1), ".impulse", ".length"; energy.kinetic, energy.potential, energy.total.
+std::vector<std::string> tensegrityColumns(const TensegrityStructure& s);
+/// One sample's row in tensegrityColumns' order, into `values` (cleared).
+/// @throws NonFiniteResult naming the quantity and the time if a value is not finite.
+void tensegrityRow(const TensegrityStructure& s, const TensegritySample& sample, std::vector<double>& values);
+
 struct TensegrityObserver {
   std::function<void(const TensegritySample&)> onSample;  ///< may be empty
   std::function<void(const TensegrityEvent&)> onEvent;    ///< may be empty

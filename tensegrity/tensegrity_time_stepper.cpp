@@ -1,4 +1,5 @@
 #include "tensegrity/tensegrity_time_stepper.hpp"
+#include "integrators/simulation.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -13,6 +14,63 @@
 #include "tensegrity/segment_closest_points.hpp"
 
 namespace flexmbd {
+
+std::vector<std::string> tensegrityColumns(const TensegrityStructure& s) {
+  const char* axes[3] = {"x", "y", "z"};
+  std::vector<std::string> c = {"t"};
+  for (int i = 0; i < s.numNodes(); ++i) {
+    for (int a = 0; a < s.dimension(); ++a) c.push_back(s.node(i).name + "." + axes[a]);
+  }
+  for (int i = 0; i < s.numNodes(); ++i) {
+    for (int a = 0; a < s.dimension(); ++a) c.push_back(s.node(i).name + ".v" + axes[a]);
+  }
+  for (int i = 0; i < s.numStruts(); ++i) {
+    c.push_back(s.strut(i).name + ".force");
+    c.push_back(s.strut(i).name + ".length");
+  }
+  for (int k = 0; k < s.numCables(); ++k) {
+    for (const char* e : {".tension", ".slack", ".impulse", ".length"}) c.push_back(s.cable(k).name + e);
+  }
+  c.insert(c.end(), {"energy.kinetic", "energy.potential", "energy.total"});
+  return c;
+}
+
+void tensegrityRow(const TensegrityStructure& s, const TensegritySample& smp, std::vector<double>& values) {
+  // A row with a non-finite value is not written: the run stops there (issue 11).
+  const auto check = [&](bool finite, const std::string& what) {
+    if (!finite) {
+      std::ostringstream t;
+      t.precision(17);
+      t << smp.t;
+      throw NonFiniteResult("non-finite " + what + " at t = " + t.str());
+    }
+  };
+  check(std::isfinite(smp.t), "time");
+  check(smp.x.allFinite(), "node positions");
+  check(smp.v.allFinite(), "node velocities");
+  for (int c = 0; c < s.numCables(); ++c) {
+    check(std::isfinite(smp.cableTension[c]) && std::isfinite(smp.cableImpulse[c]) && std::isfinite(smp.cableLength[c]),
+          "tension, impulse or length of cable \"" + s.cable(c).name + "\"");
+  }
+  check(std::isfinite(smp.kineticEnergy) && std::isfinite(smp.potentialEnergy) &&
+            std::isfinite(smp.kineticEnergy + smp.potentialEnergy),
+        "energy");
+  values.clear();
+  values.push_back(smp.t);
+  values.insert(values.end(), smp.x.data(), smp.x.data() + smp.x.size());
+  values.insert(values.end(), smp.v.data(), smp.v.data() + smp.v.size());
+  for (int i = 0; i < s.numStruts(); ++i) {
+    // N = EA (l - l0) / l0, tension positive (TensegrityStructure::strutForce)
+    const double force = s.strutForce(smp.x, i), length = s.strutLength(smp.x, i);
+    check(std::isfinite(force) && std::isfinite(length), "force or length of strut \"" + s.strut(i).name + "\"");
+    values.insert(values.end(), {force, length});
+  }
+  for (int c = 0; c < s.numCables(); ++c) {
+    values.insert(values.end(),
+                  {smp.cableTension[c], smp.slack[c] ? 1.0 : 0.0, smp.cableImpulse[c], smp.cableLength[c]});
+  }
+  values.insert(values.end(), {smp.kineticEnergy, smp.potentialEnergy, smp.kineticEnergy + smp.potentialEnergy});
+}
 
 std::string toString(TensegrityEvent::Type type) {
   switch (type) {

@@ -44,7 +44,7 @@ from . import _flexmbd
 
 __all__ = [
     "Scene", "Results", "SolverFailure", "InputError", "ModelError", "load_scene", "scene_from_dict",
-    "apply_overrides", "run_kinematics",
+    "apply_overrides", "run_kinematics", "run_tensegrity",
 ]
 
 
@@ -255,6 +255,35 @@ def load_scene(path, overrides=None):
     return scene_from_dict(scene_dict, overrides, source=path)
 
 
+def _scene_text(scene, overrides):
+    """(text, source) of a scene given as a path or a dict, with overrides applied."""
+    if isinstance(scene, dict):
+        return json.dumps(apply_overrides(scene, overrides)), "<scene>"
+    path = os.fspath(scene)
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
+    if overrides:
+        try:
+            text = json.dumps(apply_overrides(json.loads(text), overrides))
+        except json.JSONDecodeError as e:
+            raise InputError(f"{path}: not valid JSON: {e}") from None
+    return text, path
+
+
+def run_tensegrity(scene, overrides=None):
+    """A tensegrity run (a "model": "tensegrity" scene file or dict, docs/tensegrity.md):
+    Results with the columns of its results.csv (node positions and velocities, strut
+    forces, cable tensions, slack flags, impulses, energies) and a summary with the run's
+    statistics and ``events`` (snaps, slack and taut transitions, contacts: dicts with
+    the columns of events.csv). A run that stops early has status "failed", its rows kept."""
+    text, source = _scene_text(scene, overrides)
+    columns, data, summary = _flexmbd.run_tensegrity_text(text, source)
+    return Results(columns, data, summary)
+
+
 def run_kinematics(scene, overrides=None):
     """The kinematic analysis of a linkage (a kinematics scene file or dict,
     docs/kinematics.md, with overrides as for load_scene): Results whose columns are those
@@ -262,17 +291,6 @@ def run_kinematics(scene, overrides=None):
     and whose summary holds status, message, steps_completed, alpha_reached, singular
     (the singular position met, or None). A singular position ends the analysis there:
     status "failed", the rows up to it kept (no exception)."""
-    if isinstance(scene, dict):
-        text, source = json.dumps(apply_overrides(scene, overrides)), "<scene>"
-    else:
-        path = os.fspath(scene)
-        try:
-            with open(path, encoding="utf-8") as f:
-                text = f.read()
-        except OSError as e:
-            raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
-        if overrides:
-            text = json.dumps(apply_overrides(json.loads(text), overrides))
-        source = path
+    text, source = _scene_text(scene, overrides)
     columns, data, summary = _flexmbd.run_kinematics_text(text, source)
     return Results(columns, data, summary)

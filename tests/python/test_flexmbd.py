@@ -210,3 +210,20 @@ def test_kinematics_from_python_equals_the_command_line(tmp_path):
     # the locking four-bar stops at its singular position, rows kept
     lock = flexmbd.run_kinematics(example("kinematics_four_bar_lock.json"))
     assert not lock.ok and lock.summary["singular"]["kind"] == "lock" and len(lock) > 1
+
+
+def test_tensegrity_from_python_equals_the_command_line(tmp_path):
+    # The two-mass tensegrity scene: the same columns and numbers as its results.csv, and
+    # the snap of events.csv among the summary's events.
+    scene = example("tensegrity_two_masses.json")
+    out = tmp_path / "tens"
+    r = subprocess.run([CLI, "run", scene, "--out", str(out), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    columns, data = read_csv(out / "results.csv")
+    res = flexmbd.run_tensegrity(scene)
+    assert res.columns == columns
+    assert np.array_equal(res.data, data)
+    with open(out / "events.csv", newline="") as f:
+        events = list(csv.DictReader(f))
+    assert [e["type"] for e in res.summary["events"]] == [e["type"] for e in events]
+    assert res.summary["snaps"] == sum(e["type"] == "snap" for e in events)
