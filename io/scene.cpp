@@ -178,13 +178,40 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
   } else {
     ref.fail("unknown reference type " + inQuotes(type) + " (expected one of: pinned_pinned, clamped, free_free)");
   }
+  // "reduction": "normal" (default) or "craig_bampton" with its "interface_nodes"
+  const std::string reduction = r.string("reduction", "normal");
+  if (reduction == "craig_bampton") {
+    o.reduction = ModalReduction::CraigBampton;
+    if (!r.has("interface_nodes")) r.fail("missing required key \"interface_nodes\" (with \"reduction\": \"craig_bampton\")");
+    const json& n = r.required("interface_nodes");
+    if (!n.is_array() || n.empty()) {
+      r.fail("key \"interface_nodes\" must be a non-empty array of node indices [i, ...], got " + describe(n));
+    }
+    for (std::size_t k = 0; k < n.size(); ++k) {
+      const std::string label = "interface_nodes[" + std::to_string(k) + "]";
+      const int node = r.index(n[k], label);
+      if (node >= numNodes) {
+        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " does not exist (nodes 0.." +
+               std::to_string(numNodes - 1) + ")");
+      }
+      if (std::find(o.interfaceNodes.begin(), o.interfaceNodes.end(), node) != o.interfaceNodes.end()) {
+        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " is listed twice");
+      }
+      o.interfaceNodes.push_back(node);
+    }
+  } else if (reduction != "normal") {
+    r.fail("key \"reduction\" must be \"normal\" or \"craig_bampton\", got " + inQuotes(reduction));
+  } else if (r.has("interface_nodes")) {
+    r.fail("key \"interface_nodes\" is only allowed with \"reduction\": \"craig_bampton\"");
+  }
   if (r.has("modes")) {
     const json& m = r.required("modes");
     if (m.is_array()) {
       for (std::size_t k = 0; k < m.size(); ++k) o.modeSet.push_back(r.index(m[k], "modes[" + std::to_string(k) + "]"));
       if (o.modeSet.empty()) r.fail("key \"modes\" must list at least one mode");
     } else {
-      o.modes = static_cast<int>(r.integer("modes", 0, 1, kMaxModes));
+      // Craig-Bampton: the fixed-interface modes, 0 (static condensation only) allowed
+      o.modes = static_cast<int>(r.integer("modes", 0, o.reduction == ModalReduction::CraigBampton ? 0 : 1, kMaxModes));
     }
   }
   o.geometricStiffening = r.boolean("geometric_stiffening", false);
