@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bodies/ffr_invariants.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "elements/beam_element_2d.hpp"
 
 namespace flexmbd {
@@ -35,17 +36,6 @@ struct ReferenceConditions {
   Type type = Type::PinnedPinned;
   int nodeA = 0;
   int nodeB = -1;  ///< pinned-pinned only; -1: the last node
-};
-
-/// How the elastic coordinates are reduced (docs/flexible-bodies.md).
-enum class ModalReduction {
-  /// Normal modes under the reference conditions (`modes` / `modeSet`; none: nodal).
-  Normal,
-  /// Craig-Bampton: one static constraint mode per interface coordinate (every nodal
-  /// coordinate of the `interfaceNodes` not already held by the reference conditions),
-  /// then `modes` (or `modeSet`) fixed-interface normal modes (0: static condensation
-  /// only, Guyan).
-  CraigBampton,
 };
 
 struct FfrBeamOptions {

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "bodies/ffr_beam_model.hpp"  // ModalReduction
 #include "bodies/ffr_invariants_3d.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "elements/beam_element_3d.hpp"
 
 namespace flexmbd {
@@ -59,7 +59,7 @@ struct FfrBeamOptions3d {
   /// chosen set instead. Craig-Bampton: the fixed-interface modes (0: Guyan).
   int modes = 0;
   std::vector<int> modeSet;
-  /// Normal modes, or Craig-Bampton (ModalReduction, bodies/ffr_beam_model.hpp): one
+  /// Normal modes, or Craig-Bampton (ModalReduction, bodies/modal_reduction.hpp): one
   /// static constraint mode per coordinate of the `interfaceNodes` (6 per node) not
   /// already held by the reference conditions, then the fixed-interface modes.
   ModalReduction reduction = ModalReduction::Normal;

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"

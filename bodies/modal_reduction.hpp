@@ -14,6 +14,18 @@
 
 namespace flexmbd {
 
+/// How the elastic coordinates are reduced (FfrBeamOptions, FfrBeamOptions3d;
+/// docs/flexible-bodies.md).
+enum class ModalReduction {
+  /// Normal modes under the reference conditions (`modes` / `modeSet`; none: nodal).
+  Normal,
+  /// Craig-Bampton: one static constraint mode per interface coordinate (every nodal
+  /// coordinate of the `interfaceNodes` not already held by the reference conditions),
+  /// then `modes` (or `modeSet`) fixed-interface normal modes (0: static condensation
+  /// only, Guyan).
+  CraigBampton,
+};
+
 /// The 1-based mode numbers to keep: `set` if it is not empty, else 1..count (none for
 /// count 0).
 /// @throws InputError naming `owner`: count < 0, a number < 1, a number chosen twice.
