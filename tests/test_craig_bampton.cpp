@@ -26,13 +26,15 @@ namespace {
 // Static responses of the nodal and the reduced model to the same loads: two dense
 // Cholesky solves of K_ff (cond(K_ff) ~ 1e8 for these steel beams: axial EA/l against
 // rotational EI/l entries), so the round-off is ~eps cond ~ 1e-8 of the largest entry
-// in the worst coordinate; measured below 2e-10 (relative to the largest displacement).
+// in the worst coordinate; measured <= 6e-12 (relative to the largest displacement).
 constexpr double kStaticTol = 1e-8;
 // Section forces from those displacements: the element stiffness times the nodal
-// displacements, differences of nearly equal nodal values (axial: EA (u2 - u1) / l),
-// so the round-off above grows by the ratio of the largest to the smallest stiffness
-// term; measured below 1e-8 relative to the largest section force.
-constexpr double kSectionTol = 1e-7;
+// displacements. The displacement round-off (~1e-11 of the largest, a bending
+// displacement) is relative to the bending field, while the axial displacements of
+// these slender steel frames are ~1e-5 of it (ratio ~ EI / (EA L^2)); the axial force
+// EA (u2 - u1) / l thus carries a relative round-off ~1e-6: measured <= 3.5e-7 (planar
+// clamped L-frame), 1e-10 elsewhere.
+constexpr double kSectionTol = 1e-5;
 // Frequencies of the same generalized eigenproblem computed in two bases: round-off
 // ~eps lambda_max / lambda_k, below 1e-9 for these meshes.
 constexpr double kFrequencyTol = 1e-9;
@@ -101,10 +103,17 @@ SpMat projection(const Model& nodal, const Model& reduced) {
   return P.sparseView();
 }
 
-double relDiff(const MatX& a, const MatX& b) {
-  const double s = std::max(a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff());
+/// Largest entry of a - b relative to the largest entry of a, b, or to `scale` if that
+/// is larger (blocks that vanish, e.g. S-bar under mean-axis conditions, hold only
+/// round-off: they are compared on the scale they would have).
+double relDiff(const MatX& a, const MatX& b, double scale = 0.0) {
+  const double s = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), scale});
   return s > 0 ? (a - b).cwiseAbs().maxCoeff() / s : 0.0;
 }
+
+/// The scale of int rho f N dV for a weight f with int rho f^2 dV = fSquared: by
+/// Cauchy-Schwarz |int rho f N q dV| <= sqrt(fSquared q^T m_ff q).
+double inertiaScale(double fSquared, const SpMat& mff) { return std::sqrt(fSquared * MatX(mff).diagonal().maxCoeff()); }
 
 }  // namespace
 
@@ -190,7 +199,7 @@ TEST(CraigBampton, PlanarFixedInterfaceFrequenciesAreThoseOfTheHeldInterface) {
   EXPECT_LT(relDiff(Kc.bottomRightCorner(5, 5), MatX(w.cwiseAbs2().asDiagonal())), kFrequencyTol);
   EXPECT_LT(Kc.topRightCorner(nc, 5).norm(), kFrequencyTol * Kc.norm());
   // and the continuum: clamped-clamped bending 4.7300^2 sqrt(EI / rho A) / L^2; 8 Hermite
-  // elements converge as h^4 (measured 2e-6)
+  // elements converge as h^4 (measured 7e-5)
   const BeamSection s = steel8mm();
   const double w1 = 22.3733 * std::sqrt(s.youngsModulus * s.inertia / s.massPerLength()) / (0.3 * 0.3);
   EXPECT_NEAR(w[0], w1, 1e-4 * w1);
@@ -206,9 +215,10 @@ TEST(CraigBampton, PlanarInvariantsAreTheProjectionOfTheNodalInvariants) {
     const FfrInvariants& c = cb.invariants();
     const std::string what = name(type);
     EXPECT_EQ(c.mass, p.mass) << what;
-    EXPECT_LT(relDiff(c.sBar, p.sBar), kProjectionTol) << what;
-    EXPECT_LT(relDiff(c.i1, p.i1), kProjectionTol) << what;
-    EXPECT_LT(relDiff(c.j0, p.j0), kProjectionTol) << what;
+    const double sBarScale = inertiaScale(c.mass, c.mff), momentScale = inertiaScale(c.polarMoment, c.mff);
+    EXPECT_LT(relDiff(c.sBar, p.sBar, sBarScale), kProjectionTol) << what;
+    EXPECT_LT(relDiff(c.i1, p.i1, momentScale), kProjectionTol) << what;
+    EXPECT_LT(relDiff(c.j0, p.j0, momentScale), kProjectionTol) << what;
     EXPECT_LT(relDiff(MatX(c.mff), MatX(p.mff)), kProjectionTol) << what;
     EXPECT_LT(relDiff(MatX(c.sTilde), MatX(p.sTilde)), kProjectionTol) << what;
     EXPECT_LT(relDiff(MatX(c.kff), MatX(p.kff)), kProjectionTol) << what;
@@ -365,9 +375,10 @@ TEST(CraigBampton, SpatialBasisHoldsTheStaticResponseAndIsTheProjection) {
     // invariants: the projection of the nodal ones
     const FfrInvariants3d p = nodal.invariants().transformed(projection(nodal, cb));
     const FfrInvariants3d& c = cb.invariants();
-    EXPECT_LT(relDiff(c.sBar, p.sBar), kProjectionTol) << name(type);
+    EXPECT_LT(relDiff(c.sBar, p.sBar, inertiaScale(c.mass, c.mff)), kProjectionTol) << name(type);
     for (int k = 0; k < 3; ++k) {
-      EXPECT_LT(relDiff(c.positionShape[k], p.positionShape[k]), kProjectionTol) << name(type);
+      const double scale = inertiaScale(c.secondMoment(k, k), c.mff);
+      EXPECT_LT(relDiff(c.positionShape[k], p.positionShape[k], scale), kProjectionTol) << name(type);
       for (int l = 0; l < 3; ++l) EXPECT_LT(relDiff(MatX(c.sKL[k][l]), MatX(p.sKL[k][l])), kProjectionTol) << name(type);
     }
     EXPECT_LT(relDiff(MatX(c.mff), MatX(p.mff)), kProjectionTol) << name(type);
