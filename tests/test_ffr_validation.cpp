@@ -323,9 +323,16 @@ namespace {
 
 /// The midspan axial force mid.N of the elastic slider-crank's rod (8 elements) at every
 /// output time of one revolution (rtol 1e-6), the rod reduced as `rod` says.
+// Stiffness-proportional damping beta (s) of the rod: the crank starts at full speed, which
+// sets the rod's axial modes (>= 26,000 rad/s) ringing with ~1000 N; with beta = 2e-5 s
+// they decay at beta omega^2 / 2 >= 7,000 1/s (damping ratio >= 0.26) while the first
+// bending mode (1,277 rad/s) keeps a damping ratio of 1.3 %.
+constexpr double kAxialDamping = 2e-5;
+
 std::vector<double> midspanAxialForce(const nlohmann::json& rodKeys, long* steps = nullptr) {
   nlohmann::json j = testmodels::elasticSliderCrankJson();
   for (auto it = rodKeys.begin(); it != rodKeys.end(); ++it) j["bodies"][1][it.key()] = it.value();
+  j["bodies"][1]["section"]["damping"] = kAxialDamping;
   j["solver"]["t_end"] = 2 * M_PI / 150.0;
   Scene s = parseScene(j);
   s.solver.progress = false;
@@ -342,39 +349,42 @@ std::vector<double> midspanAxialForce(const nlohmann::json& rodKeys, long* steps
 
 TEST(FfrSliderCrank, CraigBamptonRodGivesTheMidspanAxialForce) {
   // The joint loads stretch the rod; the normal modes of the pinned-pinned rod (bending
-  // up to mode 4, the first axial mode is the 5th at ~26,000 rad/s) carry no axial
-  // strain, so their section force N is zero. Craig-Bampton with the joint nodes 0 and 8
-  // as interface (constraint modes psi_0, ux_8, psi_8) and 4 fixed-interface modes holds
-  // the static stretch by the joint loads; the rest of N(mid) is the quasi-static
-  // response to the rod's own axial inertia, which only the (clamped-clamped) axial
-  // fixed-interface modes at >= 52,000 rad/s would add.
-  long steps[4];
-  const std::vector<double> nodal = midspanAxialForce(nlohmann::json::object(), &steps[0]);
-  const std::vector<double> cb = midspanAxialForce(
-      {{"reduction", "craig_bampton"}, {"interface_nodes", {0, 8}}, {"modes", 4}}, &steps[1]);
-  const std::vector<double> normal4 = midspanAxialForce({{"modes", 4}}, &steps[2]);
-  const std::vector<double> normal7 = midspanAxialForce({{"modes", 7}}, &steps[3]);
-  ASSERT_EQ(cb.size(), nodal.size());
-  ASSERT_EQ(normal4.size(), nodal.size());
-  ASSERT_EQ(normal7.size(), nodal.size());
+  // up to mode 4; the first axial mode, fixed-free, is the 5th at ~26,000 rad/s) carry
+  // no axial strain, so with 4 of them the section force N is zero. Craig-Bampton with
+  // the joint nodes 0 and 8 as interface (constraint modes psi_0, ux_8, psi_8) holds the
+  // static stretch by the joint loads exactly; what it misses is the quasi-static
+  // response to the rod's own, non-uniform axial inertia (the linear constraint mode
+  // gives a uniform N), which the clamped-clamped axial fixed-interface mode (the 6th,
+  // ~52,800 rad/s) adds.
+  const nlohmann::json none = nlohmann::json::object();
+  const std::vector<double> nodal = midspanAxialForce(none);
   double peak = 0;
   for (double n : nodal) peak = std::max(peak, std::abs(n));
   auto error = [&](const std::vector<double>& N) {
+    EXPECT_EQ(N.size(), nodal.size());
     double e = 0;
-    for (size_t k = 0; k < N.size(); ++k) e = std::max(e, std::abs(N[k] - nodal[k]));
+    for (size_t k = 0; k < std::min(N.size(), nodal.size()); ++k) e = std::max(e, std::abs(N[k] - nodal[k]));
     return e / peak;
   };
-  const double eCb = error(cb), e4 = error(normal4), e7 = error(normal7);
-  std::printf("[ measured ] midspan axial force, one revolution: nodal peak |N| %.1f N (%ld steps); largest error "
-              "relative to it: Craig-Bampton 3 + 4 modes %.2f%% (%ld steps), 4 normal modes %.1f%% (%ld steps), "
-              "7 normal modes %.1f%% (%ld steps)\n",
-              peak, steps[0], 100 * eCb, steps[1], 100 * e4, steps[2], 100 * e7, steps[3]);
+  auto craigBampton = [](int modes) {
+    return nlohmann::json{{"reduction", "craig_bampton"}, {"interface_nodes", {0, 8}}, {"modes", modes}};
+  };
+  long steps[4];
+  const double cb4 = error(midspanAxialForce(craigBampton(4), &steps[0]));
+  const double cb6 = error(midspanAxialForce(craigBampton(6), &steps[1]));
+  const double normal4 = error(midspanAxialForce({{"modes", 4}}, &steps[2]));
+  const double normal7 = error(midspanAxialForce({{"modes", 7}}, &steps[3]));
+  std::printf("[ measured ] midspan axial force over one revolution, nodal peak |N| %.1f N; largest error relative "
+              "to it: Craig-Bampton 3 + 4 modes %.2f%% (%ld steps), 3 + 6 modes %.2f%% (%ld steps); normal modes: "
+              "4 %.1f%% (%ld steps), 7 %.2f%% (%ld steps)\n",
+              peak, 100 * cb4, steps[0], 100 * cb6, steps[1], 100 * normal4, steps[2], 100 * normal7, steps[3]);
   // the axial force is hundreds of newtons (slider and rod inertia at 150 rad/s)
-  EXPECT_GT(peak, 100.0);
-  // Craig-Bampton: within kCbAxialForceTolerance of the nodal model (the measured figure
-  // above; the bound leaves room for the integrator's error at rtol 1e-6)
-  constexpr double kCbAxialForceTolerance = 0.1;
-  EXPECT_LT(eCb, kCbAxialForceTolerance);
+  EXPECT_GT(peak, 300.0);
+  // Craig-Bampton, measured 8.8 % (4 modes) and 1.9 % (6 modes: with the axial
+  // fixed-interface mode); the bounds leave room for the integrator's error (rtol 1e-6)
+  constexpr double kCb4AxialForceTolerance = 0.10, kCb6AxialForceTolerance = 0.025;
+  EXPECT_LT(cb4, kCb4AxialForceTolerance);
+  EXPECT_LT(cb6, kCb6AxialForceTolerance);
   // 4 normal modes: N = 0 throughout (error 100 %)
-  EXPECT_GT(e4, 0.99);
+  EXPECT_GT(normal4, 0.99);
 }
