@@ -165,6 +165,9 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
   if (!craigBampton && !options_.interfaceNodes.empty()) {
     throw InputError(owner + ": interface nodes are for the craig_bampton reduction only");
   }
+  if (options_.inertiaModes && !craigBampton && keep.empty()) {
+    throw InputError(owner + ": inertia modes need a modal reduction (modes, or the craig_bampton reduction)");
+  }
   if (craigBampton || !keep.empty()) {
     FfrInvariants reduced = nodal.transformed(B);
     reduced.validate(owner);  // names a rigid mode left by the reference conditions
@@ -178,6 +181,15 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
       P = std::move(cb.basis);
     } else {
       P = normalModes(MatX(reduced.kff), MatX(reduced.mff), keep, owner);  // mass-normalised
+    }
+    if (options_.inertiaModes) {
+      // inertia loads of the frame's rigid motion on q_f at q_f = 0 (Q_v, Q_g in
+      // docs/flexible-bodies.md): translation S-bar^T, centrifugal I1, angular J0
+      MatX F(reduced.numElastic(), 4);
+      F << reduced.sBar.transpose(), reduced.i1, reduced.j0;
+      const int before = static_cast<int>(P.cols());
+      P = withStaticModes(reduced.kff, reduced.mff, P, F);
+      numInertiaModes_ = static_cast<int>(P.cols()) - before;
     }
     B = (B * P).sparseView();
   }

@@ -48,6 +48,11 @@ struct FfrBeamOptions {
   ModalReduction reduction = ModalReduction::Normal;
   /// Craig-Bampton only (required there): the interface nodes, e.g. the joints' nodes.
   std::vector<int> interfaceNodes;
+  /// With a reduction: add the static responses to the inertia loads of the frame's rigid
+  /// motion (translation S-bar^T, centrifugal I1, angular acceleration J0; at most 4),
+  /// so that the quasi-static deformation by the body's own inertia is held exactly
+  /// (withStaticModes, bodies/modal_reduction.hpp).
+  bool inertiaModes = false;
   /// Second-order axial strain in the strain energy (stiffening by axial load), as the
   /// element-averaged membrane strain u' + (1/2l) int v'^2 dx (locking-free); off: the
   /// linear FFR model (docs/flexible-bodies.md).
@@ -79,6 +84,9 @@ class FfrBeamModel {
   /// Craig-Bampton: the natural frequencies (rad/s) of the kept fixed-interface modes
   /// (interface held), which are q_nc+1..; empty for the other reductions.
   const VecX& fixedInterfaceFrequencies() const { return fixedInterfaceFrequencies_; }
+  /// The number of inertia modes (FfrBeamOptions::inertiaModes), the last elastic
+  /// coordinates; 0 without them.
+  int numInertiaModes() const { return numInertiaModes_; }
 
   double strainEnergy(const VecX& qf) const;
   VecX strainEnergyGradient(const VecX& qf) const;
@@ -116,6 +124,7 @@ class FfrBeamModel {
   FfrInvariants invariants_;
   std::vector<int> constraintDofs_;  // Craig-Bampton: nodal coordinate of each constraint mode
   VecX fixedInterfaceFrequencies_;   // Craig-Bampton: of the kept fixed-interface modes
+  int numInertiaModes_ = 0;
 };
 
 }  // namespace flexmbd

@@ -246,6 +246,9 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
   if (!craigBampton && !options_.interfaceNodes.empty()) {
     throw InputError(owner + ": interface nodes are for the craig_bampton reduction only");
   }
+  if (options_.inertiaModes && !craigBampton && keep.empty()) {
+    throw InputError(owner + ": inertia modes need a modal reduction (modes, or the craig_bampton reduction)");
+  }
   if (craigBampton || !keep.empty()) {
     FfrInvariants3d reduced = nodal.transformed(B);
     reduced.validate(owner);  // names a rigid mode left by the reference conditions
@@ -259,6 +262,19 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
       P = std::move(cb.basis);
     } else {
       P = normalModes(MatX(reduced.kff), MatX(reduced.mff), keep, owner);  // mass-normalised
+    }
+    if (options_.inertiaModes) {
+      // inertia loads of the frame's rigid motion on q_f at q_f = 0: translation S-bar^T,
+      // and int rho N^T (W u0) dV for every 3 x 3 W (alpha~ + omega~ omega~ spans them):
+      // the columns int rho N_l^T u0_k = row l of positionShape[k]
+      MatX F(reduced.mff.rows(), 12);
+      F.leftCols(3) = reduced.sBar.transpose();
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l < 3; ++l) F.col(3 + 3 * k + l) = reduced.positionShape[k].row(l).transpose();
+      }
+      const int before = static_cast<int>(P.cols());
+      P = withStaticModes(reduced.kff, reduced.mff, P, F);
+      numInertiaModes_ = static_cast<int>(P.cols()) - before;
     }
     B = SpMat((B * P).sparseView());
   }

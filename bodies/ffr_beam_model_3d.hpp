@@ -65,6 +65,10 @@ struct FfrBeamOptions3d {
   ModalReduction reduction = ModalReduction::Normal;
   /// Craig-Bampton only (required there): the interface nodes, e.g. the joints' nodes.
   std::vector<int> interfaceNodes;
+  /// With a reduction: add the static responses to the inertia loads of the frame's rigid
+  /// motion (translation S-bar^T, and int rho N^T u0_k of every linear field W u0 of
+  /// the rotation's accelerations alpha x u0 + omega x (omega x u0): at most 12).
+  bool inertiaModes = false;
   /// Element-averaged second-order membrane strain in the strain energy (BeamElement3d,
   /// locking-free); off: the linear FFR model.
   bool geometricStiffening = false;
@@ -97,6 +101,9 @@ class FfrBeamModel3d {
   /// Craig-Bampton: natural frequencies (rad/s) of the kept fixed-interface modes
   /// (q_nc+1..); empty for the other reductions.
   const VecX& fixedInterfaceFrequencies() const { return fixedInterfaceFrequencies_; }
+  /// The number of inertia modes (FfrBeamOptions3d::inertiaModes), the last elastic
+  /// coordinates; 0 without them.
+  int numInertiaModes() const { return numInertiaModes_; }
 
   /// Strain energy U(q_f) (J), the sum of the elements' (BeamElement3d::strainEnergy).
   double strainEnergy(const VecX& qf) const;
@@ -135,6 +142,7 @@ class FfrBeamModel3d {
   FfrInvariants3d invariants_;
   std::vector<int> constraintDofs_;  // Craig-Bampton: nodal coordinate of each constraint mode
   VecX fixedInterfaceFrequencies_;   // Craig-Bampton: of the kept fixed-interface modes
+  int numInertiaModes_ = 0;
 };
 
 }  // namespace flexmbd

@@ -117,4 +117,32 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
   return cb;
 }
 
+MatX withStaticModes(const SpMat& K, const SpMat& M, const MatX& basis, const MatX& F) {
+  const Eigen::SimplicialLDLT<SpMat> ldlt(K);
+  MatX Y = ldlt.solve(F);  // static responses K y = f
+  double largest = 0.0;    // strain energy scale y^T K y of the largest static response
+  for (int j = 0; j < Y.cols(); ++j) largest = std::max(largest, Y.col(j).dot(K * Y.col(j)));
+  if (!(largest > 0.0)) return basis;
+  if (basis.cols() > 0) {  // Y - B (B^T K B)^-1 B^T K Y: the part K-orthogonal to the basis
+    const MatX KB = K * basis;
+    const MatX Kbb = basis.transpose() * KB;
+    Y -= basis * Kbb.ldlt().solve(KB.transpose() * Y);
+  }
+  const MatX KY = K * Y;
+  const MatX Kyy = 0.5 * (Y.transpose() * KY + KY.transpose() * Y);
+  const Eigen::SelfAdjointEigenSolver<MatX> es(Kyy);
+  std::vector<int> kept;
+  for (int k = 0; k < Kyy.rows(); ++k) {
+    if (es.eigenvalues()[k] > 1e-12 * largest) kept.push_back(k);
+  }
+  MatX out(basis.rows(), basis.cols() + static_cast<Eigen::Index>(kept.size()));
+  out.leftCols(basis.cols()) = basis;
+  for (size_t k = 0; k < kept.size(); ++k) {
+    VecX y = Y * es.eigenvectors().col(kept[k]);
+    y /= std::sqrt(y.dot(M * y));  // mass-normalised
+    out.col(basis.cols() + static_cast<Eigen::Index>(k)) = y;
+  }
+  return out;
+}
+
 }  // namespace flexmbd

@@ -74,4 +74,12 @@ struct CraigBamptonBasis {
 CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& G, const std::vector<int>& keep,
                                     const std::string& owner);
 
+/// The basis (columns) extended by the static responses K^-1 F to the load vectors F
+/// (columns), less what it already holds: modal truncation augmentation (Dickens,
+/// Nakagawa & Wittbrodt, Comput. Struct. 62(6), 1997). Y = K^-1 F is made K-orthogonal
+/// to the basis, then K-orthogonalised within itself (eigenvectors of Y^T K Y); parts
+/// with a strain energy below 1e-12 of the largest static response's are dropped
+/// (already held, or a zero load); the new columns are mass-normalised.
+MatX withStaticModes(const SpMat& K, const SpMat& M, const MatX& basis, const MatX& F);
+
 }  // namespace flexmbd

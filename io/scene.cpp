@@ -215,6 +215,10 @@ FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
     }
   }
   o.geometricStiffening = r.boolean("geometric_stiffening", false);
+  o.inertiaModes = r.boolean("inertia_modes", false);
+  if (o.inertiaModes && o.reduction == ModalReduction::Normal && o.modes == 0 && o.modeSet.empty()) {
+    r.fail("key \"inertia_modes\" needs a modal reduction (\"modes\", or \"reduction\": \"craig_bampton\")");
+  }
   return o;
 }
 

@@ -591,6 +591,20 @@ TEST(SceneParse, CraigBamptonReductionKeys) {
   n["bodies"][0].erase("interface_nodes");
   n["bodies"][0]["modes"] = 0;
   EXPECT_TRUE(Mentions(errorOf(n), {"bodies[0] (\"beam\")", "\"modes\"", ">= 1"}));
+
+  // inertia modes: with a reduction only; 4 more coordinates on this straight beam
+  json i = j;
+  i["bodies"][0]["inertia_modes"] = true;
+  EXPECT_EQ(parseScene(i).system.numCoordinates(), 3 + 2 + 4);
+  i["bodies"][0]["reduction"] = "craig_bampton";
+  i["bodies"][0]["interface_nodes"] = {0, 4};
+  EXPECT_EQ(parseScene(i).system.numCoordinates(), 3 + 5 + 4);
+  i["bodies"][0]["inertia_modes"] = "yes";
+  EXPECT_TRUE(Mentions(errorOf(i), {"bodies[0] (\"beam\")", "\"inertia_modes\"", "true or false"}));
+  json nodal = json::parse(R"({"bodies": [{"name": "beam", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "density": 7850},
+      "beam": {"length": 1.0, "elements": 4}, "reference": {"type": "pinned_pinned"}, "inertia_modes": true}]})");
+  EXPECT_TRUE(Mentions(errorOf(nodal), {"bodies[0] (\"beam\")", "\"inertia_modes\"", "needs a modal reduction"}));
 }
 
 TEST(SceneParse, ToleranceClassesAndIntegrator) {
