@@ -4,7 +4,10 @@
 //  - normal modes of K phi = omega^2 M phi;
 //  - Craig-Bampton: static constraint modes (unit displacement of each interface
 //    coordinate, the rest statically condensed) and fixed-interface normal modes (the
-//    interface held). docs/flexible-bodies.md, "Craig-Bampton reduction".
+//    interface held). docs/flexible-bodies.md, "Craig-Bampton reduction";
+//  - static modes appended to either basis (the inertia modes: static responses to the
+//    inertia loads of the frame's rigid motion), docs/flexible-bodies.md, "Section
+//    forces of reduced bodies".
 #pragma once
 
 #include <string>
