@@ -180,10 +180,6 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
   return kExitInputError;
 }
 
-double cpuSecondsSince(std::clock_t start) {
-  return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
-}
-
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (tensegrity/tensegrity_command.cpp)
     if (o.format != ResultsFormat::Csv) {
@@ -240,32 +236,17 @@ int runCommand(const Options& o) {
 
   // ----- the run -----
   installStopHandlers();
-  const std::clock_t start = std::clock();
   SimulationSummary summary;
   try {
-    summary = simulate(scene->system, scene->solver,
-                       [&](const OutputSample& sample) {
-                         writer->write(sample);
-                         if (vtk) vtk->write(sample);
-                         stopIfSignalled(sample.t);
-                       });
+    summary = simulateKeepingFailures(scene->system, scene->solver, [&](const OutputSample& sample) {
+      writer->write(sample);
+      if (vtk) vtk->write(sample);
+      stopIfSignalled(sample.t);
+    });
   } catch (const InputError& e) {
     // Includes ModelError: the model cannot be set up (assembly, redundant or
     // conflicting constraints). Nothing was integrated.
     return reportInputError(outDir, o.scenePath + ": " + e.what());
-  } catch (const SolverError& e) {
-    summary = SimulationSummary{};
-    summary.ok = false;
-    summary.message = e.what();
-    summary.tReached = e.time();
-    summary.stats.lastStepSize = e.stepSize();
-    summary.cpuSeconds = cpuSecondsSince(start);
-  } catch (const std::exception& e) {
-    summary = SimulationSummary{};
-    summary.ok = false;
-    summary.message = e.what();
-    summary.tReached = writer->lastTime();
-    summary.cpuSeconds = cpuSecondsSince(start);
   }
 
   for (const std::string& w : summary.warnings) std::cerr << "flexmbd: warning: " << oneLine(w) << std::endl;

@@ -321,11 +321,11 @@ FfrBeamModel3d::ElementBasis FfrBeamModel3d::makeElementBasis(int e) const {
   return eb;
 }
 
-BeamElement3d::Vec12 FfrBeamModel3d::elementCoordinates(int e, const VecX& qf) const {
+BeamElement3d::Vec12 FfrBeamModel3d::elementCoordinates(int e, const ConstVecRef& qf) const {
   const ElementBasis& eb = elementBases_[e];
-  VecX ql(eb.cols.size());
-  for (size_t k = 0; k < eb.cols.size(); ++k) ql[k] = qf[eb.cols[k]];
-  return elements_[e].transformation() * (eb.B * ql);
+  BeamElement3d::Vec12 u = BeamElement3d::Vec12::Zero();  // B q_f over the element's columns
+  for (size_t k = 0; k < eb.cols.size(); ++k) u += eb.B.col(static_cast<Eigen::Index>(k)) * qf[eb.cols[k]];
+  return elements_[e].transformation() * u;
 }
 
 double FfrBeamModel3d::strainEnergy(const VecX& qf) const {
@@ -361,6 +361,44 @@ SpMat FfrBeamModel3d::strainEnergyHessian(const VecX& qf) const {
   SpMat H(qf.size(), qf.size());
   H.setFromTriplets(t.begin(), t.end());
   return H;
+}
+
+void FfrBeamModel3d::addStrainEnergyGradient(const ConstVecRef& qf, double scale, Eigen::Ref<VecX> out) const {
+  if (!options_.geometricStiffening) {
+    for (int j = 0; j < invariants_.kff.outerSize(); ++j) {
+      for (SpMat::InnerIterator it(invariants_.kff, j); it; ++it) out[it.row()] += scale * it.value() * qf[j];
+    }
+    return;
+  }
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const ElementBasis& eb = elementBases_[e];
+    // dU/dq_f = (T B)^T dU_e/de, e = T B q_f (chain rule over the element's columns)
+    const BeamElement3d::Vec12 ge =
+        elements_[e].transformation().transpose() * elements_[e].strainEnergyGradient(elementCoordinates(e, qf), true);
+    for (size_t k = 0; k < eb.cols.size(); ++k) out[eb.cols[k]] += scale * eb.B.col(static_cast<Eigen::Index>(k)).dot(ge);
+  }
+}
+
+void FfrBeamModel3d::addStrainEnergyHessian(const ConstVecRef& qf, double scale, const MatrixSink& K, int row0,
+                                            int col0) const {
+  if (!options_.geometricStiffening) {
+    for (int j = 0; j < invariants_.kff.outerSize(); ++j) {
+      for (SpMat::InnerIterator it(invariants_.kff, j); it; ++it) K.add(row0 + it.row(), col0 + j, scale * it.value());
+    }
+    return;
+  }
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const ElementBasis& eb = elementBases_[e];
+    const auto& T = elements_[e].transformation();
+    // d2U/dq_f2 = (T B)^T H_e (T B)
+    const BeamElement3d::Mat12 He =
+        T.transpose() * elements_[e].strainEnergyHessian(elementCoordinates(e, qf), true) * T;
+    const int n = static_cast<int>(eb.cols.size());
+    for (int j = 0; j < n; ++j) {
+      const BeamElement3d::Vec12 hj = He * eb.B.col(j);
+      for (int i = 0; i < n; ++i) K.add(row0 + eb.cols[i], col0 + eb.cols[j], scale * eb.B.col(i).dot(hj));
+    }
+  }
 }
 
 bool FfrBeamModel3d::locate(const Vec3& point, int& element, double& xi) const {

@@ -10,6 +10,7 @@
 
 #include "bodies/ffr_invariants_3d.hpp"
 #include "bodies/modal_reduction.hpp"
+#include "core/matrix_sink.hpp"
 #include "elements/beam_element_3d.hpp"
 
 namespace flexmbd {
@@ -110,6 +111,11 @@ class FfrBeamModel3d {
   VecX strainEnergyGradient(const VecX& qf) const;
   /// Sparse, with the same structure for every q_f (the Jacobian pattern is fixed).
   SpMat strainEnergyHessian(const VecX& qf) const;
+  /// out += scale * dU/dq_f, without allocating (the body's elastic force).
+  void addStrainEnergyGradient(const ConstVecRef& qf, double scale, Eigen::Ref<VecX> out) const;
+  /// K(offset + i, offset2 + j) += scale * d2U/dq_f,i dq_f,j, every entry of each
+  /// element's block written (fixed structure), without allocating.
+  void addStrainEnergyHessian(const ConstVecRef& qf, double scale, const MatrixSink& K, int row0, int col0) const;
 
   /// Element and local coordinate xi in [0, 1] of a body-frame point on the beam axis.
   /// @return false if no element passes within 1e-9 (relative) of the point.
@@ -132,7 +138,7 @@ class FfrBeamModel3d {
   };
   ElementBasis makeElementBasis(int element) const;
   /// Element nodal coordinates in element axes (T B q_f).
-  BeamElement3d::Vec12 elementCoordinates(int element, const VecX& qf) const;
+  BeamElement3d::Vec12 elementCoordinates(int element, const ConstVecRef& qf) const;
 
   BeamMesh3d mesh_;
   FfrBeamOptions3d options_;

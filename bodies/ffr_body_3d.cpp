@@ -50,6 +50,19 @@ double tinvEntry(const Mat34& Rinv, int i, int j) {
 
 }  // namespace
 
+namespace {
+const FfrBeamModel3d& requireModel(const std::shared_ptr<const FfrBeamModel3d>& model, const std::string& name) {
+  if (!model) throw InputError("body '" + name + "': no beam model given");
+  return *model;
+}
+}  // namespace
+
+FfrBody3d::FfrBody3d(std::string name, std::shared_ptr<const FfrBeamModel3d> model, const FrameState3d& initial,
+                     VecX qf0, VecX qf0dot)
+    : FfrBody3d(name, requireModel(model, name).invariants(), initial, std::move(qf0), std::move(qf0dot)) {
+  model_ = std::move(model);
+}
+
 FfrBody3d::FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameState3d& initial, VecX qf0,
                      VecX qf0dot)
     : Body(std::move(name)), inv_(std::move(invariants)), initial_(initial), qf0_(std::move(qf0)),
@@ -334,7 +347,11 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   }
   for (int i = 0; i < 3; ++i) addProduct(w_[i], pf, 2.0 * w[i], Qf);
   // elastic and damping forces
-  addProduct(inv_.kff, qf, -1.0, Qf);
+  if (model_) {
+    model_->addStrainEnergyGradient(qf, -1.0, Qf);  // -dU/dq_f (K_ff q_f when linear)
+  } else {
+    addProduct(inv_.kff, qf, -1.0, Qf);
+  }
   addProduct(inv_.dff, pf, -1.0, Qf);
 }
 
@@ -380,7 +397,11 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) dQdq.addSparse(6, 7, inv_.sKL[k][l], -Om(k, l));
   }
-  dQdq.addSparse(6, 7, inv_.kff, -1.0);
+  if (model_) {
+    model_->addStrainEnergyHessian(qf, -1.0, dQdq, 6, 7);
+  } else {
+    dQdq.addSparse(6, 7, inv_.kff, -1.0);
+  }
   // dOm_kl/dw_j = d_kj w_l + w_k d_lj - 2 d_kl w_j
   for (int j = 0; j < 3; ++j) {
     Mat3 dOm = -2.0 * w[j] * Mat3::Identity();
@@ -429,7 +450,22 @@ double FfrBody3d::gravityPotential(const ConstVecRef& q, const Vec3& g) const {
 
 double FfrBody3d::internalPotential(const ConstVecRef& q) const {
   const auto qf = q.tail(nf_);
-  return 0.5 * bilinear(inv_.kff, qf, qf);
+  return model_ ? model_->strainEnergy(VecX(qf)) : 0.5 * bilinear(inv_.kff, qf, qf);
+}
+
+FfrBody3d::BeamDeflection FfrBody3d::beamDeflection(const ConstVecRef& q, int element, double xi) const {
+  if (!model_) {
+    throw InputError("body '" + name() + "': not made from a beam mesh; its deflection and section forces are unknown");
+  }
+  const VecX qf = q.tail(nf_);
+  const FfrPoint3d p = model_->materialPoint(element, xi);
+  BeamDeflection d;
+  d.displacement = p.shape * qf;
+  const Mat3 A = rotationOf(q);
+  d.position = q.head<3>() + A * (p.position + d.displacement);  // r = R + A (u0 + N q_f)
+  d.worldDisplacement = A * d.displacement;
+  d.sectionForces = model_->sectionForces(qf, element, xi);
+  return d;
 }
 
 Vec3 FfrBody3d::centreOfMass(const ConstVecRef& q) const {

@@ -2,8 +2,10 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <string>
 
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_invariants_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "core/body.hpp"
@@ -26,7 +28,8 @@ namespace flexmbd {
 ///       [        I(q_f)       Y(q_f)   ]   I = int rho u~^T u~ dV = tr(J) 1 - J, J = int rho u u^T dV
 ///       [ sym.                m_ff     ]   Y = int rho u~ N dV
 /// Quadratic velocity forces, elastic K_ff q_f and damping D_ff q_f' are in
-/// addInternalForces. The length of p is a gauge, as for RigidBody3d.
+/// addInternalForces (with a beam model that has geometric stiffening, dU/dq_f of its
+/// strain energy instead of K_ff q_f). The length of p is a gauge, as for RigidBody3d.
 ///
 /// Nodes: a node's section frame is A_node = A (I + skew(Ntheta q_f)), first order in the
 /// small nodal rotations theta = Ntheta q_f like the linear element (not exactly
@@ -43,7 +46,15 @@ class FfrBody3d final : public Body {
   FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameState3d& initial, VecX qf0 = {},
             VecX qf0dot = {});
 
+  /// From a beam mesh model: its invariants, and its strain energy (with geometric
+  /// stiffening if the model has it on) for the elastic forces and their Jacobian.
+  /// @throws InputError as above, or if `model` is null.
+  FfrBody3d(std::string name, std::shared_ptr<const FfrBeamModel3d> model, const FrameState3d& initial,
+            VecX qf0 = {}, VecX qf0dot = {});
+
   const FfrInvariants3d& invariants() const { return inv_; }
+  /// The generating beam model, or null (invariants given directly).
+  const FfrBeamModel3d* model() const { return model_.get(); }
   int numElastic() const { return nf_; }
 
   int numCoordinates() const override { return 7 + nf_; }
@@ -95,6 +106,17 @@ class FfrBody3d final : public Body {
   Vec3 centreOfMass(const ConstVecRef& q) const override;
 
   // ----- helpers for outputs and tests (own coordinates q) --------------------------
+  /// The deformation at a point of the generating beam mesh's axis.
+  struct BeamDeflection {
+    Vec3 displacement = Vec3::Zero();       ///< elastic displacement u = N q_f, body axes
+    Vec3 position = Vec3::Zero();           ///< deformed position, world axes: R + A (u0 + u)
+    Vec3 worldDisplacement = Vec3::Zero();  ///< A u
+    BeamSectionForces3d sectionForces;      ///< element axes (BeamElement3d)
+  };
+  /// At `xi` in [0, 1] along element `element` of model() (FfrBeamModel3d::locate finds
+  /// them for a point of the undeformed axis).
+  /// @throws InputError naming the body if it was not made from a beam mesh.
+  BeamDeflection beamDeflection(const ConstVecRef& q, int element, double xi) const;
   /// A(p / |p|).
   static Mat3 rotationOf(const ConstVecRef& q) { return quaternionRotation(q.segment<4>(3)); }
   /// int rho u dV (body axes).
@@ -111,6 +133,7 @@ class FfrBody3d final : public Body {
   /// Column k of Y(q_f) = int rho u~ N dV.
   Vec3 skewShapeColumn(const ConstVecRef& qf, int k) const;
 
+  std::shared_ptr<const FfrBeamModel3d> model_;  // generating mesh model, or null
   FfrInvariants3d inv_;
   int nf_ = 0;
   FrameState3d initial_;

@@ -722,4 +722,34 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   return summary;
 }
 
+SimulationSummary simulateKeepingFailures(const System& sys, const SolverSettings& settings,
+                                          const OutputCallback& onOutput) {
+  const std::clock_t start = std::clock();
+  double lastDone = std::numeric_limits<double>::quiet_NaN();
+  const auto cpu = [&] { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; };
+  try {
+    return simulate(sys, settings, [&](const OutputSample& sample) {
+      onOutput(sample);
+      lastDone = sample.t;
+    });
+  } catch (const InputError&) {  // includes ModelError
+    throw;
+  } catch (const SolverError& e) {
+    SimulationSummary summary;
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = e.time();
+    summary.stats.lastStepSize = e.stepSize();
+    summary.cpuSeconds = cpu();
+    return summary;
+  } catch (const std::exception& e) {
+    SimulationSummary summary;
+    summary.ok = false;
+    summary.message = e.what();
+    summary.tReached = lastDone;
+    summary.cpuSeconds = cpu();
+    return summary;
+  }
+}
+
 }  // namespace flexmbd

@@ -137,4 +137,14 @@ using OutputCallback = std::function<void(const OutputSample&)>;
 SimulationSummary simulate(const System& sys, const SolverSettings& settings,
                            const OutputCallback& onOutput);
 
+/// simulate(), with every failure after the input was accepted returned as a failed
+/// summary instead of thrown: a SolverError (at initialisation too: its time and step
+/// size), or any other std::exception from the run or from `onOutput` (results that
+/// cannot be written, a non-finite value: t_reached is the time of the last output
+/// `onOutput` completed, NaN if none). InputError and ModelError still throw (the model
+/// could not be set up, nothing was integrated). Used by the command line and the
+/// Python module, so both report failures alike.
+SimulationSummary simulateKeepingFailures(const System& sys, const SolverSettings& settings,
+                                          const OutputCallback& onOutput);
+
 }  // namespace flexmbd

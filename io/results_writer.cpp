@@ -117,17 +117,56 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
   removeStaleResults(dir);
   reserveSummary(dir);
 
+  columns_ = resultColumns(scene);
+}
+
+std::vector<std::string> resultColumns(const Scene& scene) {
   const System& sys = scene.system;
-  columns_.push_back("t");
+  std::vector<std::string> columns = {"t"};
   const auto coords = sys.coordinateNames(), velocities = sys.velocityNames(), accelerations = sys.accelerationNames();
-  columns_.insert(columns_.end(), coords.begin(), coords.end());
-  columns_.insert(columns_.end(), velocities.begin(), velocities.end());
-  columns_.insert(columns_.end(), accelerations.begin(), accelerations.end());
+  columns.insert(columns.end(), coords.begin(), coords.end());
+  columns.insert(columns.end(), velocities.begin(), velocities.end());
+  columns.insert(columns.end(), accelerations.begin(), accelerations.end());
   const auto reactions = reactionOutputNames(sys);
-  columns_.insert(columns_.end(), reactions.begin(), reactions.end());
+  columns.insert(columns.end(), reactions.begin(), reactions.end());
   for (const auto& o : scene.outputs) {
     const auto names = o.columnNames();
-    columns_.insert(columns_.end(), names.begin(), names.end());
+    columns.insert(columns.end(), names.begin(), names.end());
+  }
+  return columns;
+}
+
+void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& s,
+               std::vector<double>& values) {
+  const System& sys = scene.system;
+  const long nq = sys.numCoordinates(), nv = sys.numVelocities();
+  const long m = sys.numConstraintEquations();
+  if (s.q.size() != nq) throw std::runtime_error(sizeMismatch("q", s.q.size(), nq, s.t));
+  if (s.v.size() != nv) throw std::runtime_error(sizeMismatch("v", s.v.size(), nv, s.t));
+  if (s.a.size() != nv) throw std::runtime_error(sizeMismatch("a", s.a.size(), nv, s.t));
+  if (s.lambda.size() != m) throw std::runtime_error(sizeMismatch("lambda", s.lambda.size(), m, s.t));
+  values.clear();
+  values.reserve(columns.size());
+  values.push_back(s.t);
+  for (long k = 0; k < nq; ++k) values.push_back(s.q[k]);
+  for (long k = 0; k < nv; ++k) values.push_back(s.v[k]);
+  for (long k = 0; k < nv; ++k) values.push_back(s.a[k]);
+  const VecX reactions = reactionOutputs(sys, s.q, s.lambda);
+  for (Eigen::Index k = 0; k < reactions.size(); ++k) values.push_back(reactions[k]);
+  for (const auto& o : scene.outputs) {
+    for (double x : o.evaluate(sys, s.q, s.v)) values.push_back(x);
+  }
+  if (values.size() != columns.size()) {
+    throw std::runtime_error(sizeMismatch("a row", static_cast<long>(values.size()),
+                                          static_cast<long>(columns.size()), s.t));
+  }
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!std::isfinite(values[k])) {
+      char tbuf[32];
+      std::snprintf(tbuf, sizeof tbuf, "%.10g", s.t);
+      throw NonFiniteResult("non-finite value " + std::string(std::isnan(values[k]) ? "nan" : "inf") +
+                            " in column \"" + columns[k] + "\" at t = " + tbuf);
+    }
   }
 }
 
@@ -175,37 +214,9 @@ void ResultsWriter::open() {
 }
 
 void ResultsWriter::write(const OutputSample& s) {
-  const System& sys = scene_.system;
-  const long nq = sys.numCoordinates(), nv = sys.numVelocities();
-  const long m = sys.numConstraintEquations();
-  if (s.q.size() != nq) throw std::runtime_error(sizeMismatch("q", s.q.size(), nq, s.t));
-  if (s.v.size() != nv) throw std::runtime_error(sizeMismatch("v", s.v.size(), nv, s.t));
-  if (s.a.size() != nv) throw std::runtime_error(sizeMismatch("a", s.a.size(), nv, s.t));
-  if (s.lambda.size() != m) throw std::runtime_error(sizeMismatch("lambda", s.lambda.size(), m, s.t));
   // The whole row first: a row with a non-finite value is not written (the run stops).
   std::vector<double> values;
-  values.reserve(columns_.size());
-  values.push_back(s.t);
-  for (long k = 0; k < nq; ++k) values.push_back(s.q[k]);
-  for (long k = 0; k < nv; ++k) values.push_back(s.v[k]);
-  for (long k = 0; k < nv; ++k) values.push_back(s.a[k]);
-  const VecX reactions = reactionOutputs(sys, s.q, s.lambda);
-  for (Eigen::Index k = 0; k < reactions.size(); ++k) values.push_back(reactions[k]);
-  for (const auto& o : scene_.outputs) {
-    for (double x : o.evaluate(sys, s.q, s.v)) values.push_back(x);
-  }
-  if (values.size() != columns_.size()) {
-    throw std::runtime_error(sizeMismatch("a row", static_cast<long>(values.size()),
-                                          static_cast<long>(columns_.size()), s.t));
-  }
-  for (std::size_t k = 0; k < values.size(); ++k) {
-    if (!std::isfinite(values[k])) {
-      char tbuf[32];
-      std::snprintf(tbuf, sizeof tbuf, "%.10g", s.t);
-      throw NonFiniteResult("non-finite value " + std::string(std::isnan(values[k]) ? "nan" : "inf") +
-                            " in column \"" + columns_[k] + "\" at t = " + tbuf);
-    }
-  }
+  resultRow(scene_, columns_, s, values);
   if (format_ == ResultsFormat::Hdf5) {
     if (!h5_) {
       auto file = std::make_unique<Hdf5RowFile>();
@@ -287,7 +298,9 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
   throw OutputWriteError("cannot write '" + target.string() + "': " + std::strerror(err));
 }
 
-void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene) {
+namespace {
+
+nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Scene& scene) {
   const SolverSettings& s = scene.solver;
   const IntegratorStats& st = summary.stats;
   nlohmann::ordered_json j;  // keys in this order in the file
@@ -344,7 +357,17 @@ void writeSummary(const std::filesystem::path& dir, const SimulationSummary& sum
   j["t_start"] = s.tStart;
   j["t_end"] = s.tEnd;
   j["output_step"] = s.outputStep;
-  writeJsonFile(dir, j);
+  return j;
+}
+
+}  // namespace
+
+std::string summaryJson(const SimulationSummary& summary, const Scene& scene) {
+  return summaryObject(summary, scene).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
+}
+
+void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene) {
+  writeJsonFile(dir, summaryObject(summary, scene));
 }
 
 void writeInputErrorSummary(const std::filesystem::path& dir, const std::string& message) {

@@ -25,6 +25,19 @@ ResultsFormat parseResultsFormat(const std::string& name);
 /// The file name of the results table of `format`: "results.csv" or "results.h5".
 const char* resultsFileName(ResultsFormat format);
 
+/// The columns of a scene's results table, in order: t; every coordinate
+/// "<body>.<coord>"; every velocity "<body>.<coord>_dot"; every acceleration
+/// "<body>.<coord>_ddot"; the reaction outputs (reactionOutputNames); the scene's
+/// requested outputs.
+std::vector<std::string> resultColumns(const Scene& scene);
+/// The values of one row (resultColumns' order) for a sample, into `values` (cleared).
+/// @throws NonFiniteResult for a value that is inf or NaN (naming the column and the
+///         time), std::runtime_error if the sample has the wrong sizes.
+void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& sample,
+               std::vector<double>& values);
+/// The run summary as JSON (the keys of writeSummary, in the same order).
+std::string summaryJson(const SimulationSummary& summary, const Scene& scene);
+
 /// Writes DIR/results.csv (or DIR/results.h5, see ResultsFormat): a header row, then one
 /// row per OutputSample, each flushed so that the rows written survive a failure later in
 /// the run. Columns: t; every

@@ -5,6 +5,7 @@
 #include "io/scene.hpp"
 
 #include "io/json_reader.hpp"
+#include "io/beam_model_reader.hpp"
 #include "io/scene_keys.hpp"
 #include "io/spatial_scene.hpp"
 
@@ -26,6 +27,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
@@ -81,8 +83,6 @@ using scenereaders::lookupJoint;
 /// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
 /// matrices, 72 MB and some 10 s per factorisation at 1,000 elements.
 constexpr long kMaxElements = 1000;
-/// Most elastic modes of a modal body (the same bound on its coordinates).
-constexpr long kMaxModes = 3000;
 
 using nlohmann::json;
 using namespace jsonread;
@@ -153,75 +153,6 @@ BeamSection parseSection(const json& j, const std::string& where) {
   return s;
 }
 
-FfrBeamOptions parseBeamOptions(const ObjectReader& r, int numNodes) {
-  FfrBeamOptions o;
-  const ObjectReader ref(r.object("reference"), r.where() + ": reference");
-  const std::string type = ref.string("type");
-  if (type == "pinned_pinned") {
-    ref.allowOnly(scenekeys::kReferencePinnedPinned, " for pinned_pinned");
-    o.reference.type = ReferenceConditions::Type::PinnedPinned;
-    o.reference.nodeA = 0;
-    o.reference.nodeB = numNodes - 1;
-    if (ref.has("nodes")) {
-      const json& n = ref.required("nodes");
-      if (!n.is_array() || n.size() != 2) ref.fail("key \"nodes\" must be two node indices [A, B], got " + describe(n));
-      o.reference.nodeA = ref.index(n[0], "nodes[0]");
-      o.reference.nodeB = ref.index(n[1], "nodes[1]");
-    }
-  } else if (type == "clamped") {
-    ref.allowOnly(scenekeys::kReferenceClamped, " for clamped");
-    o.reference.type = ReferenceConditions::Type::Clamped;
-    o.reference.nodeA = static_cast<int>(ref.integer("node", 0, 0));
-  } else if (type == "free_free") {
-    ref.allowOnly(scenekeys::kReferenceFreeFree, " for free_free");
-    o.reference.type = ReferenceConditions::Type::FreeFree;
-  } else {
-    ref.fail("unknown reference type " + inQuotes(type) + " (expected one of: pinned_pinned, clamped, free_free)");
-  }
-  // "reduction": "normal" (default) or "craig_bampton" with its "interface_nodes"
-  const std::string reduction = r.string("reduction", "normal");
-  if (reduction == "craig_bampton") {
-    o.reduction = ModalReduction::CraigBampton;
-    if (!r.has("interface_nodes")) r.fail("missing required key \"interface_nodes\" (with \"reduction\": \"craig_bampton\")");
-    const json& n = r.required("interface_nodes");
-    if (!n.is_array() || n.empty()) {
-      r.fail("key \"interface_nodes\" must be a non-empty array of node indices [i, ...], got " + describe(n));
-    }
-    for (std::size_t k = 0; k < n.size(); ++k) {
-      const std::string label = "interface_nodes[" + std::to_string(k) + "]";
-      const int node = r.index(n[k], label);
-      if (node >= numNodes) {
-        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " does not exist (nodes 0.." +
-               std::to_string(numNodes - 1) + ")");
-      }
-      if (std::find(o.interfaceNodes.begin(), o.interfaceNodes.end(), node) != o.interfaceNodes.end()) {
-        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " is listed twice");
-      }
-      o.interfaceNodes.push_back(node);
-    }
-  } else if (reduction != "normal") {
-    r.fail("key \"reduction\" must be \"normal\" or \"craig_bampton\", got " + inQuotes(reduction));
-  } else if (r.has("interface_nodes")) {
-    r.fail("key \"interface_nodes\" is only allowed with \"reduction\": \"craig_bampton\"");
-  }
-  if (r.has("modes")) {
-    const json& m = r.required("modes");
-    if (m.is_array()) {
-      for (std::size_t k = 0; k < m.size(); ++k) o.modeSet.push_back(r.index(m[k], "modes[" + std::to_string(k) + "]"));
-      if (o.modeSet.empty()) r.fail("key \"modes\" must list at least one mode");
-    } else {
-      // Craig-Bampton: the fixed-interface modes, 0 (static condensation only) allowed
-      o.modes = static_cast<int>(r.integer("modes", 0, o.reduction == ModalReduction::CraigBampton ? 0 : 1, kMaxModes));
-    }
-  }
-  o.geometricStiffening = r.boolean("geometric_stiffening", false);
-  o.inertiaModes = r.boolean("inertia_modes", false);
-  if (o.inertiaModes && o.reduction == ModalReduction::Normal && o.modes == 0 && o.modeSet.empty()) {
-    r.fail("key \"inertia_modes\" needs a modal reduction (\"modes\", or \"reduction\": \"craig_bampton\")");
-  }
-  return o;
-}
-
 void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
   r.allowOnly(scenekeys::kFlexibleBody, " for a flexible body");
   const BeamSection section = parseSection(r.object("section"), r.where() + ": section");
@@ -245,7 +176,8 @@ void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& s
       mesh.elements.push_back({r.index(els[e][0], label + "[0]"), r.index(els[e][1], label + "[1]"), section});
     }
   }
-  const FfrBeamOptions options = parseBeamOptions(r, static_cast<int>(mesh.nodes.size()));
+  FfrBeamOptions options;
+  scenereaders::readBeamModelOptions(r, static_cast<int>(mesh.nodes.size()), options);
   const FrameState2d init = parseFrameState(r);
   const ElasticState elastic = readElasticState(r);
   located(r.where(), [&] {
@@ -435,65 +367,6 @@ void parseForce(const json& j, const std::string& where, System& sys) {
   }
 }
 
-OutputRequest parseOutput(const json& j, const std::string& where, const System& sys,
-                          const std::vector<OutputRequest>& earlier, bool spatial) {
-  ObjectReader r(j, where);
-  r.peekName();
-  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
-  OutputRequest out;
-  if (type == "energy") {
-    r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
-    for (const auto& o : earlier) {
-      if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
-    }
-    out.type = OutputRequest::Type::Energy;
-    return out;
-  }
-  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
-  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
-  out.name = r.name("name");
-  // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
-  // "<joint>.fx" or with another output's columns.
-  if (out.name == "energy") r.fail("the name \"energy\" is reserved for the energy output columns");
-  for (int i = 0; i < sys.numBodies(); ++i) {
-    if (sys.body(BodyIndex(i)).name() == out.name) {
-      r.fail("name " + inQuotes(out.name) + " is already used by a body; give the output its own name");
-    }
-  }
-  for (int i = 0; i < sys.numConstraints(); ++i) {
-    if (sys.constraint(ConstraintIndex(i)).name() == out.name) {
-      r.fail("name " + inQuotes(out.name) + " is already used by a joint or driver; give the output its own name");
-    }
-  }
-  for (const auto& o : earlier) {
-    if (o.type != OutputRequest::Type::Energy && o.name == out.name) {
-      r.fail("duplicate output name " + inQuotes(out.name));
-    }
-  }
-  out.bodyName = r.name("body");
-  out.body = lookupBody(sys, out.bodyName, r);
-  if (spatial) {
-    if (out.type == OutputRequest::Type::Deflection) r.fail("a deflection output needs a flexible body: planar scenes only so far");
-    out.spatial = true;
-    out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
-    located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
-    return out;
-  }
-  out.point = r.vec2("point", Vec2::Zero());
-  if (out.type == OutputRequest::Type::Deflection) {
-    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
-    if (!fb || !fb->beamModel()) {
-      r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
-    }
-    if (!fb->beamModel()->locate(out.point, out.element, out.xi)) {
-      r.fail("point [" + fmt(out.point.x()) + ", " + fmt(out.point.y()) + "] is not on the axis of any element of body " +
-             inQuotes(out.bodyName) + " (undeformed, body frame)");
-    }
-    return out;
-  }
-  located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(lift(out.point), "output " + inQuotes(out.name)); });
-  return out;
-}
 
 SolverSettings parseSolver(const json& j) {
   ObjectReader r(j, "solver");
@@ -608,8 +481,82 @@ class PathTracker {
 
 // ----- public API ------------------------------------------------------------------------------
 
+OutputRequest parseOutputRequest(const json& j, const std::string& where, const System& sys,
+                          const std::vector<OutputRequest>& earlier, bool spatial) {
+  ObjectReader r(j, where);
+  r.peekName();
+  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
+  OutputRequest out;
+  if (type == "energy") {
+    r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
+    for (const auto& o : earlier) {
+      if (o.type == OutputRequest::Type::Energy) r.fail("the energy output is requested twice");
+    }
+    out.type = OutputRequest::Type::Energy;
+    return out;
+  }
+  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
+  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
+  out.name = r.name("name");
+  // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
+  // "<joint>.fx" or with another output's columns.
+  if (out.name == "energy") r.fail("the name \"energy\" is reserved for the energy output columns");
+  for (int i = 0; i < sys.numBodies(); ++i) {
+    if (sys.body(BodyIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a body; give the output its own name");
+    }
+  }
+  for (int i = 0; i < sys.numConstraints(); ++i) {
+    if (sys.constraint(ConstraintIndex(i)).name() == out.name) {
+      r.fail("name " + inQuotes(out.name) + " is already used by a joint or driver; give the output its own name");
+    }
+  }
+  for (const auto& o : earlier) {
+    if (o.type != OutputRequest::Type::Energy && o.name == out.name) {
+      r.fail("duplicate output name " + inQuotes(out.name));
+    }
+  }
+  out.bodyName = r.name("body");
+  out.body = lookupBody(sys, out.bodyName, r);
+  if (spatial) {
+    out.spatial = true;
+    out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
+    if (out.type == OutputRequest::Type::Deflection) {
+      const auto* fb = dynamic_cast<const FfrBody3d*>(&sys.body(out.body));
+      if (!fb || !fb->model()) {
+        r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
+      }
+      if (!fb->model()->locate(out.point3, out.element, out.xi)) {
+        r.fail("point [" + fmt(out.point3.x()) + ", " + fmt(out.point3.y()) + ", " + fmt(out.point3.z()) +
+               "] is not on the axis of any element of body " + inQuotes(out.bodyName) + " (undeformed, body frame)");
+      }
+      return out;
+    }
+    located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
+    return out;
+  }
+  out.point = r.vec2("point", Vec2::Zero());
+  if (out.type == OutputRequest::Type::Deflection) {
+    const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
+    if (!fb || !fb->beamModel()) {
+      r.fail("body " + inQuotes(out.bodyName) + " is not a flexible body made from a beam mesh; a deflection output needs one");
+    }
+    if (!fb->beamModel()->locate(out.point, out.element, out.xi)) {
+      r.fail("point [" + fmt(out.point.x()) + ", " + fmt(out.point.y()) + "] is not on the axis of any element of body " +
+             inQuotes(out.bodyName) + " (undeformed, body frame)");
+    }
+    return out;
+  }
+  located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(lift(out.point), "output " + inQuotes(out.name)); });
+  return out;
+}
+
 std::vector<std::string> OutputRequest::columnNames() const {
   if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
+  if (type == Type::Deflection && spatial) {
+    return {name + ".ux", name + ".uy", name + ".uz", name + ".N",  name + ".Qy",
+            name + ".Qz", name + ".Mx", name + ".My", name + ".Mz"};
+  }
   if (type == Type::Deflection) return {name + ".ux", name + ".uy", name + ".N", name + ".M"};
   if (spatial) return {name + ".x", name + ".y", name + ".z", name + ".vx", name + ".vy", name + ".vz"};
   return {name + ".x", name + ".y", name + ".vx", name + ".vy"};
@@ -623,6 +570,12 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
   }
   const Body& b = sys.body(body);
   const int off = sys.coordinateOffset(body);
+  if (spatial && type == Type::Deflection) {
+    const FfrBody3d::BeamDeflection d =
+        static_cast<const FfrBody3d&>(b).beamDeflection(q.segment(off, b.numCoordinates()), element, xi);
+    const BeamSectionForces3d& f = d.sectionForces;
+    return {d.displacement.x(), d.displacement.y(), d.displacement.z(), f.N, f.Qy, f.Qz, f.Mx, f.My, f.Mz};
+  }
   if (spatial) {
     FrameKinematics f;
     b.frameKinematics(q.segment(off, b.numCoordinates()), point3, pointId, nullptr, nullptr, f);
@@ -715,7 +668,7 @@ Scene parseScene(const json& j) {
   const json& outputs = top.array("outputs");
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     scene.outputs.push_back(
-        parseOutput(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
+        parseOutputRequest(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
   }
 
   scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};

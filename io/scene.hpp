@@ -25,15 +25,17 @@ struct OutputRequest {
   std::string bodyName;        ///< Point: the body the point belongs to
   BodyIndex body;              ///< Point: index of that body in the System
   Vec2 point = Vec2::Zero();   ///< Point, Deflection: body-frame coordinates of the point
-  bool spatial = false;        ///< Point in a spatial scene: point3, columns x, y, z, vx, vy, vz
-  Vec3 point3 = Vec3::Zero();  ///< Point (spatial): body-frame coordinates
+  bool spatial = false;        ///< Point or Deflection in a spatial scene (point3)
+  Vec3 point3 = Vec3::Zero();  ///< Point, Deflection (spatial): body-frame coordinates
   int pointId = Body::kAnyPoint;  ///< Point: the body's identifier of the point (Body::resolvePoint)
   int element = 0;             ///< Deflection: element of the beam mesh holding the point
   double xi = 0.0;             ///< Deflection: its local coordinate in [0, 1]
 
   /// Point: "<name>.x", "<name>.y", "<name>.vx", "<name>.vy";
   /// Deflection: "<name>.ux", "<name>.uy" (elastic displacement in the body frame),
-  /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there);
+  /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there); spatial:
+  /// "<name>.x", ".y", ".z", ".vx", ".vy", ".vz" and "<name>.ux", ".uy", ".uz", ".N", ".Qy",
+  /// ".Qz", ".Mx", ".My", ".Mz" (section forces and moments in element axes);
   /// Energy: "energy.kinetic", "energy.potential", "energy.total".
   std::vector<std::string> columnNames() const;
   /// Values matching columnNames() at global coordinates q and velocities v (size nq).
@@ -64,6 +66,13 @@ Scene parseSceneText(const std::string& text, const std::string& source = "<scen
 /// @throws InputError (one line, starting with the location, e.g.
 ///         `bodies[1] ("rod"): key "mass" must be > 0, got -1`) on any invalid input.
 Scene parseScene(const nlohmann::json& j);
+
+/// One output object of the scene format ("point", "deflection", "energy"; the keys of
+/// docs/scene-format.md, "Outputs") for `sys` (finalized or not); `earlier`: the outputs
+/// already requested (names must differ); `spatial`: a "dimension": 3 model.
+/// @throws InputError starting with `where`.
+OutputRequest parseOutputRequest(const nlohmann::json& j, const std::string& where, const System& sys,
+                                 const std::vector<OutputRequest>& earlier, bool spatial);
 
 /// Range checks of solver settings with the scene's key names (rtol > 0, t_end >
 /// t_start, ...), then SolverSettings::validate(). Used after command-line overrides.

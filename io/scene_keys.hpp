@@ -58,6 +58,21 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
 // spatial scenes ("dimension": 3)
 inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "position",
                                   "orientation", "velocity", "angular_velocity"};
+inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "orientation", "velocity",
+                                     "angular_velocity",     "section",     "beam",        "nodes",
+                                     "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",
+                                     "elastic_coordinates",  "elastic_velocities"};
+inline const Keys kSection3d = {"area",          "inertia_y",     "inertia_z", "torsion_constant", "width",  "height",
+                                "youngs_modulus", "shear_modulus", "poisson_ratio", "density",     "damping"};
+inline const Keys kBeam3d = {"length", "elements", "origin"};
+inline const Keys kInvariantsBody3d = {"name",        "type",       "position",            "orientation",
+                                       "velocity",    "angular_velocity", "invariants",    "elastic_coordinates",
+                                       "elastic_velocities"};
+inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_bar", "position_shape_x",
+                                   "position_shape_y", "position_shape_z", "s_xx", "s_xy", "s_xz",
+                                   "s_yy",  "s_yz",         "s_zz",          "m_ff",  "k_ff",
+                                   "d_ff",  "points"};
+inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames"};
 inline const Keys kJointFrame = {"point", "axis", "orientation"};
@@ -128,6 +143,12 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"solver", &kSolver},
       {"body.rigid.3d", &kRigidBody3d},
       {"orientation", &kOrientation},
+      {"body.flexible.3d", &kFlexibleBody3d},
+      {"body.flexible_invariants.3d", &kInvariantsBody3d},
+      {"section.3d", &kSection3d},
+      {"beam.3d", &kBeam3d},
+      {"invariants.3d", &kInvariants3d},
+      {"invariants.point.3d", &kInvariantsPoint3d},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},
       {"joint.3d.prismatic", &kSpatialJoint},

@@ -1,9 +1,11 @@
 #include "io/vtk_writer.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_2d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "joints/spatial_joint.hpp"
@@ -191,7 +193,9 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
   for (int b = 1; b < sys.numBodies(); ++b) {
     const Body& body = sys.body(BodyIndex(b));
     const auto* fb = dynamic_cast<const FfrBody2d*>(&body);
-    const bool spatial = dynamic_cast<const RigidBody3d*>(&body) != nullptr;
+    const auto* f3 = dynamic_cast<const FfrBody3d*>(&body);
+    const bool spatial = dynamic_cast<const RigidBody3d*>(&body) != nullptr ||
+                         (f3 && (f3->model() || !f3->invariants().points.empty()));
     if (rigidPoints_[b].empty() && !(fb && fb->beamModel()) && !spatial) notDrawn_.push_back(body.name());
   }
 }
@@ -199,7 +203,7 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
 void VtkWriter::write(const OutputSample& s) {
   Grid g;
   std::vector<double> axial, moment;
-  std::vector<Eigen::Vector3d> displacement;
+  std::vector<Eigen::Vector3d> displacement, sectionForce, sectionMoment;  // element axes
   std::vector<int> bodyIndex;
   std::vector<std::string> bodyNames;
   for (int b = 1; b < sys_.numBodies(); ++b) {
@@ -223,6 +227,43 @@ void VtkWriter::write(const OutputSample& s) {
       };
       for (int k = 0; k < 3; ++k) addLine(c, c + triad_ * A.col(k));
       for (const Vec3& p : spatialPoints_[b]) addLine(c, c + A * p);
+    } else if (const auto* f3 = dynamic_cast<const FfrBody3d*>(&body)) {
+      if (f3->model()) {
+        // the deformed axis, each element in `subdivisions_` segments, with the section
+        // forces (N, Qy, Qz) and moments (Mx, My, Mz) in element axes
+        const int elements = static_cast<int>(f3->model()->elements().size());
+        for (int e = 0; e < elements; ++e) {
+          std::vector<int> line;
+          for (int k = 0; k <= subdivisions_; ++k) {
+            const double xi = static_cast<double>(k) / subdivisions_;
+            const FfrBody3d::BeamDeflection d = f3->beamDeflection(q, e, xi);
+            const BeamSectionForces3d& f = d.sectionForces;
+            line.push_back(static_cast<int>(g.points.size()));
+            g.points.push_back(d.position);
+            displacement.push_back(d.worldDisplacement);
+            axial.push_back(f.N);
+            moment.push_back(std::hypot(f.My, f.Mz));
+            sectionForce.push_back(Vec3(f.N, f.Qy, f.Qz));
+            sectionMoment.push_back(Vec3(f.Mx, f.My, f.Mz));
+          }
+          g.cells.push_back(line);
+        }
+      } else if (!f3->invariants().points.empty()) {
+        // given invariants: the line through its attachment points
+        const auto& pts = f3->invariants().points;
+        const Mat3 A = FfrBody3d::rotationOf(q);
+        std::vector<int> line;
+        for (std::size_t k = 0; k < pts.size(); ++k) {
+          FrameKinematics fk;
+          body.frameKinematics(q, pts[k].position, static_cast<int>(k), nullptr, nullptr, fk);
+          line.push_back(static_cast<int>(g.points.size()));
+          g.points.push_back(fk.r);
+          displacement.push_back(A * (pts[k].shape * q.tail(f3->numElastic())));
+          axial.push_back(0.0);
+          moment.push_back(0.0);
+        }
+        g.cells.push_back(line);
+      }
     } else if (fb && fb->beamModel()) {
       const int elements = static_cast<int>(fb->beamModel()->elements().size());
       for (int e = 0; e < elements; ++e) {
@@ -251,13 +292,18 @@ void VtkWriter::write(const OutputSample& s) {
       }
       g.cells.push_back(line);
     }
+    // bodies other than spatial beams carry no section force and moment vectors
+    sectionForce.resize(g.points.size(), Vec3::Zero());
+    sectionMoment.resize(g.points.size(), Vec3::Zero());
     if (static_cast<int>(g.cells.size()) > cellsBefore) {
       bodyIndex.resize(g.cells.size(), static_cast<int>(bodyNames.size()));
       bodyNames.push_back(body.name());
     }
   }
   g.pointScalars = {{"axial_force", std::move(axial)}, {"bending_moment", std::move(moment)}};
-  g.pointVectors = {{"elastic_displacement", std::move(displacement)}};
+  g.pointVectors = {{"elastic_displacement", std::move(displacement)},
+                    {"section_force", std::move(sectionForce)},
+                    {"section_moment", std::move(sectionMoment)}};
   g.cellInts = {{"body_index", std::move(bodyIndex)}};
   g.fieldStrings = {{"body_names", std::move(bodyNames)}};
   writeVtu(collection_.nextFrame(), g, s.t);

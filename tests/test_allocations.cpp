@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <vector>
 
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "builders/planar_builders.hpp"
@@ -238,18 +239,30 @@ TEST(Allocations, EverySpatialJointDriverAndForceType) {
   expectAllocationFree(sys, "every spatial component type");
 }
 
-TEST(Allocations, SpatialFlexibleBodyWithJointsAndForces) {
-  // A spatial FFR body (three bent beam elements, invariants from BeamElement3d) on a
-  // spherical joint at its clamped node, a rigid body on a revolute joint at its tip, a
-  // spring to its middle node and a bushing, with gravity and damping.
+/// A spatial FFR body (three bent beam elements) on a spherical joint at its clamped
+/// node, a rigid body on a revolute joint at its tip, a spring to its middle node and a
+/// bushing, with gravity and damping; `stiffening`: the body from a beam model with
+/// geometric stiffening (its strain energy Hessian per element), else from invariants.
+void expectSpatialFlexibleAllocationFree(bool stiffening) {
   using namespace flexmbd::test3d;
   const std::vector<Vec3> nodes = bentNodes();
-  BeamChain3d chain = makeBeamChain(nodes, rectangularSection3d(0.03, 0.018, 2.1e11, 8.1e10, 7850.0, 1e-4),
-                                    Vec3(1.0, -1.0, 0.3));
+  const BeamSection3d section = rectangularSection3d(0.03, 0.018, 2.1e11, 8.1e10, 7850.0, 1e-4);
+  const Vec3 hint(1.0, -1.0, 0.3);
   System sys;
   FrameState3d s;
   s.orientation = quaternionRotation(Vec4(0.9, 0.1, -0.2, 0.3));
-  const BodyIndex flex = sys.addBody(std::make_unique<FfrBody3d>("flex", chain.inv, s));
+  std::unique_ptr<FfrBody3d> body;
+  if (stiffening) {
+    BeamMesh3d mesh;
+    mesh.nodes = nodes;
+    for (int e = 0; e + 1 < static_cast<int>(nodes.size()); ++e) mesh.elements.push_back({e, e + 1, section, hint});
+    FfrBeamOptions3d o;
+    o.geometricStiffening = true;
+    body = std::make_unique<FfrBody3d>("flex", std::make_shared<const FfrBeamModel3d>(mesh, o, "body 'flex'"), s);
+  } else {
+    body = std::make_unique<FfrBody3d>("flex", makeBeamChain(nodes, section, hint).inv, s);
+  }
+  const BodyIndex flex = sys.addBody(std::move(body));
   RigidBody3dProperties p;
   p.mass = 0.5;
   p.inertia = Vec3(0.01, 0.02, 0.025).asDiagonal();
@@ -268,8 +281,12 @@ TEST(Allocations, SpatialFlexibleBodyWithJointsAndForces) {
                                                 std::array<double, 6>{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}));
   sys.setGravity(Vec3(0.0, 0.0, -9.81));
   sys.finalize();
-  expectAllocationFree(sys, "spatial flexible body");
+  expectAllocationFree(sys, stiffening ? "spatial flexible body, stiffening" : "spatial flexible body");
 }
+
+TEST(Allocations, SpatialFlexibleBodyWithJointsAndForces) { expectSpatialFlexibleAllocationFree(false); }
+
+TEST(Allocations, SpatialFlexibleBodyWithGeometricStiffening) { expectSpatialFlexibleAllocationFree(true); }
 
 }  // namespace
 }  // namespace flexmbd

@@ -58,7 +58,7 @@ TEST(SpatialScene, BadInputNamesTheKeyAndWhatWasExpected) {
   expectSceneError([](auto& j) { j["bodies"][1]["orientation"] = {{"matrix", {{1, 0, 0}, {0, 1, 0}, {0, 0, 2}}}}; },
                    {"bodies[1] (\"rod\").orientation", "not a rotation"});
   expectSceneError([](auto& j) { j["bodies"][0]["inertia"] = {1.0, 1.0, 3.0}; }, {"crank", "I1 + I2 >= I3"});
-  expectSceneError([](auto& j) { j["bodies"][0]["type"] = "flexible"; }, {"bodies[0]", "planar so far"});
+  expectSceneError([](auto& j) { j["bodies"][0]["type"] = "flexible"; }, {"bodies[0]", "unknown key \"inertia\"", "flexible body in a spatial scene"});
   expectSceneError([](auto& j) { j["joints"][0]["type"] = "hinge"; }, {"joints[0]", "hinge"});
   expectSceneError([](auto& j) { j["joints"][0]["frames"] = nlohmann::json::array({nlohmann::json::object()}); },
                    {"joints[0] (\"bearing\")", "two frames"});
@@ -66,5 +66,5 @@ TEST(SpatialScene, BadInputNamesTheKeyAndWhatWasExpected) {
   expectSceneError([](auto& j) { j["drivers"][0]["joint"] = "pin"; }, {"drivers[0]", "revolute or cylindrical", "spherical"});
   expectSceneError([](auto& j) { j["drivers"][0]["type"] = "body_angle"; }, {"drivers[0]", "joint_angle"});
   expectSceneError([](auto& j) { j["gravity"] = {0, -9.81}; }, {"gravity", "3 numbers"});
-  expectSceneError([](auto& j) { j["outputs"][1]["type"] = "deflection"; }, {"outputs[1]", "planar scenes only"});
+  expectSceneError([](auto& j) { j["outputs"][1]["type"] = "deflection"; }, {"outputs[1]", "crank", "not a flexible body made from a beam mesh"});
 }

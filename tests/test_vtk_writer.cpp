@@ -10,7 +10,10 @@
 #include <regex>
 #include <sstream>
 
+#include <nlohmann/json.hpp>
+
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
@@ -163,6 +166,52 @@ TEST(VtkWriter, InvariantsBodyIsDrawnThroughItsAttachmentPoints) {
     largest = std::max({largest, std::fabs(u[3 * p]), std::fabs(u[3 * p + 1])});
   }
   EXPECT_GT(largest, 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(VtkWriter, SpatialBeamIsDrawnDeformedWithItsSectionForces) {
+  // A spatial cantilever (clamped at node 0, frame = world) deformed by the static response
+  // to a tip force F: the drawn axis ends at the deflected tip, and the section force
+  // vector is (N, Qy, Qz) = F on every point, the section moment at the root (0, -Fz L,
+  // Fy L) (BeamSectionForces3d's signs); the element is exact for this load, so to the
+  // 12 digits the file holds (1e-9 relative).
+  const double L = 0.8;
+  const Vec3 F(300.0, -2.0, 1.5);
+  nlohmann::json j = nlohmann::json::parse(R"({"dimension": 3, "bodies": [{"name": "beam", "type": "flexible",
+      "section": {"width": 0.03, "height": 0.02, "youngs_modulus": 2e9, "shear_modulus": 8e8, "density": 2700},
+      "beam": {"length": 0.8, "elements": 4}, "reference": {"type": "clamped"}}]})");
+  const Scene s0 = parseScene(j);
+  const auto& b0 = dynamic_cast<const FfrBody3d&>(s0.system.body(s0.system.findBody("beam")));
+  const int nf = b0.numElastic();
+  VecX f = VecX::Zero(nf);
+  f.segment<3>(nf - 6) = F;
+  const VecX qf = MatX(b0.invariants().kff).ldlt().solve(f);
+  j["bodies"][0]["elastic_coordinates"] = std::vector<double>(qf.data(), qf.data() + nf);
+  const Scene sc = parseScene(j);
+  const fs::path dir = fs::temp_directory_path() / ("flexmbd_vtk3_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  OutputSample o;
+  o.q = sc.system.initialCoordinates();
+  o.v = sc.system.initialVelocities();
+  {
+    VtkWriter vtk(dir, sc.system, "bodies", 4);
+    EXPECT_TRUE(vtk.bodiesNotDrawn().empty());
+    vtk.write(o);
+  }
+  const std::string vtu = read(dir / "bodies_000000.vtu");
+  const std::vector<double> pts = dataArray(vtu, ""), force = dataArray(vtu, "section_force"),
+                            moment = dataArray(vtu, "section_moment");
+  ASSERT_EQ(pts.size(), 3u * 4 * 5);  // 4 elements, 5 points each
+  ASSERT_EQ(force.size(), pts.size());
+  ASSERT_EQ(moment.size(), pts.size());
+  const Vec3 tip(pts[pts.size() - 3], pts[pts.size() - 2], pts[pts.size() - 1]);
+  const Vec3 tipExpected = Vec3(L, 0.0, 0.0) + qf.segment<3>(nf - 6);
+  EXPECT_LT((tip - tipExpected).norm(), 1e-9 * L) << tip.transpose();
+  const double scale = F.norm() * L;
+  for (size_t k = 0; k < force.size(); k += 3) {
+    EXPECT_LT((Vec3(force[k], force[k + 1], force[k + 2]) - F).norm(), 1e-9 * scale) << "point " << k / 3;
+  }
+  EXPECT_LT((Vec3(moment[0], moment[1], moment[2]) - Vec3(0.0, -F.z() * L, F.y() * L)).norm(), 1e-9 * scale);
   fs::remove_all(dir);
 }
 

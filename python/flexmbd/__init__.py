@@ -1,0 +1,243 @@
+"""flexmbd: flexible multibody dynamics from Python.
+
+Scenes (the scene format of docs/scene-format.md, with any key overridden from a
+dict), models built with the C++ API's objects and names, runs whose results are NumPy
+arrays with column names. docs/python.md.
+
+    import flexmbd
+    scene = flexmbd.load_scene("examples/slider_crank_elastic.json",
+                               overrides={"solver": {"t_end": 0.05}})
+    res = scene.run()
+    res["slider.x"], res.summary["steps"]
+"""
+
+import copy
+import json
+import os
+
+from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
+    GROUND,
+    BeamMesh2d,
+    BeamSection,
+    BodyIndex,
+    ConstraintIndex,
+    FfrBeamModel,
+    FfrBeamOptions,
+    ForceIndex,
+    FrameState2d,
+    InputError,
+    ModelError,
+    Reference,
+    RigidBodyProperties,
+    SolverSettings,
+    System,
+    TimeLaw,
+    constant_law,
+    constant_speed_law,
+    harmonic_law,
+    polynomial_law,
+    rectangular_section,
+    spin_up_law,
+    tabulated_law,
+)
+from . import _flexmbd
+
+__all__ = [
+    "Scene", "Results", "SolverFailure", "InputError", "ModelError", "load_scene", "scene_from_dict",
+    "apply_overrides",
+]
+
+
+class SolverFailure(RuntimeError):
+    """A run that stopped before t_end: the message says when and why.
+
+    Attributes: ``time`` (the time reached), ``results`` (the Results up to then)."""
+
+    def __init__(self, message, time, results):
+        super().__init__(message)
+        self.time = time
+        self.results = results
+
+
+class Results:
+    """The results table of a run (the columns of results.csv) and its summary.
+
+    ``data``: a NumPy array (rows x columns); ``columns``: the column names;
+    ``res["slider.x"]``: one column; ``summary``: the keys of summary.json as a dict;
+    ``ok``, ``message``, ``t``: status, message and the output times."""
+
+    def __init__(self, columns, data, summary):
+        self.columns = list(columns)
+        self.data = data
+        self.summary = summary
+        self._index = {c: k for k, c in enumerate(self.columns)}
+
+    @property
+    def ok(self):
+        return self.summary["status"] == "ok"
+
+    @property
+    def message(self):
+        return self.summary["message"]
+
+    @property
+    def t(self):
+        return self.data[:, 0]
+
+    def __getitem__(self, column):
+        try:
+            return self.data[:, self._index[column]]
+        except KeyError:
+            raise KeyError(f"no column {column!r} (columns: {', '.join(self.columns)})") from None
+
+    def __contains__(self, column):
+        return column in self._index
+
+    def __len__(self):
+        return self.data.shape[0]
+
+    def to_pandas(self):
+        """A pandas DataFrame of the table (pandas is optional: ImportError without it)."""
+        import pandas  # noqa: PLC0415  (optional dependency)
+        return pandas.DataFrame(self.data, columns=self.columns)
+
+    def __repr__(self):
+        return f"Results({len(self)} rows x {len(self.columns)} columns, status {self.summary['status']!r})"
+
+
+class Scene:
+    """A model ready to run: a system, solver settings and requested outputs.
+
+    Made from a scene file (load_scene), a scene dict (scene_from_dict) or built in Python::
+
+        scene = flexmbd.Scene("pendulum")
+        sys = scene.system
+        bar = sys.add_rigid_body("bar", flexmbd.RigidBodyProperties(mass=1, inertia=1/12, com=(0.5, 0)))
+        sys.add_revolute_joint("pin", "ground", (0, 0), bar, (0, 0))
+        scene.solver.t_end = 2.0
+        res = scene.run()
+    """
+
+    def __init__(self, name="", _native=None):
+        self._native = _native if _native is not None else _flexmbd.Scene(name)
+
+    @property
+    def name(self):
+        return self._native.name
+
+    @property
+    def system(self):
+        return self._native.system
+
+    @property
+    def solver(self):
+        return self._native.solver
+
+    def add_output(self, output, spatial=False):
+        """An output of the scene format ({"type": "point", "name": ..., "body": ..., "point": [...]},
+        "deflection" or "energy"): extra result columns."""
+        self._native.add_output_json(json.dumps(output), spatial)
+
+    def run(self, progress=False, raise_on_failure=True):
+        """Runs the model (the GIL is released: runs in threads go on in parallel).
+
+        Returns Results. A solver failure raises SolverFailure (its ``results`` hold the
+        rows up to the failure) unless raise_on_failure is False; input and model errors
+        raise InputError / ModelError (ValueError) with the engine's message."""
+        columns, data, summary_text, ok = self._native._run(progress)
+        results = Results(columns, data, json.loads(summary_text))
+        if not ok and raise_on_failure:
+            s = results.summary
+            time = s["t_reached"] if s["t_reached"] is not None else float("nan")
+            raise SolverFailure(f"solver failure: {s['message']} (results up to t = {time:g} kept in .results)",
+                                time, results)
+        return results
+
+
+def apply_overrides(scene_dict, overrides):
+    """A copy of scene_dict with overrides applied.
+
+    ``overrides`` maps keys to values: nested dicts merge into objects
+    ({"solver": {"rtol": 1e-6}}), and a dotted path with list indices addresses any key
+    ({"bodies[1].section.youngs_modulus": 1e11, "solver.t_end": 0.1}). A path through a
+    key or index that does not exist raises InputError naming it."""
+    result = copy.deepcopy(scene_dict)
+    for key, value in (overrides or {}).items():
+        _set_path(result, key, value)
+    return result
+
+
+def _merge(target, value):
+    if isinstance(target, dict) and isinstance(value, dict):
+        for k, v in value.items():
+            if k in target and isinstance(target[k], dict) and isinstance(v, dict):
+                _merge(target[k], v)
+            else:
+                target[k] = copy.deepcopy(v)
+        return target
+    return copy.deepcopy(value)
+
+
+def _path_parts(path):
+    parts = []
+    for piece in path.split("."):
+        while "[" in piece:
+            name, rest = piece.split("[", 1)
+            if name:
+                parts.append(name)
+            index, piece = rest.split("]", 1)
+            try:
+                parts.append(int(index))
+            except ValueError:
+                raise InputError(f"override {path!r}: [{index}] is not an index") from None
+        if piece:
+            parts.append(piece)
+    return parts
+
+
+def _set_path(root, path, value):
+    parts = _path_parts(path)
+    node = root
+    for depth, part in enumerate(parts[:-1]):
+        where = path if depth == len(parts) - 2 else ".".join(str(p) for p in parts[: depth + 1])
+        if isinstance(part, int):
+            if not isinstance(node, list) or not -len(node) <= part < len(node):
+                raise InputError(f"override {path!r}: no element [{part}] at {where!r}")
+            node = node[part]
+        else:
+            if not isinstance(node, dict):
+                raise InputError(f"override {path!r}: {where!r} is not an object")
+            node = node.setdefault(part, {})
+    last = parts[-1]
+    if isinstance(last, int):
+        if not isinstance(node, list) or not -len(node) <= last < len(node):
+            raise InputError(f"override {path!r}: no element [{last}]")
+        node[last] = copy.deepcopy(value)
+    else:
+        if not isinstance(node, dict):
+            raise InputError(f"override {path!r}: the parent of {last!r} is not an object")
+        node[last] = _merge(node[last], value) if last in node else copy.deepcopy(value)
+
+
+def scene_from_dict(scene_dict, overrides=None, source="<scene>"):
+    """A Scene from a scene-format dict (with overrides applied)."""
+    text = json.dumps(apply_overrides(scene_dict, overrides))
+    return Scene(_native=_flexmbd.parse_scene_text(text, source))
+
+
+def load_scene(path, overrides=None):
+    """A Scene from a scene file, with any key overridden (apply_overrides). Errors are
+    InputError with the engine's message, starting with the path."""
+    path = os.fspath(path)
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
+    if not overrides:
+        return Scene(_native=_flexmbd.parse_scene_text(text, path))
+    try:
+        scene_dict = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise InputError(f"{path}: not valid JSON: {e}") from None
+    return scene_from_dict(scene_dict, overrides, source=path)

@@ -1,0 +1,372 @@
+// The flexmbd Python module's compiled part (_flexmbd): thin pybind11 bindings of the
+// C++ API. Scenes (from text, with the scene format's keys), the planar builders of
+// builders/planar_builders.hpp, the beam model, time laws, solver settings, and a run
+// that returns the results table (the columns of results.csv) and the summary (the keys
+// of summary.json). The Python package (python/flexmbd/__init__.py) adds NumPy results,
+// overrides of scene keys and the exceptions. docs/python.md.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "bodies/ffr_beam_model.hpp"
+#include "bodies/ffr_body_2d.hpp"
+#include "builders/planar_builders.hpp"
+#include "core/errors.hpp"
+#include "integrators/simulation.hpp"
+#include "io/results_writer.hpp"
+#include "io/scene.hpp"
+
+namespace py = pybind11;
+using namespace flexmbd;
+
+namespace {
+
+using Law = std::shared_ptr<TimeLaw>;
+Law mutableLaw(TimeLawPtr p) { return std::const_pointer_cast<TimeLaw>(std::move(p)); }
+
+/// What a run returns: the results table (row-major) and the summary as JSON text.
+struct RunOutput {
+  std::vector<std::string> columns;
+  std::vector<double> data;
+  long rows = 0;
+  std::string summary;
+  bool ok = false;
+};
+
+/// Runs a scene (finalizing its system first if needed). Called without the GIL: it
+/// touches no Python object. InputError and ModelError propagate (translated to the
+/// Python exceptions of the same names); every other failure is a failed summary with
+/// the rows up to it (simulateKeepingFailures).
+RunOutput runScene(Scene& scene, bool progress) {
+  if (!scene.system.isFinalized()) scene.system.finalize();
+  RunOutput out;
+  out.columns = resultColumns(scene);
+  SolverSettings settings = scene.solver;
+  settings.progress = progress;
+  checkSolverSettings(settings);
+  std::vector<double> row;
+  const SimulationSummary summary = simulateKeepingFailures(scene.system, settings, [&](const OutputSample& s) {
+    resultRow(scene, out.columns, s, row);
+    out.data.insert(out.data.end(), row.begin(), row.end());
+    ++out.rows;
+  });
+  out.ok = summary.ok;
+  out.summary = summaryJson(summary, scene);
+  return out;
+}
+
+py::array_t<double> table(const RunOutput& r) {
+  const py::ssize_t cols = static_cast<py::ssize_t>(r.columns.size());
+  py::array_t<double> a({static_cast<py::ssize_t>(r.rows), cols});
+  if (!r.data.empty()) std::memcpy(a.mutable_data(), r.data.data(), r.data.size() * sizeof(double));
+  return a;
+}
+
+/// A body given as a BodyIndex or by name ("ground" included).
+BodyIndex body(const System& sys, const py::object& b) {
+  if (py::isinstance<py::str>(b)) {
+    const std::string name = b.cast<std::string>();
+    return name == "ground" ? kGround : sys.findBody(name);  // InputError listing the known bodies
+  }
+  return b.cast<BodyIndex>();
+}
+
+ConstraintIndex joint(const System& sys, const py::object& j) {
+  if (py::isinstance<py::str>(j)) {
+    const std::string name = j.cast<std::string>();
+    for (int c = 0; c < sys.numConstraints(); ++c) {
+      if (sys.constraint(ConstraintIndex(c)).name() == name) return ConstraintIndex(c);
+    }
+    throw InputError("no joint named '" + name + "'");
+  }
+  return j.cast<ConstraintIndex>();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_flexmbd, m) {
+  m.doc() = "flexmbd: flexible multibody dynamics (compiled part; use the flexmbd package)";
+
+  // ----- errors: the C++ types, the same messages ------------------------------------
+  static py::exception<InputError> inputError(m, "InputError", PyExc_ValueError);
+  static py::exception<ModelError> modelError(m, "ModelError", inputError.ptr());
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ModelError& e) {
+      modelError(e.what());
+    } catch (const InputError& e) {
+      inputError(e.what());
+    }
+  });
+
+  // ----- indices, states, properties -----------------------------------------------------
+  py::class_<BodyIndex>(m, "BodyIndex")
+      .def_readonly("value", &BodyIndex::value)
+      .def("__repr__", [](const BodyIndex& b) { return "BodyIndex(" + std::to_string(b.value) + ")"; });
+  py::class_<ConstraintIndex>(m, "ConstraintIndex").def_readonly("value", &ConstraintIndex::value);
+  py::class_<ForceIndex>(m, "ForceIndex").def_readonly("value", &ForceIndex::value);
+  m.attr("GROUND") = kGround;
+
+  py::class_<FrameState2d>(m, "FrameState2d")
+      .def(py::init([](const Vec2& position, double angle, const Vec2& velocity, double angularVelocity) {
+             return FrameState2d{position, angle, velocity, angularVelocity};
+           }),
+           py::arg("position") = Vec2::Zero(), py::arg("angle") = 0.0, py::arg("velocity") = Vec2::Zero(),
+           py::arg("angular_velocity") = 0.0)
+      .def_readwrite("position", &FrameState2d::position)
+      .def_readwrite("angle", &FrameState2d::angle)
+      .def_readwrite("velocity", &FrameState2d::velocity)
+      .def_readwrite("angular_velocity", &FrameState2d::angularVelocity);
+  py::class_<RigidBodyProperties>(m, "RigidBodyProperties")
+      .def(py::init([](double mass, double inertia, const Vec2& com) { return RigidBodyProperties{mass, inertia, com}; }),
+           py::arg("mass"), py::arg("inertia"), py::arg("com") = Vec2::Zero())
+      .def_readwrite("mass", &RigidBodyProperties::mass)
+      .def_readwrite("inertia", &RigidBodyProperties::inertia)
+      .def_readwrite("com", &RigidBodyProperties::com);
+
+  // ----- time laws (core/time_law.hpp) ----------------------------------------------------
+  // pybind11 holders cannot be shared_ptr<const T>: laws are held as shared_ptr<TimeLaw>
+  // (Law) and handed to the engine as TimeLawPtr (immutable there).
+  py::class_<TimeLaw, Law>(m, "TimeLaw")
+      .def("__call__", [](const TimeLaw& law, double t) {
+        const LawValue v = law.evaluate(t);
+        return py::make_tuple(v.f, v.df, v.ddf);
+      }, "(f, f', f'') at t")
+      .def_property_readonly("type_name", &TimeLaw::typeName);
+  m.def("constant_law", [](double v) { return mutableLaw(makeConstantLaw(v)); }, py::arg("value"));
+  m.def("constant_speed_law", [](double w, double a0) { return mutableLaw(makeConstantSpeedLaw(w, a0)); },
+        py::arg("speed"), py::arg("initial") = 0.0);
+  m.def("polynomial_law", [](std::vector<double> c) { return mutableLaw(makePolynomialLaw(std::move(c))); },
+        py::arg("coefficients"));
+  m.def("harmonic_law",
+        [](double a, double w, double phase, double offset) { return mutableLaw(makeHarmonicLaw(a, w, phase, offset)); },
+        py::arg("amplitude"), py::arg("omega"), py::arg("phase") = 0.0, py::arg("offset") = 0.0);
+  m.def("spin_up_law", [](double w, double ramp, double a0) { return mutableLaw(makeSpinUpLaw(w, ramp, a0)); },
+        py::arg("speed"), py::arg("ramp_time"), py::arg("initial") = 0.0);
+  m.def("tabulated_law",
+        [](std::vector<double> t, std::vector<double> v) { return mutableLaw(makeTabulatedLaw(std::move(t), std::move(v))); },
+        py::arg("times"), py::arg("values"));
+
+  // ----- flexible beams (bodies/ffr_beam_model.hpp) --------------------------------------
+  py::class_<BeamSection>(m, "BeamSection")
+      .def(py::init([](double area, double inertia, double E, double rho, double damping) {
+             BeamSection s;
+             s.area = area;
+             s.inertia = inertia;
+             s.youngsModulus = E;
+             s.density = rho;
+             s.damping = damping;
+             return s;
+           }),
+           py::arg("area"), py::arg("inertia"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0)
+      .def_readwrite("area", &BeamSection::area)
+      .def_readwrite("inertia", &BeamSection::inertia)
+      .def_readwrite("youngs_modulus", &BeamSection::youngsModulus)
+      .def_readwrite("density", &BeamSection::density)
+      .def_readwrite("damping", &BeamSection::damping);
+  m.def(
+      "rectangular_section",
+      [](double width, double height, double E, double rho, double damping) {
+        BeamSection s = rectangularSection(width, height, E, rho);
+        s.damping = damping;
+        return s;
+      },
+      py::arg("width"), py::arg("height"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0);
+  py::class_<BeamMesh2d>(m, "BeamMesh2d")
+      .def(py::init([](const std::vector<Vec2>& nodes, const std::vector<std::pair<int, int>>& elements,
+                       const BeamSection& section) {
+             BeamMesh2d mesh;
+             mesh.nodes = nodes;
+             for (const auto& [a, b] : elements) mesh.elements.push_back({a, b, section});
+             return mesh;
+           }),
+           py::arg("nodes"), py::arg("elements"), py::arg("section"))
+      .def_static("straight", &BeamMesh2d::straight, py::arg("length"), py::arg("elements"), py::arg("section"),
+                  py::arg("origin") = Vec2::Zero())
+      .def_readonly("nodes", &BeamMesh2d::nodes);
+  py::enum_<ReferenceConditions::Type>(m, "Reference")
+      .value("PINNED_PINNED", ReferenceConditions::Type::PinnedPinned)
+      .value("CLAMPED", ReferenceConditions::Type::Clamped)
+      .value("FREE_FREE", ReferenceConditions::Type::FreeFree);
+  py::class_<FfrBeamOptions>(m, "FfrBeamOptions")
+      .def(py::init([](ReferenceConditions::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
+                       bool stiffening) {
+             FfrBeamOptions o;
+             o.reference.type = type;
+             o.reference.nodeA = nodeA;
+             o.reference.nodeB = nodeB;
+             o.modes = modes;
+             o.modeSet = std::move(modeSet);
+             o.geometricStiffening = stiffening;
+             return o;
+           }),
+           py::arg("reference") = ReferenceConditions::Type::PinnedPinned, py::arg("node_a") = 0,
+           py::arg("node_b") = -1, py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{},
+           py::arg("geometric_stiffening") = false);
+  py::class_<FfrBeamModel, std::shared_ptr<FfrBeamModel>>(m, "FfrBeamModel")
+      .def(py::init([](BeamMesh2d mesh, const FfrBeamOptions& o, const std::string& owner) {
+             return std::make_shared<FfrBeamModel>(std::move(mesh), o, owner);
+           }),
+           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model")
+      .def("natural_frequencies", &FfrBeamModel::naturalFrequencies, "rad/s, ascending (frame held fixed)")
+      .def_property_readonly("num_elastic", &FfrBeamModel::numElastic);
+
+  // ----- the system and the builders (builders/planar_builders.hpp) --------------------
+  py::class_<System>(m, "System")
+      .def(
+          "add_rigid_body",
+          [](System& s, const std::string& name, const RigidBodyProperties& p, const FrameState2d& init) {
+            return addRigidBody(s, name, p, init);
+          },
+          py::arg("name"), py::arg("properties"), py::arg("initial") = FrameState2d{})
+      .def(
+          "add_flexible_body",
+          [](System& s, const std::string& name, std::shared_ptr<FfrBeamModel> model, const FrameState2d& init,
+             std::optional<VecX> qf, std::optional<VecX> qfDot) {
+            auto b = std::make_unique<FfrBody2d>(name, std::shared_ptr<const FfrBeamModel>(model), init);
+            if (qf || qfDot) {
+              const int nf = b->numElastic();
+              b->setInitialElasticState(qf ? *qf : VecX::Zero(nf), qfDot ? *qfDot : VecX::Zero(nf));
+            }
+            return s.addBody(std::move(b));
+          },
+          py::arg("name"), py::arg("model"), py::arg("initial") = FrameState2d{},
+          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none())
+      .def(
+          "add_revolute_joint",
+          [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj) {
+            return addRevoluteJoint(s, name, body(s, bi), pi, body(s, bj), pj);
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"))
+      .def(
+          "add_prismatic_joint",
+          [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj,
+             const Vec2& axis) { return addPrismaticJoint(s, name, body(s, bi), pi, body(s, bj), pj, axis); },
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
+          py::arg("axis"))
+      .def(
+          "add_fixed_joint",
+          [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj) {
+            return addFixedJoint(s, name, body(s, bi), pi, body(s, bj), pj);
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"))
+      .def(
+          "add_body_coordinate_driver",
+          [](System& s, const std::string& name, py::object b, const std::string& coordinate, Law law) {
+            return addBodyCoordinateDriver(s, name, body(s, b), coordinate, std::move(law));
+          },
+          py::arg("name"), py::arg("body"), py::arg("coordinate"), py::arg("law"))
+      .def(
+          "add_joint_driver",
+          [](System& s, const std::string& name, py::object j, Law law) {
+            return addJointDriver(s, name, joint(s, j), std::move(law));
+          },
+          py::arg("name"), py::arg("joint"), py::arg("law"))
+      .def(
+          "add_spring_damper",
+          [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj,
+             double k, double c, double l0) {
+            return addSpringDamper(s, name, body(s, bi), pi, body(s, bj), pj, k, c, l0);
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
+          py::arg("stiffness"), py::arg("damping"), py::arg("free_length"))
+      .def(
+          "add_rotational_spring_damper",
+          [](System& s, const std::string& name, py::object j, double k, double c, double a0) {
+            return addRotationalSpringDamper(s, name, joint(s, j), k, c, a0);
+          },
+          py::arg("name"), py::arg("joint"), py::arg("stiffness"), py::arg("damping"), py::arg("free_angle"))
+      .def(
+          "add_applied_load",
+          [](System& s, const std::string& name, py::object b, const Vec2& point, Law fx, Law fy, Law torque) { return addAppliedLoad(s, name, body(s, b), point, fx, fy, torque); },
+          py::arg("name"), py::arg("body"), py::arg("point"), py::arg("force_x") = nullptr,
+          py::arg("force_y") = nullptr, py::arg("torque") = nullptr)
+      .def(
+          "set_gravity", [](System& s, const Vec2& g) { s.setGravity(g); }, py::arg("gravity"))
+      .def("find_body", &System::findBody, py::arg("name"))
+      .def("finalize", &System::finalize)
+      .def_property_readonly("is_finalized", &System::isFinalized)
+      .def_property_readonly("num_bodies", &System::numBodies)
+      .def_property_readonly("num_coordinates", [](const System& s) { return s.numCoordinates(); })
+      .def_property_readonly("num_velocities", [](const System& s) { return s.numVelocities(); })
+      .def("coordinate_names", &System::coordinateNames)
+      .def("initial_coordinates", &System::initialCoordinates)
+      .def("coordinate_offset", &System::coordinateOffset, py::arg("body"));
+
+  // ----- solver settings (integrators/simulation.hpp) ------------------------------------
+  py::class_<SolverSettings>(m, "SolverSettings")
+      .def(py::init<>())
+      .def_readwrite("rtol", &SolverSettings::rtol)
+      .def_readwrite("atol", &SolverSettings::atol)
+      .def_readwrite("t_start", &SolverSettings::tStart)
+      .def_readwrite("t_end", &SolverSettings::tEnd)
+      .def_readwrite("output_step", &SolverSettings::outputStep)
+      .def_readwrite("max_step", &SolverSettings::maxStepSize)
+      .def_readwrite("max_steps", &SolverSettings::maxSteps)
+      .def_readwrite("max_order", &SolverSettings::maxOrder)
+      .def_readwrite("initial_step", &SolverSettings::initialStepSize)
+      .def_readwrite("fd_jacobian", &SolverSettings::finiteDifferenceJacobian)
+      .def_readwrite("cross_singular", &SolverSettings::crossSingular)
+      .def_property(
+          "formulation", [](const SolverSettings& s) { return toString(s.formulation); },
+          [](SolverSettings& s, const std::string& f) { s.formulation = parseFormulation(f); })
+      .def_property(
+          "integrator", [](const SolverSettings& s) { return toString(s.integrator); },
+          [](SolverSettings& s, const std::string& i) { s.integrator = parseIntegrator(i); })
+      .def("validate", &SolverSettings::validate);
+
+  // ----- scenes and runs -----------------------------------------------------------------
+  py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene")
+      .def(py::init([](const std::string& name) {
+             auto s = std::make_shared<Scene>();
+             s->name = name;
+             return s;
+           }),
+           py::arg("name") = "")
+      .def_readwrite("name", &Scene::name)
+      .def_property_readonly("system", [](Scene& s) -> System& { return s.system; }, py::return_value_policy::reference_internal)
+      .def_property(
+          "solver", [](Scene& s) -> SolverSettings& { return s.solver; },
+          [](Scene& s, const SolverSettings& v) { s.solver = v; }, py::return_value_policy::reference_internal)
+      .def(
+          "add_output_json",
+          [](Scene& s, const std::string& text, bool spatial) {
+            const nlohmann::json j = nlohmann::json::parse(text);
+            const std::string where = "outputs[" + std::to_string(s.outputs.size()) + "]";
+            s.outputs.push_back(parseOutputRequest(j, where, s.system, s.outputs, spatial));
+          },
+          py::arg("json"), py::arg("spatial") = false)
+      .def_property_readonly("output_columns", [](const Scene& s) {
+        std::vector<std::string> c;
+        for (const auto& o : s.outputs) {
+          const auto n = o.columnNames();
+          c.insert(c.end(), n.begin(), n.end());
+        }
+        return c;
+      })
+      .def(
+          "_run",
+          [](Scene& s, bool progress) {
+            RunOutput r;
+            {
+              py::gil_scoped_release release;  // several runs may go on in threads
+              r = runScene(s, progress);
+            }
+            return py::make_tuple(r.columns, table(r), r.summary, r.ok);
+          },
+          py::arg("progress") = false);
+  m.def(
+      "parse_scene_text",
+      [](const std::string& text, const std::string& source) {
+        return std::make_shared<Scene>(parseSceneText(text, source));
+      },
+      py::arg("text"), py::arg("source") = "<scene>");
+}

@@ -1,0 +1,179 @@
+"""The Python module against the engine: closed forms, the command line's results,
+models built in Python against scene files, every error type, runs in threads.
+
+Run by CTest (tests/CMakeLists.txt: PYTHONPATH=build/python, FLEXMBD_CLI, FLEXMBD_SOURCE_DIR).
+"""
+import csv
+import math
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import flexmbd
+
+SOURCE = os.environ.get("FLEXMBD_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+CLI = os.environ.get("FLEXMBD_CLI", os.path.join(SOURCE, "build", "app", "flexmbd"))
+
+
+def example(name):
+    return os.path.join(SOURCE, "examples", name)
+
+
+def rigid_crank_in_python():
+    """examples/slider_crank_rigid.json built with the C++ API's objects and names."""
+    scene = flexmbd.Scene("rigid slider-crank, l1 = 1, l2 = 2 (source document 000)")
+    sys = scene.system
+    crank = sys.add_rigid_body("crank", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.1, com=(0.5, 0.0)),
+                               flexmbd.FrameState2d(position=(0.0, 0.0), angle=0.0))
+    rod = sys.add_rigid_body("rod", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.4, com=(1.0, 0.0)),
+                             flexmbd.FrameState2d(position=(1.0, 0.0)))
+    slider = sys.add_rigid_body("slider", flexmbd.RigidBodyProperties(mass=0.5, inertia=0.01),
+                                flexmbd.FrameState2d(position=(3.0, 0.0)))
+    sys.add_revolute_joint("O1", flexmbd.GROUND, (0, 0), crank, (0, 0))
+    sys.add_revolute_joint("O2", crank, (1, 0), rod, (0, 0))
+    sys.add_revolute_joint("O3", rod, (2, 0), slider, (0, 0))
+    sys.add_prismatic_joint("P", "ground", (0, 0), "slider", (0, 0), axis=(1, 0))
+    sys.add_body_coordinate_driver("motor", crank, "theta", flexmbd.constant_speed_law(1.0))
+    s = scene.solver
+    s.formulation = "ggl"
+    s.rtol, s.atol = 1e-8, 1e-10
+    s.t_end, s.output_step = 2 * math.pi, math.pi / 30
+    return scene
+
+
+def test_rigid_slider_crank_from_python_follows_the_closed_form():
+    # x = cos t + sqrt(4 - sin^2 t) (crank l1 = 1 at 1 rad/s, rod l2 = 2). At rtol 1e-8 the
+    # engine's tests reach ~1e-9 m; bound 1e-7 m.
+    res = rigid_crank_in_python().run()
+    assert res.ok, res.message
+    t = res.t
+    exact = np.cos(t) + np.sqrt(4.0 - np.sin(t) ** 2)
+    assert np.max(np.abs(res["slider.x"] - exact)) < 1e-7
+    assert res.data.shape == (61, len(res.columns))
+    assert res.summary["steps"] > 0 and res.summary["formulation"] == "ggl"
+
+
+def test_a_model_built_in_python_equals_the_same_scene_file():
+    # The same objects through the scene reader and through the bindings: the same
+    # System, the same arithmetic, so the same numbers to the last bit.
+    a = flexmbd.load_scene(example("slider_crank_rigid.json"), overrides={"solver.output_step": math.pi / 30}).run()
+    b = rigid_crank_in_python().run()
+    assert a.columns == b.columns
+    assert np.array_equal(a.data, b.data)
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], np.array([[float(x) for x in r] for r in rows[1:]])
+
+
+def test_the_elastic_crank_equals_the_command_line(tmp_path):
+    # The CLI writes 17 significant digits, which read back to the same doubles: equal.
+    out = tmp_path / "cli"
+    scene = example("slider_crank_elastic.json")
+    r = subprocess.run([CLI, "run", scene, "--out", str(out), "--quiet", "--t-end", "0.004"],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    columns, data = read_csv(out / "results.csv")
+    res = flexmbd.load_scene(scene, overrides={"solver": {"t_end": 0.004}}).run()
+    assert res.columns == columns
+    assert np.array_equal(res.data, data)
+    assert "mid.uy" in res and len(res) == data.shape[0]
+
+
+def test_overrides_reach_any_key_and_name_missing_ones():
+    base = flexmbd.load_scene(example("slider_crank_elastic.json"), overrides={"solver.t_end": 0.002})
+    stiff = flexmbd.load_scene(example("slider_crank_elastic.json"),
+                               overrides={"solver.t_end": 0.002, "bodies[1].section.youngs_modulus": 2e13})
+    a, b = base.run(), stiff.run()
+    # a 100 x stiffer rod deflects about 100 x less (bound: 20 x)
+    assert np.max(np.abs(b["mid.uy"])) < np.max(np.abs(a["mid.uy"])) / 20
+    with pytest.raises(flexmbd.InputError, match=r"no element \[7\]"):
+        flexmbd.load_scene(example("slider_crank_elastic.json"), overrides={"bodies[7].mass": 1.0})
+
+
+def test_input_errors_are_value_errors_with_the_engines_message(tmp_path):
+    # The message the command line prints (after "flexmbd: error: ").
+    bad = flexmbd.apply_overrides(
+        __import__("json").load(open(example("slider_crank_rigid.json"))), {"bodies[0].mass": -1.0})
+    path = tmp_path / "bad.json"
+    path.write_text(__import__("json").dumps(bad))
+    with pytest.raises(flexmbd.InputError) as e:
+        flexmbd.load_scene(path)
+    assert isinstance(e.value, ValueError)
+    r = subprocess.run([CLI, "run", str(path), "--out", str(tmp_path / "o"), "--quiet"], capture_output=True, text=True)
+    assert r.returncode == 2
+    assert str(e.value) in r.stderr
+    assert 'bodies[0] ("crank"): key "mass" must be > 0, got -1' in str(e.value)
+    with pytest.raises(flexmbd.InputError, match="cannot open scene file"):
+        flexmbd.load_scene(tmp_path / "missing.json")
+    with pytest.raises(flexmbd.InputError, match="unknown body 'nope'"):
+        flexmbd.Scene().system.add_revolute_joint("j", "ground", (0, 0), "nope", (0, 0))
+
+
+def test_a_model_error_names_the_redundant_joint():
+    scene = rigid_crank_in_python()
+    scene.system.add_revolute_joint("again", "crank", (1, 0), "rod", (0, 0))  # O2 twice
+    with pytest.raises(flexmbd.ModelError, match="again") as e:
+        scene.run()
+    assert isinstance(e.value, flexmbd.InputError)
+
+
+def test_a_solver_failure_says_when_and_keeps_the_results():
+    # A lock-up: the slider crank with a rod shorter than the crank stops at the dead
+    # position; crossing singular positions off, the run fails there.
+    scene = flexmbd.load_scene(example("slider_crank_lockup.json"), overrides={"solver.cross_singular": False})
+    with pytest.raises(flexmbd.SolverFailure) as e:
+        scene.run()
+    f = e.value
+    assert f.time > 0 and len(f.results) > 1
+    assert f.results.t[-1] <= f.time
+    assert "solver failure" in str(f) and f.results.summary["status"] == "failed"
+    res = scene.run(raise_on_failure=False)
+    assert not res.ok and res.message == f.results.message
+
+
+def test_runs_in_threads_release_the_gil_and_give_the_same_numbers():
+    # While a run goes on in a thread, the main thread keeps running Python (it could not
+    # if the run held the GIL); two runs in threads equal the run alone.
+    alone = flexmbd.load_scene(example("slider_crank_elastic.json"), overrides={"solver.t_end": 0.01}).run()
+    results = [None, None]
+
+    def work(k):
+        results[k] = flexmbd.load_scene(example("slider_crank_elastic.json"), overrides={"solver.t_end": 0.01}).run()
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(2)]
+    for th in threads:
+        th.start()
+    ticks = 0
+    while any(th.is_alive() for th in threads):
+        ticks += 1
+    for th in threads:
+        th.join()
+    assert ticks > 1000
+    for r in results:
+        assert np.array_equal(r.data, alone.data)
+
+
+def test_flexible_body_built_in_python():
+    # A pinned-pinned beam's natural frequencies from the model, and a flexible body in a
+    # system: the frame at the first node, the columns q1.. of its elastic coordinates.
+    section = flexmbd.rectangular_section(0.01, 0.01, 2.1e11, 7850.0)
+    model = flexmbd.FfrBeamModel(flexmbd.BeamMesh2d.straight(1.0, 8, section),
+                                 flexmbd.FfrBeamOptions(reference=flexmbd.Reference.PINNED_PINNED, modes=3))
+    w = model.natural_frequencies()
+    # first bending frequency of a pinned-pinned beam: pi^2 sqrt(EI / (rho A L^4)); 8 cubic
+    # elements: 1e-4 relative
+    EI, rhoA = 2.1e11 * 0.01 ** 4 / 12, 7850.0 * 1e-4
+    assert abs(w[0] / (math.pi ** 2 * math.sqrt(EI / rhoA)) - 1) < 1e-4
+    scene = flexmbd.Scene("beam")
+    beam = scene.system.add_flexible_body("beam", model, flexmbd.FrameState2d(angular_velocity=1.0))
+    scene.system.add_revolute_joint("pin", "ground", (0, 0), beam, (0, 0))
+    scene.add_output({"type": "deflection", "name": "mid", "body": "beam", "point": [0.5, 0]})
+    scene.solver.t_end, scene.solver.output_step = 0.01, 0.005
+    res = scene.run()
+    assert res.ok and "beam.q3" in res and "mid.M" in res
