@@ -3,6 +3,7 @@
 //   flexmbd kinematics SCENE.json --out DIR [...]   (linkage/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
+//   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "app/command_line.hpp"
+#include "app/modes_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
 #include "core/errors.hpp"
@@ -51,6 +53,8 @@ const char* const kUsage =
     "       flexmbd summary DIR\n"
     "       flexmbd plot DIR [DIR ...] [--columns A,B] [--x COLUMN] [--out FILE.png]\n"
     "                    [--labels L1,L2] [--title TEXT] [--deg]\n"
+    "       flexmbd modes SCENE.json --out DIR [--at T] [--count N] [--steady]\n"
+    "                     [--sweep NAME:FROM:TO:N] [--solver auto|dense|sparse]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -86,6 +90,18 @@ const char* const kUsage =
     "column of the horizontal axis (default t, or alpha), --out the PNG (default\n"
     "DIR/plot.png), --labels one legend label per DIR, --title, --deg angles in degrees.\n"
     "Units follow from the column names; the path of the PNG is printed.\n"
+    "\n"
+    "modes linearises the equations of motion of SCENE.json (planar or spatial) about its\n"
+    "consistent state at t_start (solved for static equilibrium if at rest; --at T: the\n"
+    "state simulated to T) and writes DIR/modes.csv (frequencies, damping ratios,\n"
+    "eigenvalues), DIR/mode_shapes.csv (one column per mode) and DIR/vtk/mode_NN.pvd; it\n"
+    "prints them with the natural frequencies of every beam body's model. --count N modes\n"
+    "(default 10). --sweep NAME:FROM:TO:N: the modes at N speeds of the constant_speed\n"
+    "driver or of the initial spin of the body NAME, DIR/campbell.csv and campbell.png\n"
+    "(see docs/modes.md). --steady: the state is the steady motion at the initial velocities\n"
+    "(accelerations zero: a rotor stretched by its centrifugal load), solved by Newton.\n"
+    "--solver: dense (Eigen), sparse (Spectra shift-invert) or auto (dense up to 400\n"
+    "independent coordinates).\n"
     "\n"
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
@@ -130,7 +146,7 @@ Options parseCommandLine(int argc, char** argv) {
   }
   if (args[0] != "run") {
     throw UsageError("unknown command '" + args[0] +
-                     "' (expected 'run', 'kinematics', 'summary', 'plot', '--help' or '--version')");
+                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', '--help' or '--version')");
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
@@ -281,6 +297,12 @@ int mainImpl(int argc, char** argv) {
     bool help = false;
     for (const auto& a : rest) help = help || a == "--help" || a == "-h";
     if (!help) return runKinematicsCommand(rest);  // same exit statuses 0/1/2
+  }
+  if (argc >= 2 && std::string(argv[1]) == "modes") {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return runModesCommand(rest);
   }
   if (argc >= 2 && (std::string(argv[1]) == "summary" || std::string(argv[1]) == "plot")) {
     const std::vector<std::string> rest(argv + 2, argv + argc);

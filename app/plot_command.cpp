@@ -133,20 +133,20 @@ std::vector<std::string> splitList(const std::string& s) {
 
 bool isExecutable(const fs::path& p) { return ::access(p.c_str(), X_OK) == 0 && fs::is_regular_file(p); }
 
-fs::path findScript() {
-  if (const char* env = std::getenv("FLEXMBD_PLOT_SCRIPT"); env && *env) return env;
+fs::path findScript(const std::string& name = kScriptName) {
+  if (const char* env = std::getenv("FLEXMBD_PLOT_SCRIPT"); env && *env && name == kScriptName) return env;
   std::vector<fs::path> candidates;
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(self.parent_path().parent_path() / "share" / "flexmbd" / kScriptName);
-  if (*FLEXMBD_SCRIPTS_DIR) candidates.push_back(fs::path(FLEXMBD_SCRIPTS_DIR) / kScriptName);
+  if (!ec) candidates.push_back(self.parent_path().parent_path() / "share" / "flexmbd" / name);
+  if (*FLEXMBD_SCRIPTS_DIR) candidates.push_back(fs::path(FLEXMBD_SCRIPTS_DIR) / name);
   std::string looked;
   for (const fs::path& c : candidates) {
     if (fs::is_regular_file(c, ec)) return c;
     looked += (looked.empty() ? "" : ", ") + c.string();
   }
-  throw std::runtime_error("plot: cannot find " + std::string(kScriptName) + " (looked in " + looked +
-                           "; set FLEXMBD_PLOT_SCRIPT to its path)");
+  throw std::runtime_error("plot: cannot find " + name + " (looked in " + looked +
+                           (name == kScriptName ? "; set FLEXMBD_PLOT_SCRIPT to its path)" : ")"));
 }
 
 std::string findPython() {
@@ -182,6 +182,12 @@ int runAndWait(const std::vector<std::string>& argv) {
 }
 
 }  // namespace
+
+int runPythonScript(const std::string& scriptName, const std::vector<std::string>& args) {
+  std::vector<std::string> argv = {findPython(), findScript(scriptName).string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return runAndWait(argv);
+}
 
 int runPlotCommand(const std::vector<std::string>& args) {
   std::vector<std::string> scriptArgs;

@@ -14,4 +14,10 @@ namespace flexmbd {
 /// stdout); 1 it could not plot (no Python, no matplotlib, the file not written).
 int runPlotCommand(const std::vector<std::string>& args);
 
+/// Runs the plotting script `scriptName` of scripts/ (found and interpreted as for plot:
+/// <bin>/../share/flexmbd/, then the source tree's scripts/; $FLEXMBD_PYTHON or
+/// /usr/bin/python3) with `args`: its exit status, 0 or 2, any other failure 1.
+/// @throws std::runtime_error if the script cannot be found or started.
+int runPythonScript(const std::string& scriptName, const std::vector<std::string>& args);
+
 }  // namespace flexmbd

@@ -1,0 +1,392 @@
+// flexmbd modes: linearisation and modal analysis from the command line (docs/modes.md).
+#include "app/modes_command.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/command_line.hpp"
+#include "app/plot_command.hpp"
+#include "bodies/ffr_body_2d.hpp"
+#include "core/errors.hpp"
+#include "core/number_text.hpp"
+#include "integrators/linearization.hpp"
+#include "integrators/simulation.hpp"
+#include "io/scene.hpp"
+#include "io/vtk_writer.hpp"
+
+namespace flexmbd {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kExitOk = 0;
+constexpr int kExitFailure = 1;
+constexpr int kExitInputError = 2;
+/// Frames of the VTK animation of one mode shape (one period).
+constexpr int kShapeFrames = 16;
+/// Largest displacement of the drawn mode shapes, as a fraction of the model's size.
+constexpr double kShapeAmplitude = 0.05;
+/// Largest rotation (rad) of the drawn mode shapes when no length moves.
+constexpr double kShapeAngle = 0.1;
+
+/// --sweep NAME:FROM:TO:N
+struct Sweep {
+  std::string name;
+  double from = 0.0, to = 0.0;
+  int points = 0;
+};
+
+struct ModesCommandOptions {
+  std::string scenePath, outDir;
+  std::optional<double> at;
+  int count = 10;
+  std::optional<Sweep> sweep;
+  bool quiet = false;
+  bool steady = false;  ///< --steady: solveSteadyMotion instead of the consistent state
+  EigenSolverKind solver = EigenSolverKind::Automatic;  ///< --solver
+};
+
+EigenSolverKind parseSolver(const std::string& text) {
+  if (text == "auto") return EigenSolverKind::Automatic;
+  if (text == "dense") return EigenSolverKind::Dense;
+  if (text == "sparse") return EigenSolverKind::Sparse;
+  throw cli::UsageError("option --solver expects auto, dense or sparse, got '" + text + "'");
+}
+
+int parseCount(const std::string& text) {
+  const double x = cli::parseNumberOption("--count", text);
+  if (x != std::floor(x) || x < 1 || x > 10000) {
+    throw cli::UsageError("option --count expects a whole number 1..10000, got '" + text + "'");
+  }
+  return static_cast<int>(x);
+}
+
+Sweep parseSweep(const std::string& text) {
+  // the name may hold ':': the last three fields are FROM, TO, N
+  std::vector<std::string> parts;
+  std::string rest = text;
+  for (int k = 0; k < 3; ++k) {
+    const auto c = rest.rfind(':');
+    if (c == std::string::npos) {
+      throw cli::UsageError("option --sweep expects NAME:FROM:TO:N (a driver or body name, the speed range in rad/s "
+                            "and the number of speeds), got '" + text + "'");
+    }
+    parts.insert(parts.begin(), rest.substr(c + 1));
+    rest = rest.substr(0, c);
+  }
+  if (rest.empty()) throw cli::UsageError("option --sweep: the driver or body name is empty in '" + text + "'");
+  Sweep s;
+  s.name = rest;
+  s.from = cli::parseNumberOption("--sweep (FROM)", parts[0]);
+  s.to = cli::parseNumberOption("--sweep (TO)", parts[1]);
+  const double n = cli::parseNumberOption("--sweep (N)", parts[2]);
+  if (n != std::floor(n) || n < 1 || n > 1000) {
+    throw cli::UsageError("option --sweep: N must be a whole number 1..1000, got '" + parts[2] + "'");
+  }
+  s.points = static_cast<int>(n);
+  return s;
+}
+
+ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
+  const cli::SplitArguments split = cli::splitArguments(
+      args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep", "--solver"}),
+      cli::withCommon(cli::kCommonFlags, {{"--steady", "--steady"}}), "modes: ");
+  ModesCommandOptions o;
+  o.quiet = split.flags.count("--quiet") > 0;
+  o.steady = split.flags.count("--steady") > 0;
+  for (const auto& [name, value] : split.values) {
+    if (name == "--out") {
+      if (value.empty()) throw cli::UsageError("option --out needs a directory");
+      o.outDir = value;
+    } else if (name == "--at") {
+      o.at = cli::parseNumberOption(name, value);
+    } else if (name == "--count") {
+      o.count = parseCount(value);
+    } else if (name == "--solver") {
+      o.solver = parseSolver(value);
+    } else {
+      o.sweep = parseSweep(value);
+    }
+  }
+  if (split.positional.empty()) throw cli::UsageError("modes: missing the scene file (flexmbd modes SCENE.json --out DIR)");
+  if (split.positional.size() > 1) {
+    throw cli::UsageError("modes: expected one scene file, got " + std::to_string(split.positional.size()) +
+                          " arguments ('" + split.positional[0] + "', '" + split.positional[1] + "', ...)");
+  }
+  o.scenePath = split.positional[0];
+  if (o.outDir.empty()) throw cli::UsageError("modes: missing --out DIR (the output directory)");
+  if (o.at && o.sweep) throw cli::UsageError("modes: --at and --sweep cannot be combined (a sweep linearises at t_start)");
+  if (o.at && o.steady) throw cli::UsageError("modes: --at and --steady cannot be combined (--steady solves for the state)");
+  return o;
+}
+
+std::string readText(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream buf;
+  buf << in.rdbuf();
+  if (!in && !in.eof()) throw InputError("cannot read scene file '" + path + "'");
+  return buf.str();
+}
+
+std::string number(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.12g", x);
+  return buf;
+}
+
+/// The sparse solver, and any model too large for the dense one, takes the sparse
+/// (coordinate-partitioning) basis; the others the orthonormal one.
+BasisKind basisFor(const System& sys, EigenSolverKind solver) {
+  const bool sparse = solver == EigenSolverKind::Sparse ||
+                      (solver == EigenSolverKind::Automatic && sys.numVelocities() > kDenseModesLimit);
+  return sparse ? BasisKind::CoordinatePartitioning : BasisKind::Svd;
+}
+
+/// The state at t_start: the consistent state (an equilibrium if at rest), or with
+/// `steady` the steady motion at the initial velocities.
+ReferenceState initialReference(const Scene& scene, bool steady) {
+  const System& sys = scene.system;
+  return steady ? solveSteadyMotion(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities())
+                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
+}
+
+/// The state to linearise about: initialReference, or the state reached by simulating to `at`.
+/// @throws SolverError if that simulation fails.
+ReferenceState findReference(const Scene& scene, std::optional<double> at, bool steady, bool quiet) {
+  const System& sys = scene.system;
+  if (!at) return initialReference(scene, steady);
+  if (!(*at > scene.solver.tStart)) {
+    throw InputError("option --at must be > t_start (" + fmt(scene.solver.tStart, 6) + ") of the scene, got " +
+                     fmt(*at, 6));
+  }
+  SolverSettings s = scene.solver;
+  s.tEnd = *at;
+  s.progress = !quiet;
+  OutputSample last;
+  const SimulationSummary summary = simulate(sys, s, [&](const OutputSample& sample) { last = sample; });
+  if (!summary.ok) throw SolverError("the simulation to --at " + fmt(*at, 6) + " failed: " + summary.message,
+                                     summary.tReached, 0.0);
+  return ReferenceState{last.t, last.q, last.v, last.a, last.lambda};
+}
+
+void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {
+  std::ofstream out(file);
+  out << "index,frequency_hz,omega_rad_s,damping_ratio,real,imag\n";
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const Mode& m = modes[k];
+    out << k + 1 << ',' << number(m.frequencyHz) << ',' << number(m.omega) << ',' << number(m.dampingRatio) << ','
+        << number(m.eigenvalue.real()) << ',' << number(m.eigenvalue.imag()) << '\n';
+  }
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+void writeShapesCsv(const fs::path& file, const std::vector<Mode>& modes, const std::vector<std::string>& names) {
+  std::ofstream out(file);
+  out << "velocity";
+  for (size_t k = 0; k < modes.size(); ++k) out << ",mode_" << k + 1;
+  out << '\n';
+  for (size_t i = 0; i < names.size(); ++i) {
+    out << names[i];
+    for (const Mode& m : modes) out << ',' << number(m.shape[static_cast<Eigen::Index>(i)].real());
+    out << '\n';
+  }
+  if (!out) throw std::runtime_error("cannot write " + file.string());
+}
+
+/// Scale of a drawn mode shape: its largest length entry moves kShapeAmplitude of the
+/// model's size (its largest angle kShapeAngle if it moves no length).
+double shapeScale(const System& sys, const VecX& shape) {
+  const std::vector<CoordinateKind> kinds = sys.velocityKinds();
+  double lengths = 0.0, angles = 0.0;
+  for (Eigen::Index k = 0; k < shape.size(); ++k) {
+    (kinds[k] == CoordinateKind::Angle ? angles : lengths) = std::max(kinds[k] == CoordinateKind::Angle ? angles : lengths,
+                                                                      std::abs(shape[k]));
+  }
+  if (lengths > 1e-12 * std::max(angles, 1e-300)) return kShapeAmplitude * sys.characteristicLength() / lengths;
+  return angles > 0.0 ? kShapeAngle / angles : 0.0;
+}
+
+/// DIR/vtk/mode_NN.pvd: one period of each mode shape, q = q_ref (+) c Re(shape e^{i phi}).
+void writeShapesVtk(const fs::path& dir, const System& sys, const ReferenceState& ref, const std::vector<Mode>& modes) {
+  for (size_t k = 0; k < modes.size(); ++k) {
+    char prefix[32];
+    std::snprintf(prefix, sizeof prefix, "mode_%02zu", k + 1);
+    VtkWriter vtk(dir, sys, prefix);
+    const double c = shapeScale(sys, modes[k].shape.real());
+    for (int f = 0; f < kShapeFrames; ++f) {
+      const double phi = 2 * M_PI * f / kShapeFrames;
+      const VecX dx = c * (modes[k].shape * std::exp(std::complex<double>(0.0, phi))).real();
+      OutputSample s;
+      s.t = static_cast<double>(f) / kShapeFrames;  // the fraction of the period
+      s.q = sys.applyIncrement(ref.q, dx);
+      s.v = VecX::Zero(sys.numVelocities());
+      s.a = VecX::Zero(sys.numVelocities());
+      s.lambda = ref.lambda;
+      vtk.write(s);
+    }
+  }
+}
+
+void printTable(const std::vector<Mode>& modes) {
+  std::printf("  mode   frequency (Hz)   omega (rad/s)   damping ratio   eigenvalue\n");
+  for (size_t k = 0; k < modes.size(); ++k) {
+    const Mode& m = modes[k];
+    std::printf("  %4zu   %14.6g   %13.6g   %13.4g   %.6g %+.6gi\n", k + 1, m.frequencyHz, m.omega, m.dampingRatio,
+                m.eigenvalue.real(), m.eigenvalue.imag());
+  }
+}
+
+/// The natural frequencies of each beam body's model under its reference conditions
+/// (frame held fixed; FfrBeamModel::naturalFrequencies).
+void printBeamFrequencies(const System& sys, int count) {
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const auto* ffr = dynamic_cast<const FfrBody2d*>(&sys.body(BodyIndex(b)));
+    if (!ffr || !ffr->beamModel()) continue;
+    const VecX w = ffr->beamModel()->naturalFrequencies();
+    std::printf("beam \"%s\": natural frequencies of its model on its reference conditions (frame fixed), Hz:",
+                cli::oneLine(ffr->name()).c_str());
+    for (int k = 0; k < std::min<int>(count, static_cast<int>(w.size())); ++k) std::printf(" %.6g", w[k] / (2 * M_PI));
+    std::printf("\n");
+  }
+}
+
+/// The scene's JSON with the speed of driver or body `name` set to `speed`: a driver's
+/// constant_speed law, or a body's initial angular velocity (spatial: along its given direction).
+/// @throws InputError naming the driver, body or key.
+nlohmann::json withSpeed(nlohmann::json j, const std::string& name, double speed) {
+  const bool spatial = j.contains("dimension") && j["dimension"] == 3;
+  if (j.contains("drivers") && j["drivers"].is_array()) {
+    for (auto& d : j["drivers"]) {
+      if (!d.is_object() || !d.contains("name") || d["name"] != name) continue;
+      if (!d.contains("law") || !d["law"].is_object() || d["law"].value("type", "") != "constant_speed") {
+        throw InputError("--sweep: driver \"" + name + "\" needs a law of type \"constant_speed\" (key \"law\") to sweep its speed");
+      }
+      d["law"]["speed"] = speed;
+      return j;
+    }
+  }
+  if (j.contains("bodies") && j["bodies"].is_array()) {
+    for (auto& b : j["bodies"]) {
+      if (!b.is_object() || !b.contains("name") || b["name"] != name) continue;
+      if (!spatial) {
+        b["angular_velocity"] = speed;
+        return j;
+      }
+      if (!b.contains("angular_velocity") || !b["angular_velocity"].is_array() || b["angular_velocity"].size() != 3) {
+        throw InputError("--sweep: body \"" + name + "\" needs an \"angular_velocity\" [wx, wy, wz] giving the spin axis");
+      }
+      Vec3 w;
+      for (int k = 0; k < 3; ++k) w[k] = b["angular_velocity"][k].get<double>();
+      if (w.norm() == 0.0) throw InputError("--sweep: body \"" + name + "\": key \"angular_velocity\" is zero, it must give the spin axis");
+      w *= speed / w.norm();
+      b["angular_velocity"] = {w[0], w[1], w[2]};
+      return j;
+    }
+  }
+  throw InputError("--sweep: the scene has no driver or body named \"" + name +
+                   "\" (give a driver with a constant_speed law or a body with an initial spin)");
+}
+
+int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs::path& out) {
+  const Sweep& sw = *o.sweep;
+  std::ofstream csv(out / "campbell.csv");
+  csv << "speed";
+  for (int k = 1; k <= o.count; ++k) csv << ",f" << k << "_hz";
+  for (int k = 1; k <= o.count; ++k) csv << ",zeta" << k;
+  csv << '\n';
+  ModesOptions mo;
+  mo.count = o.count;
+  mo.solver = o.solver;
+  std::printf("Campbell sweep of \"%s\": %d speeds from %g to %g rad/s\n", cli::oneLine(sw.name).c_str(), sw.points,
+              sw.from, sw.to);
+  for (int i = 0; i < sw.points; ++i) {
+    const double speed = sw.points == 1 ? sw.from : sw.from + (sw.to - sw.from) * i / (sw.points - 1);
+    const Scene scene = parseSceneText(withSpeed(base, sw.name, speed).dump(), o.scenePath);
+    const System& sys = scene.system;
+    const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo, basisFor(sys, o.solver));
+    csv << number(speed);
+    for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].frequencyHz) : "");
+    for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].dampingRatio) : "");
+    csv << '\n';
+    std::printf("  speed %10.6g rad/s:", speed);
+    for (size_t k = 0; k < std::min<size_t>(modes.size(), 6); ++k) std::printf(" %.5g", modes[k].frequencyHz);
+    std::printf(" Hz%s\n", modes.size() > 6 ? " ..." : "");
+  }
+  csv.close();
+  if (!csv) throw std::runtime_error("cannot write " + (out / "campbell.csv").string());
+  std::printf("Campbell diagram: %s\n", (out / "campbell.csv").string().c_str());
+  ::setenv("FLEXMBD_PLOT_FROM_CLI", "1", 1);
+  return runPythonScript("plot_campbell.py", {(out / "campbell.csv").string(), "--out", (out / "campbell.png").string(),
+                                              "--title", "Campbell diagram: " + sw.name});
+}
+
+}  // namespace
+
+int runModesCommand(const std::vector<std::string>& args) {
+  ModesCommandOptions o;
+  nlohmann::json base;
+  std::optional<Scene> scene;
+  try {
+    o = parseOptions(args);
+    const std::string text = readText(o.scenePath);
+    scene.emplace(parseSceneText(text, o.scenePath));
+    base = nlohmann::json::parse(text);
+  } catch (const std::exception& e) {
+    cli::printError(e.what());
+    return kExitInputError;
+  }
+  const fs::path out(o.outDir);
+  try {
+    std::error_code ec;
+    if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw InputError("--out '" + o.outDir + "' exists and is not a directory");
+    fs::create_directories(out);
+  } catch (const std::exception& e) {
+    cli::printError(e.what());
+    return kExitInputError;
+  }
+  try {
+    if (o.sweep) {
+      printBeamFrequencies(scene->system, o.count);
+      return runSweep(o, base, out);
+    }
+    const System& sys = scene->system;
+    const ReferenceState ref = findReference(*scene, o.at, o.steady, o.quiet);
+    const LinearizedSystem lin = linearize(sys, ref);
+    const ReducedSystem red = reduce(lin, basisFor(sys, o.solver));
+    ModesOptions mo;
+    mo.count = o.count;
+    mo.solver = o.solver;
+    const std::vector<Mode> modes = computeModes(red, mo);
+    writeModesCsv(out / "modes.csv", modes);
+    writeShapesCsv(out / "mode_shapes.csv", modes, lin.velocityNames);
+    writeShapesVtk(out / "vtk", sys, ref, modes);
+    const double aMax = ref.a.size() ? ref.a.lpNorm<Eigen::Infinity>() : 0.0;
+    std::printf("flexmbd: modes of %s about t = %g (%s; max |a| = %.3g): %d velocities, %d independent\n",
+                o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : o.steady ? "steady motion" : "in motion", aMax,
+                sys.numVelocities(), static_cast<int>(red.N.cols()));
+    printTable(modes);
+    printBeamFrequencies(sys, o.count);
+    std::printf("results: %s, %s, %s\n", (out / "modes.csv").string().c_str(), (out / "mode_shapes.csv").string().c_str(),
+                (out / "vtk").string().c_str());
+    return kExitOk;
+  } catch (const InputError& e) {  // ModelError included: no equilibrium, no degree of freedom
+    cli::printError(o.scenePath + ": " + e.what());
+    return kExitInputError;
+  } catch (const std::exception& e) {
+    cli::printError(e.what());
+    return kExitFailure;
+  }
+}
+
+}  // namespace flexmbd

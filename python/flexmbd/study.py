@@ -1,0 +1,431 @@
+"""Parameter studies: one scene run over parameter axes on Dask distributed.
+
+A study file (JSON, docs/python.md "Parameter studies") names a scene, the parameter
+axes (a grid, a zipped list, or random samples with a seed) as scene keys to override,
+and the values to collect from each run. Points run as Dask tasks (a LocalCluster here,
+or any scheduler by address); each returns a small record; records land in
+DIR/study.csv as points finish, so an interrupted study keeps what it finished and a
+rerun skips those points. Failures are recorded per point, never fatal.
+
+    flexmbd-study examples/study_resonance.json --out out/resonance --workers 2
+"""
+
+import argparse
+import csv
+import importlib
+import itertools
+import json
+import logging
+import math
+import os
+import random
+import sys
+import time
+
+import numpy as np
+
+from . import InputError, scene_from_dict
+
+FIXED_COLUMNS = ["point", "status", "message", "t_reached", "wall_seconds"]
+STUDY_KEYS = {"name", "scene", "overrides", "axes", "combine", "samples", "outputs", "plot"}
+AXIS_KEYS = {"name", "key", "values", "range", "count", "spacing"}
+OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions"}
+PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
+
+
+def _fail(where, message):
+    raise InputError(f"{where}: {message}")
+
+
+def _allow_only(obj, allowed, where):
+    if not isinstance(obj, dict):
+        _fail(where, f"must be an object, got {json.dumps(obj)}")
+    unknown = sorted(set(obj) - allowed)
+    if unknown:
+        _fail(where, f"unknown key {unknown[0]!r} (allowed keys: {', '.join(sorted(allowed))})")
+
+
+class Study:
+    """A parsed study file. ``points``: the parameter values of every point, in order."""
+
+    def __init__(self, spec, path="<study>"):
+        where = path
+        _allow_only(spec, STUDY_KEYS, where)
+        if "scene" not in spec:
+            _fail(where, 'key "scene" is required (the scene file, relative to the study file)')
+        base = os.path.dirname(os.path.abspath(path)) if path != "<study>" else os.getcwd()
+        self.path = path
+        self.name = spec.get("name", os.path.splitext(os.path.basename(path))[0])
+        self.scene_path = os.path.join(base, spec["scene"])
+        try:
+            with open(self.scene_path, encoding="utf-8") as f:
+                self.scene = json.load(f)
+        except OSError as e:
+            _fail(where, f'key "scene": cannot open {self.scene_path!r}: {e.strerror}')
+        except json.JSONDecodeError as e:
+            _fail(where, f'key "scene": {self.scene_path!r} is not valid JSON: {e}')
+        self.overrides = spec.get("overrides", {})
+        if not isinstance(self.overrides, dict):
+            _fail(where, 'key "overrides" must be an object of scene keys')
+        self.axes = self._parse_axes(spec, where)
+        self.points = self._make_points(spec, where)
+        self.outputs = spec.get("outputs", {"summary": ["steps", "cpu_seconds"]})
+        _allow_only(self.outputs, OUTPUT_KEYS, where + ": outputs")
+        self.output_names = output_names(self.outputs)
+        self.plot = spec.get("plot")
+        if self.plot is not None:
+            _allow_only(self.plot, PLOT_KEYS, where + ": plot")
+            for k in ("x", "y"):
+                if k not in self.plot:
+                    _fail(where + ": plot", f"key {k!r} is required")
+
+    @staticmethod
+    def _parse_axes(spec, where):
+        axes = spec.get("axes")
+        if not isinstance(axes, list) or not axes:
+            _fail(where, 'key "axes" must be a non-empty list of axes {"name", "key", "values" | "range"}')
+        out = []
+        names = set()
+        for i, a in enumerate(axes):
+            w = f"{where}: axes[{i}]"
+            _allow_only(a, AXIS_KEYS, w)
+            if "key" not in a:
+                _fail(w, 'key "key" is required (the scene key to override, e.g. "drivers[0].law.speed")')
+            name = a.get("name", a["key"])
+            if name in names:
+                _fail(w, f"duplicate axis name {name!r}")
+            names.add(name)
+            if "values" in a:
+                values = a["values"]
+                if not isinstance(values, list) or not values:
+                    _fail(w, 'key "values" must be a non-empty list')
+            elif "range" in a:
+                r = a["range"]
+                if not (isinstance(r, list) and len(r) == 2 and all(isinstance(x, (int, float)) for x in r)):
+                    _fail(w, 'key "range" must be [low, high]')
+                spacing = a.get("spacing", "linear")
+                if spacing not in ("linear", "log"):
+                    _fail(w, f'key "spacing" must be "linear" or "log", got {spacing!r}')
+                if spacing == "log" and not (r[0] > 0 and r[1] > 0):
+                    _fail(w, "a log range needs positive bounds")
+                count = a.get("count")
+                values = None
+                if count is not None:
+                    if not isinstance(count, int) or count < 1:
+                        _fail(w, 'key "count" must be an integer >= 1')
+                    grid = np.geomspace(r[0], r[1], count) if spacing == "log" else np.linspace(r[0], r[1], count)
+                    values = [float(x) for x in grid]
+            else:
+                _fail(w, 'give "values" or "range"')
+            out.append({"name": name, "key": a["key"], "values": values, "range": a.get("range"),
+                        "spacing": a.get("spacing", "linear")})
+        return out
+
+    def _make_points(self, spec, where):
+        combine = spec.get("combine", "random" if "samples" in spec else "grid")
+        if combine == "random":
+            samples = spec.get("samples")
+            if not isinstance(samples, dict) or not isinstance(samples.get("count"), int) or samples["count"] < 1:
+                _fail(where, 'random studies need "samples": {"count": N, "seed": S}')
+            rng = random.Random(samples.get("seed", 0))
+            points = []
+            for _ in range(samples["count"]):
+                p = {}
+                for a in self.axes:
+                    if a["range"] is None:
+                        p[a["name"]] = rng.choice(a["values"])
+                    elif a["spacing"] == "log":
+                        lo, hi = math.log(a["range"][0]), math.log(a["range"][1])
+                        p[a["name"]] = math.exp(rng.uniform(lo, hi))
+                    else:
+                        p[a["name"]] = rng.uniform(*a["range"])
+                points.append(p)
+            return points
+        for a in self.axes:
+            if a["values"] is None:
+                _fail(where, f'axis {a["name"]!r}: a range needs "count" in a {combine} study')
+        if combine == "grid":
+            return [dict(zip([a["name"] for a in self.axes], combo))
+                    for combo in itertools.product(*[a["values"] for a in self.axes])]
+        if combine == "zip":
+            lengths = {len(a["values"]) for a in self.axes}
+            if len(lengths) != 1:
+                _fail(where, '"combine": "zip" needs axes of equal length')
+            return [dict(zip([a["name"] for a in self.axes], combo)) for combo in zip(*[a["values"] for a in self.axes])]
+        _fail(where, f'key "combine" must be "grid", "zip" or "random", got {combine!r}')
+        return []
+
+    def overrides_of(self, point):
+        o = dict(self.overrides)
+        for a in self.axes:
+            o[a["key"]] = point[a["name"]]
+        return o
+
+    @property
+    def columns(self):
+        return ["point"] + [a["name"] for a in self.axes] + FIXED_COLUMNS[1:] + self.output_names
+
+
+def load_study(path):
+    try:
+        with open(path, encoding="utf-8") as f:
+            spec = json.load(f)
+    except OSError as e:
+        raise InputError(f"cannot open study file '{path}': {e.strerror}") from None
+    except json.JSONDecodeError as e:
+        raise InputError(f"{path}: not valid JSON: {e}") from None
+    return Study(spec, path)
+
+
+def output_names(outputs):
+    names = [f"summary.{k}" for k in outputs.get("summary", [])]
+    for kind in ("max_abs", "max", "min", "final"):
+        names += [f"{kind}({c})" for c in outputs.get(kind, [])]
+    for i, a in enumerate(outputs.get("at", [])):
+        names.append(a.get("name", f"{a['column']}@{a['t']}"))
+    for f in outputs.get("functions", []):
+        names.append(f)
+    return names
+
+
+def collect(results, outputs):
+    """The values named by output_names(outputs) from a run's Results (NaN where a run
+    ended before a requested time)."""
+    values = [results.summary.get(k) for k in outputs.get("summary", [])]
+    t = results.t if len(results) else np.array([])
+    mask = t >= outputs.get("after", -math.inf) if len(t) else np.array([], dtype=bool)
+
+    def column(c):
+        return results[c][mask] if len(t) else np.array([])
+
+    for kind, fn in (("max_abs", lambda x: np.max(np.abs(x))), ("max", np.max), ("min", np.min),
+                     ("final", lambda x: x[-1])):
+        for c in outputs.get(kind, []):
+            x = column(c)
+            values.append(float(fn(x)) if len(x) else math.nan)
+    for a in outputs.get("at", []):
+        if len(t) and t[0] <= a["t"] <= t[-1]:
+            values.append(float(np.interp(a["t"], t, results[a["column"]])))
+        else:
+            values.append(math.nan)
+    for spec in outputs.get("functions", []):
+        module, _, name = spec.partition(":")
+        values.append(float(getattr(importlib.import_module(module), name)(results)))
+    return values
+
+
+def run_point(index, scene, overrides, outputs, names):
+    """One point (a Dask task): a small record, whatever happens in the run."""
+    start = time.perf_counter()
+    record = {"point": index, "status": "ok", "message": "", "t_reached": math.nan}
+    results = None
+    try:
+        results = scene_from_dict(scene, overrides, source=f"point {index}").run(raise_on_failure=False)
+        record["status"] = "ok" if results.ok else "failed"
+        record["message"] = "" if results.ok else results.message
+        tr = results.summary.get("t_reached")
+        record["t_reached"] = tr if tr is not None else math.nan
+    except InputError as e:
+        record["status"] = "input_error"
+        record["message"] = str(e)
+    except Exception as e:  # noqa: BLE001  (a point's failure is recorded, never fatal)
+        record["status"] = "error"
+        record["message"] = f"{type(e).__name__}: {e}"
+    values = [math.nan] * len(names)
+    if results is not None and record["status"] == "ok":
+        try:
+            values = collect(results, outputs)
+        except Exception as e:  # noqa: BLE001
+            record["status"] = "error"
+            record["message"] = f"outputs: {type(e).__name__}: {e}"
+    record["wall_seconds"] = time.perf_counter() - start
+    record["values"] = values
+    return record
+
+
+class TableWriter:
+    """DIR/study.csv: the header, then one row per finished point, flushed as written;
+    a rerun reads the points already there (resume)."""
+
+    def __init__(self, path, columns):
+        self.path, self.columns = path, columns
+        self.done = {}
+        if os.path.exists(path):
+            with open(path, newline="", encoding="utf-8") as f:
+                rows = list(csv.reader(f))
+            if rows and rows[0] != columns:
+                raise InputError(f"{path} holds another study (its columns differ); use another --out or delete it")
+            for r in rows[1:]:
+                if len(r) == len(columns):
+                    self.done[int(r[0])] = r
+            self.file = open(path, "a", newline="", encoding="utf-8")
+        else:
+            self.file = open(path, "w", newline="", encoding="utf-8")
+            csv.writer(self.file).writerow(columns)
+            self.file.flush()
+        self.writer = csv.writer(self.file)
+
+    def write(self, row):
+        self.writer.writerow([repr(x) if isinstance(x, float) else x for x in row])
+        self.file.flush()
+
+    def close(self):
+        self.file.close()
+
+
+class Progress:
+    """Points done, failed, rate and time left on stderr: one updated line on a
+    terminal, else a line every tenth of the study."""
+
+    def __init__(self, total, done, stream=sys.stderr):
+        self.total, self.done, self.failed, self.stream = total, done, 0, stream
+        self.start, self.ran = time.perf_counter(), 0
+        self.tty = hasattr(stream, "isatty") and stream.isatty()
+        self.every = max(1, total // 10)
+
+    def update(self, status):
+        self.done += 1
+        self.ran += 1
+        self.failed += status != "ok"
+        elapsed = time.perf_counter() - self.start
+        rate = self.ran / elapsed if elapsed > 0 else math.inf
+        left = (self.total - self.done) / rate if rate > 0 else math.inf
+        line = (f"study: {self.done}/{self.total} points, {self.failed} failed, "
+                f"{rate:.2f} points/s, ~{left:.0f} s left")
+        if self.tty:
+            self.stream.write("\r" + line + "   ")
+        elif self.ran % self.every == 0 or self.done == self.total:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def finish(self):
+        if self.tty:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def run_study(study, out_dir, scheduler=None, workers=None, progress=True):
+    """Runs the points not yet in out_dir/study.csv. ``workers == 0``: serially in this
+    process; else on Dask: the scheduler at ``scheduler`` (an address) or a LocalCluster
+    of ``workers`` processes (default: the machine's cores). Returns (ran, failed)."""
+    os.makedirs(out_dir, exist_ok=True)
+    table = TableWriter(os.path.join(out_dir, "study.csv"), study.columns)
+    todo = [i for i in range(len(study.points)) if i not in table.done]
+    prog = Progress(len(study.points), len(study.points) - len(todo), sys.stderr if progress else open(os.devnull, "w"))
+    failed = 0
+
+    def write(record):
+        nonlocal failed
+        p = study.points[record["point"]]
+        row = [record["point"]] + [p[a["name"]] for a in study.axes]
+        row += [record["status"], record["message"], record["t_reached"], record["wall_seconds"]] + record["values"]
+        table.write(row)
+        failed += record["status"] != "ok"
+        prog.update(record["status"])
+
+    args = lambda i: (i, study.scene, study.overrides_of(study.points[i]), study.outputs, study.output_names)  # noqa: E731
+    try:
+        if workers == 0 and scheduler is None:
+            for i in todo:
+                write(run_point(*args(i)))
+        else:
+            from dask.distributed import Client, LocalCluster, as_completed  # noqa: PLC0415
+
+            cluster = None
+            if scheduler is None:
+                n = workers or os.cpu_count() or 1
+                cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                       silence_logs=logging.ERROR)
+            client = Client(scheduler or cluster)
+            try:
+                futures = [client.submit(run_point, *args(i), pure=False) for i in todo]
+                index = {f.key: i for f, i in zip(futures, todo)}
+                for future in as_completed(futures):
+                    try:
+                        record = future.result()
+                    except Exception as e:  # noqa: BLE001  (a worker died: recorded)
+                        record = {"point": index[future.key], "status": "error",
+                                  "message": f"{type(e).__name__}: {e}", "t_reached": math.nan,
+                                  "wall_seconds": math.nan, "values": [math.nan] * len(study.output_names)}
+                    write(record)
+            finally:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+    finally:
+        prog.finish()
+        table.close()
+    return len(todo), failed
+
+
+def read_table(path):
+    """study.csv as (columns, rows of strings)."""
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def plot(study, out_dir):
+    """The study's "plot": y columns against x, one line per value of "group"; a PNG."""
+    import matplotlib  # noqa: PLC0415
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    spec = study.plot
+    columns, rows = read_table(os.path.join(out_dir, "study.csv"))
+    ys = spec["y"] if isinstance(spec["y"], list) else [spec["y"]]
+    for c in [spec["x"], *ys] + ([spec["group"]] if "group" in spec else []):
+        if c not in columns:
+            raise InputError(f"{study.path}: plot: no column {c!r} in study.csv (columns: {', '.join(columns)})")
+    col = {c: k for k, c in enumerate(columns)}
+    ok = [r for r in rows if r[col["status"]] == "ok"]
+    groups = sorted({r[col[spec["group"]]] for r in ok}, key=float) if "group" in spec else [None]
+    fig, axes = plt.subplots(len(ys), 1, figsize=(8, 3.2 * len(ys)), sharex=True, squeeze=False)
+    for ax, y in zip(axes[:, 0], ys):
+        for g in groups:
+            sel = sorted((r for r in ok if g is None or r[col[spec["group"]]] == g), key=lambda r: float(r[col[spec["x"]]]))
+            ax.plot([float(r[col[spec["x"]]]) for r in sel], [float(r[col[y]]) for r in sel], marker="o", ms=3,
+                    label=None if g is None else f"{spec['group']} = {float(g):g}")
+        ax.set_ylabel(y)
+        ax.grid(True, alpha=0.3)
+        if spec.get("log_x"):
+            ax.set_xscale("log")
+        if spec.get("log_y"):
+            ax.set_yscale("log")
+        if groups != [None]:
+            ax.legend(fontsize=8)
+    axes[-1, 0].set_xlabel(spec["x"])
+    fig.suptitle(spec.get("title", study.name))
+    fig.tight_layout()
+    out = os.path.join(out_dir, spec.get("file", "study.png"))
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+    return out
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(prog="flexmbd-study", description="Run a parameter study of a flexmbd scene.")
+    p.add_argument("study", help="the study file (JSON)")
+    p.add_argument("--out", required=True, help="output directory: study.csv (resumed if present), the plot")
+    p.add_argument("--scheduler", help="a running Dask scheduler's address (tcp://host:8786); default: a LocalCluster")
+    p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: the cores); 0: serially here")
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    a = p.parse_args(argv)
+    try:
+        if a.workers is not None and a.workers < 0:
+            raise InputError(f"option --workers must be >= 0, got {a.workers}")
+        study = load_study(a.study)
+        ran, failed = run_study(study, a.out, a.scheduler, a.workers, progress=not a.quiet)
+        print(f"flexmbd-study: {len(study.points)} points in {os.path.join(a.out, 'study.csv')} "
+              f"({ran} run now, {failed} of them not ok)")
+        if study.plot:
+            print(f"flexmbd-study: plot in {plot(study, a.out)}")
+    except InputError as e:
+        print(f"flexmbd-study: error: {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
