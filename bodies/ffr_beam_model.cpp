@@ -5,6 +5,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 
@@ -158,27 +159,39 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
   // B2 keeps unit columns where it can: sparse for the pinned and clamped conditions
   SpMat B = nullSpaceBasis(C).sparseView(1.0, 1e-14);
 
-  // ----- modal reduction -----------------------------------------------------------
-  if (options_.modes > 0 || !options_.modeSet.empty()) {
+  // ----- modal reduction (bodies/modal_reduction.hpp) -------------------------------
+  const std::vector<int> keep = chosenModes(options_.modes, options_.modeSet, owner);
+  const bool craigBampton = options_.reduction == ModalReduction::CraigBampton;
+  if (!craigBampton && !options_.interfaceNodes.empty()) {
+    throw InputError(owner + ": interface nodes are for the craig_bampton reduction only");
+  }
+  if (options_.inertiaModes && !craigBampton && keep.empty()) {
+    throw InputError(owner + ": inertia modes need a modal reduction (modes, or the craig_bampton reduction)");
+  }
+  if (craigBampton || !keep.empty()) {
     FfrInvariants reduced = nodal.transformed(B);
     reduced.validate(owner);  // names a rigid mode left by the reference conditions
-    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(reduced.kff), MatX(reduced.mff));
-    const int available = static_cast<int>(eig.eigenvalues().size());
-    std::vector<int> keep;
-    if (!options_.modeSet.empty()) {
-      keep = options_.modeSet;
+    MatX P;
+    if (craigBampton) {
+      std::vector<int> dofs;
+      const MatX G = interfaceConditions(B, 3, options_.interfaceNodes, owner, dofs);
+      CraigBamptonBasis cb = craigBamptonBasis(reduced.kff, reduced.mff, G, keep, owner);
+      for (int r : cb.interfaceRows) constraintDofs_.push_back(dofs[r]);
+      fixedInterfaceFrequencies_ = std::move(cb.fixedInterfaceFrequencies);
+      P = std::move(cb.basis);
     } else {
-      for (int k = 1; k <= options_.modes; ++k) keep.push_back(k);
+      P = normalModes(MatX(reduced.kff), MatX(reduced.mff), keep, owner);  // mass-normalised
     }
-    MatX Phi(B.cols(), keep.size());
-    for (size_t k = 0; k < keep.size(); ++k) {
-      if (keep[k] < 1 || keep[k] > available) {
-        throw InputError(owner + ": mode " + std::to_string(keep[k]) + " does not exist (the mesh has modes 1.." +
-                         std::to_string(available) + ")");
-      }
-      Phi.col(k) = eig.eigenvectors().col(keep[k] - 1);  // mass-normalised
+    if (options_.inertiaModes) {
+      // inertia loads of the frame's rigid motion on q_f at q_f = 0 (Q_v, Q_g in
+      // docs/flexible-bodies.md): translation S-bar^T, centrifugal I1, angular J0
+      MatX F(reduced.numElastic(), 4);
+      F << reduced.sBar.transpose(), reduced.i1, reduced.j0;
+      const int before = static_cast<int>(P.cols());
+      P = withStaticModes(reduced.kff, reduced.mff, P, F);
+      numInertiaModes_ = static_cast<int>(P.cols()) - before;
     }
-    B = (B * Phi).sparseView();
+    B = (B * P).sparseView();
   }
   basis_ = B;
   for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(makeElementBasis(static_cast<int>(e)));

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bodies/ffr_invariants.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "elements/beam_element_2d.hpp"
 
 namespace flexmbd {
@@ -41,8 +42,17 @@ struct FfrBeamOptions {
   ReferenceConditions reference;
   /// Modal reduction: 0 keeps every nodal coordinate; n > 0 keeps the first n modes
   /// (under the reference conditions); `modeSet` (1-based) keeps a chosen set instead.
+  /// Craig-Bampton: the fixed-interface modes.
   int modes = 0;
   std::vector<int> modeSet;
+  ModalReduction reduction = ModalReduction::Normal;
+  /// Craig-Bampton only (required there): the interface nodes, e.g. the joints' nodes.
+  std::vector<int> interfaceNodes;
+  /// With a reduction: add the static responses to the inertia loads of the frame's rigid
+  /// motion (translation S-bar^T, centrifugal I1, angular acceleration J0; at most 4),
+  /// so that the quasi-static deformation by the body's own inertia is held exactly
+  /// (withStaticModes, bodies/modal_reduction.hpp).
+  bool inertiaModes = false;
   /// Second-order axial strain in the strain energy (stiffening by axial load), as the
   /// element-averaged membrane strain u' + (1/2l) int v'^2 dx (locking-free); off: the
   /// linear FFR model (docs/flexible-bodies.md).
@@ -67,6 +77,16 @@ class FfrBeamModel {
   /// Natural frequencies (rad/s) of the body with its frame held fixed, ascending:
   /// K_ff phi = omega^2 m_ff phi.
   VecX naturalFrequencies() const;
+  /// Craig-Bampton: the nodal coordinate (3 node + k, k = ux, uy, psi) of each constraint
+  /// mode, i.e. of the first elastic coordinates q_1..q_nc (q_k is that nodal
+  /// displacement); empty for the other reductions.
+  const std::vector<int>& constraintModeCoordinates() const { return constraintDofs_; }
+  /// Craig-Bampton: the natural frequencies (rad/s) of the kept fixed-interface modes
+  /// (interface held), which are q_nc+1..; empty for the other reductions.
+  const VecX& fixedInterfaceFrequencies() const { return fixedInterfaceFrequencies_; }
+  /// The number of inertia modes (FfrBeamOptions::inertiaModes), the last elastic
+  /// coordinates; 0 without them.
+  int numInertiaModes() const { return numInertiaModes_; }
 
   double strainEnergy(const VecX& qf) const;
   VecX strainEnergyGradient(const VecX& qf) const;
@@ -78,7 +98,11 @@ class FfrBeamModel {
   bool locate(const Vec2& point, int& element, double& xi) const;
   /// Shape of an arbitrary material point on element `element` at xi.
   FfrPoint materialPoint(int element, double xi) const;
-  /// Axial force and bending moment at (element, xi) for the elastic coordinates q_f.
+  /// Axial force and bending moment at (element, xi) for the elastic coordinates q_f:
+  /// the element's stiffness times the nodal displacements basis() q_f. A reduced body
+  /// gives only what its basis holds: normal bending modes carry no axial strain, while
+  /// Craig-Bampton constraint modes hold the exact static response to loads at the
+  /// interface nodes (docs/flexible-bodies.md, "Section forces of reduced bodies").
   Vec2 sectionForces(const VecX& qf, int element, double xi) const;
 
  private:
@@ -98,6 +122,9 @@ class FfrBeamModel {
   SpMatRow basis_;
   std::vector<ElementBasis> elementBases_;  // per element, built once with basis_
   FfrInvariants invariants_;
+  std::vector<int> constraintDofs_;  // Craig-Bampton: nodal coordinate of each constraint mode
+  VecX fixedInterfaceFrequencies_;   // Craig-Bampton: of the kept fixed-interface modes
+  int numInertiaModes_ = 0;
 };
 
 }  // namespace flexmbd

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 
@@ -239,37 +240,43 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
   }
   SpMat B = sparseNullSpaceBasis(C);
 
-  // ----- modal reduction -----------------------------------------------------------
-  if (options_.modes < 0) {
-    throw InputError(owner + ": modes must be >= 0 (0 keeps the nodal coordinates), got " +
-                     std::to_string(options_.modes));
+  // ----- modal reduction (bodies/modal_reduction.hpp) -------------------------------
+  const std::vector<int> keep = chosenModes(options_.modes, options_.modeSet, owner);
+  const bool craigBampton = options_.reduction == ModalReduction::CraigBampton;
+  if (!craigBampton && !options_.interfaceNodes.empty()) {
+    throw InputError(owner + ": interface nodes are for the craig_bampton reduction only");
   }
-  if (options_.modes > 0 || !options_.modeSet.empty()) {
+  if (options_.inertiaModes && !craigBampton && keep.empty()) {
+    throw InputError(owner + ": inertia modes need a modal reduction (modes, or the craig_bampton reduction)");
+  }
+  if (craigBampton || !keep.empty()) {
     FfrInvariants3d reduced = nodal.transformed(B);
     reduced.validate(owner);  // names a rigid mode left by the reference conditions
-    const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(reduced.kff), MatX(reduced.mff));
-    const int available = static_cast<int>(eig.eigenvalues().size());
-    std::vector<int> keep;
-    if (!options_.modeSet.empty()) {
-      keep = options_.modeSet;
+    MatX P;
+    if (craigBampton) {
+      std::vector<int> dofs;
+      const MatX G = interfaceConditions(B, kNodeDofs, options_.interfaceNodes, owner, dofs);
+      CraigBamptonBasis cb = craigBamptonBasis(reduced.kff, reduced.mff, G, keep, owner);
+      for (int r : cb.interfaceRows) constraintDofs_.push_back(dofs[r]);
+      fixedInterfaceFrequencies_ = std::move(cb.fixedInterfaceFrequencies);
+      P = std::move(cb.basis);
     } else {
-      for (int k = 1; k <= options_.modes; ++k) keep.push_back(k);
+      P = normalModes(MatX(reduced.kff), MatX(reduced.mff), keep, owner);  // mass-normalised
     }
-    std::vector<int> sorted = keep;
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
-      throw InputError(owner + ": mode " + std::to_string(*std::adjacent_find(sorted.begin(), sorted.end())) +
-                       " is chosen twice; expected distinct modes");
-    }
-    MatX Phi(B.cols(), keep.size());
-    for (size_t k = 0; k < keep.size(); ++k) {
-      if (keep[k] < 1 || keep[k] > available) {
-        throw InputError(owner + ": mode " + std::to_string(keep[k]) + " does not exist (the mesh has modes 1.." +
-                         std::to_string(available) + ")");
+    if (options_.inertiaModes) {
+      // inertia loads of the frame's rigid motion on q_f at q_f = 0: translation S-bar^T,
+      // and int rho N^T (W u0) dV for every 3 x 3 W (alpha~ + omega~ omega~ spans them):
+      // the columns int rho N_l^T u0_k = row l of positionShape[k]
+      MatX F(reduced.mff.rows(), 12);
+      F.leftCols(3) = reduced.sBar.transpose();
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l < 3; ++l) F.col(3 + 3 * k + l) = reduced.positionShape[k].row(l).transpose();
       }
-      Phi.col(k) = eig.eigenvectors().col(keep[k] - 1);  // mass-normalised
+      const int before = static_cast<int>(P.cols());
+      P = withStaticModes(reduced.kff, reduced.mff, P, F);
+      numInertiaModes_ = static_cast<int>(P.cols()) - before;
     }
-    B = SpMat((B * Phi).sparseView());
+    B = SpMat((B * P).sparseView());
   }
   basis_ = B;
   for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(makeElementBasis(static_cast<int>(e)));

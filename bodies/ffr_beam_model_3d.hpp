@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bodies/ffr_invariants_3d.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "core/matrix_sink.hpp"
 #include "elements/beam_element_3d.hpp"
 
@@ -56,9 +57,19 @@ struct FfrBeamOptions3d {
   ReferenceConditions3d reference;
   /// Modal reduction: 0 keeps every nodal coordinate; n > 0 keeps the first n modes
   /// (under the reference conditions, mass-normalised); `modeSet` (1-based) keeps a
-  /// chosen set instead.
+  /// chosen set instead. Craig-Bampton: the fixed-interface modes (0: Guyan).
   int modes = 0;
   std::vector<int> modeSet;
+  /// Normal modes, or Craig-Bampton (ModalReduction, bodies/modal_reduction.hpp): one
+  /// static constraint mode per coordinate of the `interfaceNodes` (6 per node) not
+  /// already held by the reference conditions, then the fixed-interface modes.
+  ModalReduction reduction = ModalReduction::Normal;
+  /// Craig-Bampton only (required there): the interface nodes, e.g. the joints' nodes.
+  std::vector<int> interfaceNodes;
+  /// With a reduction: add the static responses to the inertia loads of the frame's rigid
+  /// motion (translation S-bar^T, and int rho N^T u0_k of every linear field W u0 of
+  /// the rotation's accelerations alpha x u0 + omega x (omega x u0): at most 12).
+  bool inertiaModes = false;
   /// Element-averaged second-order membrane strain in the strain energy (BeamElement3d,
   /// locking-free); off: the linear FFR model.
   bool geometricStiffening = false;
@@ -84,6 +95,16 @@ class FfrBeamModel3d {
   /// Natural frequencies (rad/s) of the body with its frame held fixed, ascending:
   /// K_ff phi = omega^2 m_ff phi (dense: for tests and small models).
   VecX naturalFrequencies() const;
+  /// Craig-Bampton: the nodal coordinate (6 node + k, k = ux, uy, uz, thx, thy, thz) of
+  /// each constraint mode, i.e. of q_1..q_nc (q_k is that nodal displacement); empty
+  /// for the other reductions.
+  const std::vector<int>& constraintModeCoordinates() const { return constraintDofs_; }
+  /// Craig-Bampton: natural frequencies (rad/s) of the kept fixed-interface modes
+  /// (q_nc+1..); empty for the other reductions.
+  const VecX& fixedInterfaceFrequencies() const { return fixedInterfaceFrequencies_; }
+  /// The number of inertia modes (FfrBeamOptions3d::inertiaModes), the last elastic
+  /// coordinates; 0 without them.
+  int numInertiaModes() const { return numInertiaModes_; }
 
   /// Strain energy U(q_f) (J), the sum of the elements' (BeamElement3d::strainEnergy).
   double strainEnergy(const VecX& qf) const;
@@ -102,7 +123,10 @@ class FfrBeamModel3d {
   /// Position, shape and rotation shape of the axis point of element `element` at xi.
   /// @throws std::out_of_range for a bad element index.
   FfrPoint3d materialPoint(int element, double xi) const;
-  /// Section forces (element frame, BeamSectionForces3d) at (element, xi) for q_f.
+  /// Section forces (element frame, BeamSectionForces3d) at (element, xi) for q_f: the
+  /// element's stiffness times the nodal displacements basis() q_f, so a reduced body
+  /// gives what its basis holds (Craig-Bampton: the exact static response to loads at
+  /// the interface nodes; docs/spatial-flexible.md).
   BeamSectionForces3d sectionForces(const VecX& qf, int element, double xi) const;
 
  private:
@@ -122,6 +146,9 @@ class FfrBeamModel3d {
   SpMatRow basis_;
   std::vector<ElementBasis> elementBases_;  // per element, built once with basis_
   FfrInvariants3d invariants_;
+  std::vector<int> constraintDofs_;  // Craig-Bampton: nodal coordinate of each constraint mode
+  VecX fixedInterfaceFrequencies_;   // Craig-Bampton: of the kept fixed-interface modes
+  int numInertiaModes_ = 0;
 };
 
 }  // namespace flexmbd

@@ -1,5 +1,7 @@
 #include "io/beam_model_reader.hpp"
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include "bodies/ffr_beam_model.hpp"
@@ -42,16 +44,49 @@ void readBeamModelOptions(const ObjectReader& r, int numNodes, Options& o) {
   } else {
     ref.fail("unknown reference type " + inQuotes(type) + " (expected one of: pinned_pinned, clamped, free_free)");
   }
+  // "reduction": "normal" (default) or "craig_bampton" with its "interface_nodes" (the
+  // keys are allowed where the body's key list has them: planar bodies so far)
+  const std::string reduction = r.string("reduction", "normal");
+  if (reduction == "craig_bampton") {
+    o.reduction = ModalReduction::CraigBampton;
+    if (!r.has("interface_nodes")) r.fail("missing required key \"interface_nodes\" (with \"reduction\": \"craig_bampton\")");
+    const json& n = r.required("interface_nodes");
+    if (!n.is_array() || n.empty()) {
+      r.fail("key \"interface_nodes\" must be a non-empty array of node indices [i, ...], got " + describe(n));
+    }
+    for (std::size_t k = 0; k < n.size(); ++k) {
+      const std::string label = "interface_nodes[" + std::to_string(k) + "]";
+      const int node = r.index(n[k], label);
+      if (node >= numNodes) {
+        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " does not exist (nodes 0.." +
+               std::to_string(numNodes - 1) + ")");
+      }
+      if (std::find(o.interfaceNodes.begin(), o.interfaceNodes.end(), node) != o.interfaceNodes.end()) {
+        r.fail("key " + inQuotes(label) + ": node " + std::to_string(node) + " is listed twice");
+      }
+      o.interfaceNodes.push_back(node);
+    }
+  } else if (reduction != "normal") {
+    r.fail("key \"reduction\" must be \"normal\" or \"craig_bampton\", got " + inQuotes(reduction));
+  } else if (r.has("interface_nodes")) {
+    r.fail("key \"interface_nodes\" is only allowed with \"reduction\": \"craig_bampton\"");
+  }
+  const bool craigBampton = o.reduction == ModalReduction::CraigBampton;
   if (r.has("modes")) {
     const json& m = r.required("modes");
     if (m.is_array()) {
       for (std::size_t k = 0; k < m.size(); ++k) o.modeSet.push_back(r.index(m[k], "modes[" + std::to_string(k) + "]"));
       if (o.modeSet.empty()) r.fail("key \"modes\" must list at least one mode");
     } else {
-      o.modes = static_cast<int>(r.integer("modes", 0, 1, kMaxModes));
+      // Craig-Bampton: the fixed-interface modes, 0 (static condensation only) allowed
+      o.modes = static_cast<int>(r.integer("modes", 0, craigBampton ? 0 : 1, kMaxModes));
     }
   }
   o.geometricStiffening = r.boolean("geometric_stiffening", false);
+  o.inertiaModes = r.boolean("inertia_modes", false);
+  if (o.inertiaModes && !craigBampton && o.modes == 0 && o.modeSet.empty()) {
+    r.fail("key \"inertia_modes\" needs a modal reduction (\"modes\", or \"reduction\": \"craig_bampton\")");
+  }
 }
 
 template void readBeamModelOptions<FfrBeamOptions>(const ObjectReader&, int, FfrBeamOptions&);

@@ -1,13 +1,16 @@
 // Reader of the beam-model keys that planar and spatial flexible bodies share
-// (docs/scene-format.md): "reference" (conditions B2), "modes" (modal reduction) and
-// "geometric_stiffening". Called by io/scene.cpp and io/spatial_scene.cpp.
+// (docs/scene-format.md): "reference" (conditions B2), "modes" (modal reduction),
+// "reduction" with "interface_nodes" (Craig-Bampton), "inertia_modes" and
+// "geometric_stiffening". Called by io/scene.cpp and io/spatial_scene.cpp (whose key
+// lists say which of these a body accepts).
 #pragma once
 
 #include "io/json_reader.hpp"
 
 namespace flexmbd::scenereaders {
 
-/// Fills options.reference, .modes / .modeSet and .geometricStiffening from the body
+/// Fills options.reference, .modes / .modeSet, .reduction / .interfaceNodes,
+/// .inertiaModes and .geometricStiffening from the body
 /// object `r` (a mesh of `numNodes` nodes); FfrBeamOptions or FfrBeamOptions3d.
 /// @throws InputError naming the key.
 template <class Options>

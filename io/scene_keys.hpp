@@ -23,7 +23,7 @@ inline const Keys kFlexibleBody = {"name",     "type",     "position",    "angle
                                    "velocity", "angular_velocity",       "section",
                                    "beam",     "nodes",    "elements",   "reference",
                                    "modes",    "geometric_stiffening",   "elastic_coordinates",
-                                   "elastic_velocities"};
+                                   "elastic_velocities", "reduction", "interface_nodes", "inertia_modes"};
 inline const Keys kInvariantsBody = {"name",     "type",       "position",           "angle",
                                      "velocity", "angular_velocity", "invariants", "elastic_coordinates",
                                      "elastic_velocities"};

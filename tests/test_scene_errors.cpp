@@ -544,6 +544,69 @@ TEST(SceneParse, InitialElasticStateOfFlexibleBodies) {
   EXPECT_NE(errorOf(r).find("unknown key \"elastic_coordinates\""), std::string::npos);
 }
 
+TEST(SceneParse, CraigBamptonReductionKeys) {
+  // A pinned-pinned beam of 4 elements, Craig-Bampton with interface nodes 0 and 4 and 2
+  // fixed-interface modes: 3 constraint modes (psi_0, ux_4, psi_4) + 2 modes.
+  json j = json::parse(R"({"bodies": [{"name": "beam", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "density": 7850},
+      "beam": {"length": 1.0, "elements": 4}, "reference": {"type": "pinned_pinned"},
+      "reduction": "craig_bampton", "interface_nodes": [0, 4], "modes": 2}]})");
+  EXPECT_EQ(parseScene(j).system.numCoordinates(), 3 + 5);
+  j["bodies"][0]["modes"] = 0;  // Guyan: static condensation only
+  EXPECT_EQ(parseScene(j).system.numCoordinates(), 3 + 3);
+  j["bodies"][0].erase("modes");
+  EXPECT_EQ(parseScene(j).system.numCoordinates(), 3 + 3);
+  j["bodies"][0]["reduction"] = "normal";
+  j["bodies"][0].erase("interface_nodes");
+  j["bodies"][0]["modes"] = 2;
+  EXPECT_EQ(parseScene(j).system.numCoordinates(), 3 + 2);
+
+  // errors name the body and the key
+  auto with = [&](const char* key, const json& value, std::initializer_list<const char*> parts) {
+    json b = j;
+    b["bodies"][0]["reduction"] = "craig_bampton";
+    b["bodies"][0]["interface_nodes"] = {0, 4};
+    if (value.is_null()) {
+      b["bodies"][0].erase(key);
+    } else {
+      b["bodies"][0][key] = value;
+    }
+    EXPECT_TRUE(Mentions(errorOf(b), parts)) << key << " = " << value.dump();
+  };
+  with("reduction", "craig", {"bodies[0] (\"beam\")", "\"reduction\"", "\"craig\"", "craig_bampton"});
+  with("reduction", 1, {"bodies[0] (\"beam\")", "\"reduction\"", "must be a string"});
+  with("interface_nodes", nullptr, {"bodies[0] (\"beam\")", "missing required key \"interface_nodes\""});
+  with("interface_nodes", json::array(), {"bodies[0] (\"beam\")", "\"interface_nodes\"", "non-empty array"});
+  with("interface_nodes", 3, {"bodies[0] (\"beam\")", "\"interface_nodes\"", "non-empty array"});
+  with("interface_nodes", {0, 5}, {"bodies[0] (\"beam\")", "interface_nodes[1]", "node 5 does not exist", "0..4"});
+  with("interface_nodes", {0, -1}, {"bodies[0] (\"beam\")", "interface_nodes[1]", "non-negative integer"});
+  with("interface_nodes", {4, 4}, {"bodies[0] (\"beam\")", "interface_nodes[1]", "listed twice"});
+  with("interface_nodes", {0, 1.5}, {"bodies[0] (\"beam\")", "interface_nodes[1]", "non-negative integer"});
+  with("modes", -1, {"bodies[0] (\"beam\")", "\"modes\"", ">= 0"});
+  with("modes", 20, {"bodies[0] (\"beam\")", "fixed-interface mode 20 does not exist"});
+  // interface nodes only with craig_bampton; modes 0 only with it
+  json n = j;
+  n["bodies"][0]["interface_nodes"] = {0};
+  EXPECT_TRUE(Mentions(errorOf(n), {"bodies[0] (\"beam\")", "\"interface_nodes\"", "only allowed with"}));
+  n["bodies"][0].erase("interface_nodes");
+  n["bodies"][0]["modes"] = 0;
+  EXPECT_TRUE(Mentions(errorOf(n), {"bodies[0] (\"beam\")", "\"modes\"", ">= 1"}));
+
+  // inertia modes: with a reduction only; 4 more coordinates on this straight beam
+  json i = j;
+  i["bodies"][0]["inertia_modes"] = true;
+  EXPECT_EQ(parseScene(i).system.numCoordinates(), 3 + 2 + 4);
+  i["bodies"][0]["reduction"] = "craig_bampton";
+  i["bodies"][0]["interface_nodes"] = {0, 4};
+  EXPECT_EQ(parseScene(i).system.numCoordinates(), 3 + 5 + 4);
+  i["bodies"][0]["inertia_modes"] = "yes";
+  EXPECT_TRUE(Mentions(errorOf(i), {"bodies[0] (\"beam\")", "\"inertia_modes\"", "true or false"}));
+  json nodal = json::parse(R"({"bodies": [{"name": "beam", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "density": 7850},
+      "beam": {"length": 1.0, "elements": 4}, "reference": {"type": "pinned_pinned"}, "inertia_modes": true}]})");
+  EXPECT_TRUE(Mentions(errorOf(nodal), {"bodies[0] (\"beam\")", "\"inertia_modes\"", "needs a modal reduction"}));
+}
+
 TEST(SceneParse, ToleranceClassesAndIntegrator) {
   json j = baseScene();
   j["solver"]["atol_angle"] = 1e-9;
