@@ -61,7 +61,8 @@ inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia",
 inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "orientation", "velocity",
                                      "angular_velocity",     "section",     "beam",        "nodes",
                                      "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",
-                                     "elastic_coordinates",  "elastic_velocities"};
+                                     "elastic_coordinates",  "elastic_velocities", "reduction", "interface_nodes",
+                                     "inertia_modes"};
 inline const Keys kSection3d = {"area",          "inertia_y",     "inertia_z", "torsion_constant", "width",  "height",
                                 "youngs_modulus", "shear_modulus", "poisson_ratio", "density",     "damping"};
 inline const Keys kBeam3d = {"length", "elements", "origin"};
