@@ -200,9 +200,12 @@ PYBIND11_MODULE(_flexmbd, m) {
       .value("PINNED_PINNED", ReferenceConditions::Type::PinnedPinned)
       .value("CLAMPED", ReferenceConditions::Type::Clamped)
       .value("FREE_FREE", ReferenceConditions::Type::FreeFree);
+  py::enum_<ModalReduction>(m, "ModalReduction")
+      .value("NORMAL", ModalReduction::Normal)
+      .value("CRAIG_BAMPTON", ModalReduction::CraigBampton);
   py::class_<FfrBeamOptions>(m, "FfrBeamOptions")
       .def(py::init([](ReferenceConditions::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
-                       bool stiffening) {
+                       bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes) {
              FfrBeamOptions o;
              o.reference.type = type;
              o.reference.nodeA = nodeA;
@@ -210,11 +213,15 @@ PYBIND11_MODULE(_flexmbd, m) {
              o.modes = modes;
              o.modeSet = std::move(modeSet);
              o.geometricStiffening = stiffening;
+             o.reduction = reduction;
+             o.interfaceNodes = std::move(interfaceNodes);
+             o.inertiaModes = inertiaModes;
              return o;
            }),
            py::arg("reference") = ReferenceConditions::Type::PinnedPinned, py::arg("node_a") = 0,
            py::arg("node_b") = -1, py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{},
-           py::arg("geometric_stiffening") = false);
+           py::arg("geometric_stiffening") = false, py::arg("reduction") = ModalReduction::Normal,
+           py::arg("interface_nodes") = std::vector<int>{}, py::arg("inertia_modes") = false);
   py::class_<FfrBeamModel, std::shared_ptr<FfrBeamModel>>(m, "FfrBeamModel")
       .def(py::init([](BeamMesh2d mesh, const FfrBeamOptions& o, const std::string& owner) {
              return std::make_shared<FfrBeamModel>(std::move(mesh), o, owner);

@@ -26,6 +26,7 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     ForceIndex,
     FrameState2d,
     InputError,
+    ModalReduction,
     ModelError,
     Reference,
     RigidBodyProperties,

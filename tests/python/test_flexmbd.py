@@ -227,3 +227,18 @@ def test_tensegrity_from_python_equals_the_command_line(tmp_path):
         events = list(csv.DictReader(f))
     assert [e["type"] for e in res.summary["events"]] == [e["type"] for e in events]
     assert res.summary["snaps"] == sum(e["type"] == "snap" for e in events)
+
+
+def test_craig_bampton_rod_from_python_carries_the_axial_force():
+    # A pinned-pinned rod reduced by Craig-Bampton at its end nodes keeps the
+    # static axial stretch a joint load causes: its constraint modes span it, so the
+    # number of elastic coordinates is (constraint modes) + (fixed-interface modes).
+    section = flexmbd.rectangular_section(0.008, 0.008, 2e11, 7870.0)
+    mesh = flexmbd.BeamMesh2d.straight(0.3, 8, section)
+    cb = flexmbd.FfrBeamModel(mesh, flexmbd.FfrBeamOptions(reference=flexmbd.Reference.PINNED_PINNED, modes=2,
+                                                           reduction=flexmbd.ModalReduction.CRAIG_BAMPTON,
+                                                           interface_nodes=[0, 8]))
+    normal = flexmbd.FfrBeamModel(mesh, flexmbd.FfrBeamOptions(reference=flexmbd.Reference.PINNED_PINNED, modes=2))
+    # pinned-pinned holds node 0's two translations and node 8's transverse one: the
+    # interface keeps node 0's slope, node 8's axial displacement and slope (3 modes)
+    assert cb.num_elastic == 3 + 2 and normal.num_elastic == 2
