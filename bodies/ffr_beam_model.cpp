@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "bodies/modal_reduction.hpp"
+#include "bodies/beam_mesh_topology.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 
@@ -34,31 +35,13 @@ BeamMesh2d BeamMesh2d::straight(double length, int numElements, const BeamSectio
 FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const std::string& owner)
     : mesh_(std::move(mesh)), options_(options) {
   const int nn = static_cast<int>(mesh_.nodes.size());
-  if (mesh_.elements.empty()) throw InputError(owner + ": the beam mesh has no elements");
-  // every node used, the mesh connected (union-find)
-  std::vector<int> parent(nn);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  std::vector<bool> used(nn, false);
+  std::vector<std::pair<int, int>> elementNodes;
+  for (const auto& el : mesh_.elements) elementNodes.emplace_back(el.node1, el.node2);
+  checkBeamMeshTopology(nn, elementNodes, owner);
   for (size_t e = 0; e < mesh_.elements.size(); ++e) {
     const auto& el = mesh_.elements[e];
     const std::string who = owner + ": element " + std::to_string(e);
-    for (int n : {el.node1, el.node2}) {
-      if (n < 0 || n >= nn) {
-        throw InputError(who + ": node " + std::to_string(n) + " does not exist (nodes 0.." + std::to_string(nn - 1) + ")");
-      }
-      used[n] = true;
-    }
-    if (el.node1 == el.node2) throw InputError(who + ": both ends are node " + std::to_string(el.node1));
-    parent[find(el.node1)] = find(el.node2);
     elements_.emplace_back(mesh_.nodes[el.node1], mesh_.nodes[el.node2], el.section, who);
-  }
-  for (int n = 0; n < nn; ++n) {
-    if (!used[n]) throw InputError(owner + ": node " + std::to_string(n) + " belongs to no element");
-    if (find(n) != find(0)) throw InputError(owner + ": the mesh is not connected (node " + std::to_string(n) + " is cut off from node 0)");
   }
 
   // ----- nodal invariants (3 coordinates per node) --------------------------------
