@@ -53,7 +53,7 @@ test: build
 sanitize: setup
 	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Debug \
 	  -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-	  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined"
+	  -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" -DFLEXMBD_BUILD_PYTHON=OFF
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
 	cd $(SANITIZE_BUILD) && \
 	  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1 \
