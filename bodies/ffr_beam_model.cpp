@@ -177,7 +177,7 @@ FfrBeamModel::FfrBeamModel(BeamMesh2d mesh, const FfrBeamOptions& options, const
     B = (B * P).sparseView();
   }
   basis_ = B;
-  for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(makeElementBasis(static_cast<int>(e)));
+  for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(elementBasis(static_cast<int>(e)));
   invariants_ = nodal.transformed(B);
   invariants_.points.clear();
   for (int n = 0; n < nn; ++n) {
@@ -196,24 +196,10 @@ VecX FfrBeamModel::naturalFrequencies() const {
   return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
-FfrBeamModel::ElementBasis FfrBeamModel::makeElementBasis(int e) const {
+FfrBeamModel::ElementBasis FfrBeamModel::elementBasis(int e) const {
   const auto& el = mesh_.elements[e];
-  const int rows[6] = {dof(el.node1, 0), dof(el.node1, 1), dof(el.node1, 2),
-                       dof(el.node2, 0), dof(el.node2, 1), dof(el.node2, 2)};
-  ElementBasis eb;
-  for (int r : rows) {
-    for (SpMatRow::InnerIterator it(basis_, r); it; ++it) eb.cols.push_back(static_cast<int>(it.col()));
-  }
-  std::sort(eb.cols.begin(), eb.cols.end());
-  eb.cols.erase(std::unique(eb.cols.begin(), eb.cols.end()), eb.cols.end());
-  eb.B = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, eb.cols.size());
-  for (int r = 0; r < 6; ++r) {
-    for (SpMatRow::InnerIterator it(basis_, rows[r]); it; ++it) {
-      const auto k = std::lower_bound(eb.cols.begin(), eb.cols.end(), static_cast<int>(it.col())) - eb.cols.begin();
-      eb.B(r, k) = it.value();
-    }
-  }
-  return eb;
+  return makeElementBasis<6>(basis_, {dof(el.node1, 0), dof(el.node1, 1), dof(el.node1, 2), dof(el.node2, 0),
+                                      dof(el.node2, 1), dof(el.node2, 2)});
 }
 
 BeamElement2d::Vec6 FfrBeamModel::elementCoordinates(int e, const ElementBasis& eb, const VecX& qf) const {

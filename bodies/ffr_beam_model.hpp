@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bodies/element_basis.hpp"
 #include "bodies/ffr_invariants.hpp"
 #include "bodies/modal_reduction.hpp"
 #include "elements/beam_element_2d.hpp"
@@ -106,13 +107,9 @@ class FfrBeamModel {
   Vec2 sectionForces(const VecX& qf, int element, double xi) const;
 
  private:
-  /// The rows of basis() of an element's six nodal coordinates, over the elastic
-  /// coordinates `cols` they depend on (compact, so element loops stay O(elements)).
-  struct ElementBasis {
-    std::vector<int> cols;
-    Eigen::Matrix<double, 6, Eigen::Dynamic> B;
-  };
-  ElementBasis makeElementBasis(int element) const;
+  /// The rows of basis() of an element's six nodal coordinates (bodies/element_basis.hpp).
+  using ElementBasis = flexmbd::ElementBasis<6>;
+  ElementBasis elementBasis(int element) const;
   /// Element nodal displacements in element axes (T B q_f).
   BeamElement2d::Vec6 elementCoordinates(int element, const ElementBasis& eb, const VecX& qf) const;
 

@@ -259,7 +259,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
     B = SpMat((B * P).sparseView());
   }
   basis_ = B;
-  for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(makeElementBasis(static_cast<int>(e)));
+  for (size_t e = 0; e < elements_.size(); ++e) elementBases_.push_back(elementBasis(static_cast<int>(e)));
   invariants_ = nodal.transformed(B);
   invariants_.points.clear();
   for (int n = 0; n < nn; ++n) {
@@ -278,27 +278,14 @@ VecX FfrBeamModel3d::naturalFrequencies() const {
   return eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
 }
 
-FfrBeamModel3d::ElementBasis FfrBeamModel3d::makeElementBasis(int e) const {
+FfrBeamModel3d::ElementBasis FfrBeamModel3d::elementBasis(int e) const {
   const auto& el = mesh_.elements[e];
-  int rows[12];
+  std::array<int, 12> rows;
   for (int a = 0; a < kNodeDofs; ++a) {
     rows[a] = dof(el.node1, a);
     rows[a + kNodeDofs] = dof(el.node2, a);
   }
-  ElementBasis eb;
-  for (int r : rows) {
-    for (SpMatRow::InnerIterator it(basis_, r); it; ++it) eb.cols.push_back(static_cast<int>(it.col()));
-  }
-  std::sort(eb.cols.begin(), eb.cols.end());
-  eb.cols.erase(std::unique(eb.cols.begin(), eb.cols.end()), eb.cols.end());
-  eb.B = Eigen::Matrix<double, 12, Eigen::Dynamic>::Zero(12, eb.cols.size());
-  for (int r = 0; r < 12; ++r) {
-    for (SpMatRow::InnerIterator it(basis_, rows[r]); it; ++it) {
-      const auto k = std::lower_bound(eb.cols.begin(), eb.cols.end(), static_cast<int>(it.col())) - eb.cols.begin();
-      eb.B(r, k) = it.value();
-    }
-  }
-  return eb;
+  return makeElementBasis<12>(basis_, rows);
 }
 
 BeamElement3d::Vec12 FfrBeamModel3d::elementCoordinates(int e, const ConstVecRef& qf) const {

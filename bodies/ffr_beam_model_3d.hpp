@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "bodies/element_basis.hpp"
 #include "bodies/ffr_invariants_3d.hpp"
 #include "bodies/modal_reduction.hpp"
 #include "core/matrix_sink.hpp"
@@ -130,13 +131,9 @@ class FfrBeamModel3d {
   BeamSectionForces3d sectionForces(const VecX& qf, int element, double xi) const;
 
  private:
-  /// The rows of basis() of an element's twelve nodal coordinates, over the elastic
-  /// coordinates `cols` they depend on (compact, so element loops stay O(elements)).
-  struct ElementBasis {
-    std::vector<int> cols;
-    Eigen::Matrix<double, 12, Eigen::Dynamic> B;
-  };
-  ElementBasis makeElementBasis(int element) const;
+  /// The rows of basis() of an element's twelve nodal coordinates (bodies/element_basis.hpp).
+  using ElementBasis = flexmbd::ElementBasis<12>;
+  ElementBasis elementBasis(int element) const;
   /// Element nodal coordinates in element axes (T B q_f).
   BeamElement3d::Vec12 elementCoordinates(int element, const ConstVecRef& qf) const;
 
