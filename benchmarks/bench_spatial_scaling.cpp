@@ -41,7 +41,7 @@ double peakMemoryMb() {
 }
 
 nlohmann::json baseScene() {
-  std::ifstream in(sourcePath("examples/spatial_slider_crank_elastic.json"));
+  std::ifstream in(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_slider_crank_elastic.json");
   if (!in) throw std::runtime_error("cannot read examples/spatial_slider_crank_elastic.json");
   return nlohmann::json::parse(in);
 }

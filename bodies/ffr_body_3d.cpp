@@ -3,18 +3,13 @@
 #include <algorithm>
 #include <sstream>
 
+#include "bodies/euler_frame_rates.hpp"
 #include "core/errors.hpp"
 
 namespace flexmbd {
 namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
-
-/// T+ of the rotation block: 2 L(p) / |p|^2 (3 x 4), as RigidBody3d.
-Mat34 rotationInverse(const ConstVecRef& q) {
-  const Vec4 p = q.segment<4>(3);
-  return (2.0 / p.squaredNorm()) * quaternionL(p);
-}
 
 /// (S^T x)_k = (column k of S) . x.
 template <class X>
@@ -153,18 +148,12 @@ bool FfrBody3d::isDissipative() const {
 
 // ----- kinematic equation -------------------------------------------------------------
 
-void FfrBody3d::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
-  T.setZero(numCoordinates(), numVelocities());
-  T.topLeftCorner<3, 3>().setIdentity();
-  T.block<4, 3>(3, 3) = 0.5 * quaternionL(q.segment<4>(3)).transpose();  // p' = 1/2 L^T w
-  T.bottomRightCorner(nf_, nf_).setIdentity();
+void FfrBody3d::addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const {
+  addEulerFrameRateMatrix(q, nf_, T);
 }
 
-void FfrBody3d::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
-  Tinv.setZero(numVelocities(), numCoordinates());
-  Tinv.topLeftCorner<3, 3>().setIdentity();
-  Tinv.block<3, 4>(3, 3) = rotationInverse(q);
-  Tinv.bottomRightCorner(nf_, nf_).setIdentity();
+void FfrBody3d::addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const {
+  addEulerFrameRateInverse(q, nf_, Tinv);
 }
 
 void FfrBody3d::addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
@@ -290,7 +279,7 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   // rotation dpi = Rinv dp (Rinv = 2 L(p) / |p|^2, zero along p: the gauge).
   const auto qf = q.tail(nf_), af = a.tail(nf_);
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 s = firstMomentAt(q);
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
@@ -359,7 +348,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
                                           const MatrixSink& dQdv) const {
   const auto qf = q.tail(nf_), pf = v.tail(nf_);
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 s = firstMomentAt(q);
   const Vec3 w = v.segment<3>(3);
   const Mat3 ws = skew(w), Om = ws * ws;
@@ -433,7 +422,7 @@ void FfrBody3d::addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) co
 
 void FfrBody3d::addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const {
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 gb = A.transpose() * g;
   const Mat3 gs = skew(gb);
   K.addBlock(3, 3, Mat34(skew(firstMomentAt(q)) * gs * Rinv));
@@ -536,7 +525,7 @@ void FfrBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int poi
       out.Jw.col(a) = A * pt.rotationShape.col(c - 6);
     }
   }
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   out.Tinv.resize(nv, nq);
   for (int i = 0; i < nv; ++i) {
     for (int j = 0; j < nq; ++j) out.Tinv(i, j) = tinvEntry(Rinv, cols ? (*cols)[i] : i, qcols ? (*qcols)[j] : j);
@@ -551,7 +540,7 @@ void FfrBody3d::addFrameCurvature(const ConstVecRef& q, const Vec3& point, int p
   const FfrPoint3d& pt = node(point, pointId);
   const auto qf = q.tail(nf_);
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 u = pt.position + pt.shape * qf;
   const Vec3 br = A.transpose() * wr, bw = A.transpose() * ww;
   const Mat3 brs = skew(br), bws = skew(bw);

@@ -70,8 +70,8 @@ class FfrBody3d final : public Body {
   double mass() const override { return inv_.mass; }
 
   bool velocitiesAreCoordinateRates() const override { return false; }
-  void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const override;
-  void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const override;
+  void addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const override;
+  void addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const override;
   void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const override;
   void addCoordinateRateJacobian(const ConstVecRef& q, const ConstVecRef& w, const MatrixSink& K) const override;
   void applyIncrement(const ConstVecRef& q, const ConstVecRef& dv, Eigen::Ref<VecX> out) const override;

@@ -98,6 +98,11 @@ class DaeSystem final : public DaeProblem {
   DaeLayout layout_;
   SparsePattern pattern_;
   VecX metric_;  ///< D of the GGL stabilisation (nv)
+  /// Per body with T != I: the structural non-zeros of T (nq x nv) and T+ (nv x nq), each in
+  /// a square pattern of size nq (empty for T = I). Built once: a body's T is sparse (the
+  /// identity on elastic coordinates), and assembling it densely made the Jacobian pattern
+  /// of a spatial flexible body quadratic in its mesh (issue 24).
+  std::vector<SparsePattern> ratePattern_, rateInversePattern_;
 };
 
 }  // namespace flexmbd
