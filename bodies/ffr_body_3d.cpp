@@ -198,14 +198,46 @@ Vec3 FfrBody3d::firstMomentAt(const ConstVecRef& q) const {
   return inv_.firstMoment + inv_.sBar * q.tail(nf_);
 }
 
+template <class Visit>
+void FfrBody3d::forEachUpperSkl(Visit&& visit) const {
+  // The six stored S_kl with k <= l; S_lk = S_kl^T (validated) is read through them, so
+  // each inertia integral walks the nodal mesh once (issue 24).
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      const SpMat& S = inv_.sKL[k][l];
+      for (int j = 0; j < S.outerSize(); ++j) {
+        for (SpMat::InnerIterator it(S, j); it; ++it) visit(k, l, static_cast<int>(it.row()), j, it.value());
+      }
+    }
+  }
+}
+
+namespace {
+/// The skew pair of W_i = S_ab - S_ba: for the stored upper S_kl (k < l), the index i of
+/// the W it forms and the sign (W_x = S_yz - S_zy, W_y = -(S_xz - S_zx), W_z = S_xy - S_yx).
+struct SkewPair {
+  int index;
+  double sign;
+};
+constexpr SkewPair skewPairOf(int k, int l) {
+  return k == 0 ? (l == 1 ? SkewPair{2, 1.0} : SkewPair{1, -1.0}) : SkewPair{0, 1.0};
+}
+}  // namespace
+
 Mat3 FfrBody3d::secondMomentAt(const ConstVecRef& qf) const {
   // J = int rho (u0 + N qf)(u0 + N qf)^T dV = J0 + P + P^T + (qf^T S_kl qf)_kl,
   // P_kl = int rho u0_k N_l dV qf = positionShape[k].row(l) qf
+  Mat3 quadratic = Mat3::Zero();
+  forEachUpperSkl([&](int k, int l, int i, int j, double s) { quadratic(k, l) += qf[i] * s * qf[j]; });
+  return secondMomentFrom(qf, quadratic);
+}
+
+Mat3 FfrBody3d::secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const {
   Mat3 J = inv_.secondMoment;
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) {
       const double pkl = inv_.positionShape[k].row(l).dot(qf);
-      J(k, l) += pkl + bilinear(inv_.sKL[k][l], qf, qf);
+      J(k, l) += pkl + quadratic(std::min(k, l), std::max(k, l));  // qf^T S_lk qf = qf^T S_kl qf
       J(l, k) += pkl;
     }
   }
@@ -263,14 +295,27 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   const Vec3 s = firstMomentAt(q);
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
+  auto of = out.tail(nf_);
+  // One walk over the S_kl: the quadratic part of J (for I aw), Y af = X0 af + (qf^T W_i af)_i
+  // and the rows f' Y^T aw = X0^T aw + sum_i aw_i W_i^T qf (W_i = sign (S_kl - S_kl^T))
+  Mat3 quadratic = Mat3::Zero();
+  Vec3 yaf = x0_ * af;
+  forEachUpperSkl([&](int k, int l, int i, int j, double sv) {
+    quadratic(k, l) += qf[i] * sv * qf[j];
+    if (k == l) return;
+    const SkewPair w = skewPairOf(k, l);
+    const double ws = w.sign * sv;
+    yaf[w.index] += ws * (qf[i] * af[j] - af[i] * qf[j]);
+    of[j] += aw[w.index] * ws * qf[i];
+    of[i] -= aw[w.index] * ws * qf[j];
+  });
+  const Mat3 J = secondMomentFrom(qf, quadratic);
   // row R: m aR - A s~ aw + A S-bar af
   out.head<3>() += inv_.mass * aR + A * (aw.cross(s) + inv_.sBar * af);
-  // row theta: s~ A^T aR + I aw + Y af, Y af = X0 af + (qf^T W_i af)_i
-  const Vec3 yaf = x0_ * af + Vec3(bilinear(w_[0], qf, af), bilinear(w_[1], qf, af), bilinear(w_[2], qf, af));
-  out.segment<3>(3) += s.cross(bR) + inertiaAt(q) * aw + yaf;
+  // row theta: s~ A^T aR + I aw + Y af, I = tr(J) 1 - J (Shabana eq. 5.110)
+  out.segment<3>(3) += s.cross(bR) + (J.trace() * aw - J * aw) + yaf;
   // rows f: S-bar^T A^T aR + Y^T aw + m_ff af
-  auto of = out.tail(nf_);
-  for (int k = 0; k < nf_; ++k) of[k] += inv_.sBar.col(k).dot(bR) + skewShapeColumn(qf, k).dot(aw);
+  of.noalias() += inv_.sBar.transpose() * bR + x0_.transpose() * aw;
   addProduct(inv_.mff, af, 1.0, of);
 }
 
@@ -321,20 +366,33 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   const Mat3 ws = skew(w), Om = ws * ws;
   const Vec3 sp = inv_.sBar * pf;
   Q.head<3>() -= A * (Om * s + 2.0 * ws * sp);
+  auto Qf = Q.tail(nf_);
+  // One walk over the S_kl (k <= l, S_lk = S_kl^T): the quadratic parts of J (qf^T S_kl qf)
+  // and G (qf'^T S_kl qf), -Om_kl S_kl qf and the Coriolis term 2 w_i W_i qf' into Q_f.
+  Mat3 quadratic = Mat3::Zero(), Gq = Mat3::Zero();
+  forEachUpperSkl([&](int k, int l, int i, int j, double sv) {
+    const double t = sv * qf[j];
+    quadratic(k, l) += qf[i] * t;
+    Gq(k, l) += pf[i] * t;
+    Qf[i] -= Om(k, l) * t;
+    if (k == l) return;
+    Gq(l, k) += qf[i] * sv * pf[j];  // qf'^T S_lk qf = qf^T S_kl qf'
+    Qf[j] -= Om(l, k) * sv * qf[i];  // (S_lk qf)_j = (S_kl^T qf)_j
+    const SkewPair wp = skewPairOf(k, l);
+    const double c = 2.0 * w[wp.index] * wp.sign * sv;  // 2 w_i (S_kl - S_kl^T) qf'
+    Qf[i] += c * pf[j];
+    Qf[j] -= c * pf[i];
+  });
+  const Mat3 J = secondMomentFrom(qf, quadratic);
   Mat3 G;
   for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + bilinear(inv_.sKL[k][l], pf, qf);
+    for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + Gq(k, l);
   }
-  Q.segment<3>(3) -= w.cross(inertiaAt(q) * w) + 2.0 * (G.trace() * w - G * w);
-  auto Qf = Q.tail(nf_);
+  Q.segment<3>(3) -= w.cross(J.trace() * w - J * w) + 2.0 * (G.trace() * w - G * w);
+  // int rho N_k^T u_l dV = positionShape[l].row(k)^T + S_kl qf: the constant part
   for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) {
-      // int rho N_k^T u_l dV = positionShape[l].row(k)^T + S_kl qf
-      Qf.noalias() -= Om(k, l) * inv_.positionShape[l].row(k).transpose();
-      addProduct(inv_.sKL[k][l], qf, -Om(k, l), Qf);
-    }
+    for (int l = 0; l < 3; ++l) Qf.noalias() -= Om(k, l) * inv_.positionShape[l].row(k).transpose();
   }
-  for (int i = 0; i < 3; ++i) addProduct(w_[i], pf, 2.0 * w[i], Qf);
   // elastic and damping forces
   if (model_) {
     model_->addStrainEnergyGradient(qf, -1.0, Qf);  // -dU/dq_f (K_ff q_f when linear)

@@ -128,6 +128,11 @@ class FfrBody3d final : public Body {
   const FfrPoint3d& node(const Vec3& point, int pointId) const;
   /// J(q_f) = int rho u u^T dV.
   Mat3 secondMomentAt(const ConstVecRef& qf) const;
+  /// J(q_f) from its quadratic part, (qf^T S_kl qf) in the upper triangle (k <= l).
+  Mat3 secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const;
+  /// visit(k, l, i, j, s) for every stored entry s = (S_kl)_ij with k <= l.
+  template <class Visit>
+  void forEachUpperSkl(Visit&& visit) const;
   /// dJ/dq_f,k.
   Mat3 secondMomentDerivative(const ConstVecRef& qf, int k) const;
   /// Column k of Y(q_f) = int rho u~ N dV.
