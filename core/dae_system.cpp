@@ -267,7 +267,7 @@ VecX DaeSystem::differentialIds() const {
 std::vector<int64_t> DaeSystem::eliminationGroups() const {
   const DaeLayout& L = layout_;
   std::vector<int64_t> groups(L.size, 0);
-  for (int k = L.lambda; k < L.size; ++k) groups[k] = 1;
+  for (int k = L.lambda; k < L.size; ++k) groups[k] = 2;
   for (int f : sys_.frameCoordinates()) groups[L.q + f] = 1;
   for (int f : sys_.frameVelocities()) groups[L.v + f] = 1;
   return groups;

@@ -78,7 +78,8 @@ class DaeSystem final : public DaeProblem {
 
   /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
   /// the positions and velocities of elastic coordinates, 1 for frame coordinates
-  /// (coupled to their whole body) and multipliers (zero diagonal), to be eliminated last.
+  /// (coupled to their whole body), 2 for multipliers (zero diagonal); KluOrdering
+  /// (integrators/klu_ordering.hpp) chooses which go last.
   std::vector<int64_t> eliminationGroups() const override;
 
   /// y and y' from positions, velocities, accelerations and multipliers (mu = 0).
