@@ -119,15 +119,16 @@ void jacobianBench(benchmark::State& st, const std::string& model) {
   st.counters["jac_in_residuals"] = tJac / tRes;
 }
 
-/// engineOrdering: as the engine's IdaSolver (configureKluOrdering); else KLU's
+/// engineOrdering: as the engine's IdaSolver (KluOrdering::choose); else KLU's
 /// defaults (AMD after BTF, pivot threshold 1e-3), for comparison.
 void kluRefactorBench(benchmark::State& st, const std::string& model, bool engineOrdering) {
   Fixture& f = fixture(model);
   assembleJacobian(f);
   klu_l_common common;
   klu_l_defaults(&common);
-  const std::vector<int64_t> groups = f.dae->eliminationGroups();
-  if (engineOrdering) configureKluOrdering(common, groups);
+  const KluOrdering ordering =
+      engineOrdering ? KluOrdering::choose(*f.dae, 0.0, f.y, f.yp, kOrderingTrialCj) : KluOrdering();
+  ordering.configure(common);
   const SuiteSparse_long n = f.dae->size();
   klu_l_symbolic* sym = klu_l_analyze(n, f.colStart.data(), f.rowIndex.data(), &common);
   klu_l_numeric* num = sym ? klu_l_factor(f.colStart.data(), f.rowIndex.data(), f.values.data(), sym, &common)

@@ -136,7 +136,12 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
       nodal.sBar.col(idx[a]) += sb.col(a);
       for (int k = 0; k < 3; ++k) nodal.positionShape[k].col(idx[a]) += ps[k].col(a);
       for (int b = 0; b < 12; ++b) {
-        for (int kl = 0; kl < 9; ++kl) tS[kl].emplace_back(idx[a], idx[b], skl[kl](a, b));
+        // S_kl keep their exact zeros out: an element along a body axis moves its
+        // coordinates in one direction each (S_xx has only axial entries), and the body
+        // walks the stored entries at every evaluation (issue 24)
+        for (int kl = 0; kl < 9; ++kl) {
+          if (skl[kl](a, b) != 0.0) tS[kl].emplace_back(idx[a], idx[b], skl[kl](a, b));
+        }
         tm.emplace_back(idx[a], idx[b], mm(a, b));
         tk.emplace_back(idx[a], idx[b], kk(a, b));
         if (beta > 0.0) td.emplace_back(idx[a], idx[b], beta * kk(a, b));

@@ -3,18 +3,13 @@
 #include <algorithm>
 #include <sstream>
 
+#include "bodies/euler_frame_rates.hpp"
 #include "core/errors.hpp"
 
 namespace flexmbd {
 namespace {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
-
-/// T+ of the rotation block: 2 L(p) / |p|^2 (3 x 4), as RigidBody3d.
-Mat34 rotationInverse(const ConstVecRef& q) {
-  const Vec4 p = q.segment<4>(3);
-  return (2.0 / p.squaredNorm()) * quaternionL(p);
-}
 
 /// (S^T x)_k = (column k of S) . x.
 template <class X>
@@ -103,6 +98,7 @@ FfrBody3d::FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameSt
   w_[1] = S[2][0] - SpMat(S[2][0].transpose());
   w_[2] = S[0][1] - SpMat(S[0][1].transpose());
   for (auto& w : w_) w.makeCompressed();
+  for (const FfrPoint3d& p : inv_.points) nodeSupport_.push_back(FfrInvariants3d::support(p));
 }
 
 std::vector<std::string> FfrBody3d::coordinateNames() const {
@@ -153,18 +149,12 @@ bool FfrBody3d::isDissipative() const {
 
 // ----- kinematic equation -------------------------------------------------------------
 
-void FfrBody3d::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
-  T.setZero(numCoordinates(), numVelocities());
-  T.topLeftCorner<3, 3>().setIdentity();
-  T.block<4, 3>(3, 3) = 0.5 * quaternionL(q.segment<4>(3)).transpose();  // p' = 1/2 L^T w
-  T.bottomRightCorner(nf_, nf_).setIdentity();
+void FfrBody3d::addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const {
+  addEulerFrameRateMatrix(q, nf_, T);
 }
 
-void FfrBody3d::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
-  Tinv.setZero(numVelocities(), numCoordinates());
-  Tinv.topLeftCorner<3, 3>().setIdentity();
-  Tinv.block<3, 4>(3, 3) = rotationInverse(q);
-  Tinv.bottomRightCorner(nf_, nf_).setIdentity();
+void FfrBody3d::addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const {
+  addEulerFrameRateInverse(q, nf_, Tinv);
 }
 
 void FfrBody3d::addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
@@ -209,14 +199,35 @@ Vec3 FfrBody3d::firstMomentAt(const ConstVecRef& q) const {
   return inv_.firstMoment + inv_.sBar * q.tail(nf_);
 }
 
+namespace {
+/// The skew pair of W_i = S_ab - S_ba: for the stored upper S_kl (k < l), the index i of
+/// the W it forms and the sign (W_x = S_yz - S_zy, W_y = -(S_xz - S_zx), W_z = S_xy - S_yx).
+struct SkewPair {
+  int index;
+  double sign;
+};
+constexpr SkewPair skewPairOf(int k, int l) {
+  return k == 0 ? (l == 1 ? SkewPair{2, 1.0} : SkewPair{1, -1.0}) : SkewPair{0, 1.0};
+}
+}  // namespace
+
 Mat3 FfrBody3d::secondMomentAt(const ConstVecRef& qf) const {
   // J = int rho (u0 + N qf)(u0 + N qf)^T dV = J0 + P + P^T + (qf^T S_kl qf)_kl,
   // P_kl = int rho u0_k N_l dV qf = positionShape[k].row(l) qf
+  // (the six stored S_kl with k <= l; S_lk = S_kl^T is validated)
+  Mat3 quadratic = Mat3::Zero();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) quadratic(k, l) = bilinear(inv_.sKL[k][l], qf, qf);
+  }
+  return secondMomentFrom(qf, quadratic);
+}
+
+Mat3 FfrBody3d::secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const {
   Mat3 J = inv_.secondMoment;
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) {
       const double pkl = inv_.positionShape[k].row(l).dot(qf);
-      J(k, l) += pkl + bilinear(inv_.sKL[k][l], qf, qf);
+      J(k, l) += pkl + quadratic(std::min(k, l), std::max(k, l));  // qf^T S_lk qf = qf^T S_kl qf
       J(l, k) += pkl;
     }
   }
@@ -274,14 +285,46 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   const Vec3 s = firstMomentAt(q);
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
+  auto of = out.tail(nf_);
+  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated; issue 24): the
+  // quadratic part of J (for I aw), Y af = X0 af + (qf^T W_i af)_i and the rows f' part
+  // Y^T aw = X0^T aw + sum_i aw_i W_i^T qf, W_i = sign (S_kl - S_kl^T) (skewPairOf)
+  Mat3 quadratic = Mat3::Zero();
+  Vec3 yaf = x0_ * af;
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      const SpMat& S = inv_.sKL[k][l];
+      if (k == l) {
+        quadratic(k, l) = bilinear(S, qf, qf);
+        continue;
+      }
+      const SkewPair wp = skewPairOf(k, l);
+      const double cw = wp.sign * aw[wp.index];
+      double jq = 0.0, y = 0.0;
+      for (int j = 0; j < S.outerSize(); ++j) {
+        const double qj = qf[j], aj = af[j];
+        double sq = 0.0;  // (S^T qf)_j
+        for (SpMat::InnerIterator it(S, j); it; ++it) {
+          const int i = static_cast<int>(it.row());
+          const double sv = it.value();
+          jq += qf[i] * sv * qj;
+          y += sv * (qf[i] * aj - af[i] * qj);
+          of[i] -= cw * sv * qj;
+          sq += sv * qf[i];
+        }
+        of[j] += cw * sq;
+      }
+      quadratic(k, l) = jq;
+      yaf[wp.index] += wp.sign * y;
+    }
+  }
+  const Mat3 J = secondMomentFrom(qf, quadratic);
   // row R: m aR - A s~ aw + A S-bar af
   out.head<3>() += inv_.mass * aR + A * (aw.cross(s) + inv_.sBar * af);
-  // row theta: s~ A^T aR + I aw + Y af, Y af = X0 af + (qf^T W_i af)_i
-  const Vec3 yaf = x0_ * af + Vec3(bilinear(w_[0], qf, af), bilinear(w_[1], qf, af), bilinear(w_[2], qf, af));
-  out.segment<3>(3) += s.cross(bR) + inertiaAt(q) * aw + yaf;
+  // row theta: s~ A^T aR + I aw + Y af, I = tr(J) 1 - J (Shabana eq. 5.110)
+  out.segment<3>(3) += s.cross(bR) + (J.trace() * aw - J * aw) + yaf;
   // rows f: S-bar^T A^T aR + Y^T aw + m_ff af
-  auto of = out.tail(nf_);
-  for (int k = 0; k < nf_; ++k) of[k] += inv_.sBar.col(k).dot(bR) + skewShapeColumn(qf, k).dot(aw);
+  of.noalias() += inv_.sBar.transpose() * bR + x0_.transpose() * aw;
   addProduct(inv_.mff, af, 1.0, of);
 }
 
@@ -290,7 +333,7 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   // rotation dpi = Rinv dp (Rinv = 2 L(p) / |p|^2, zero along p: the gauge).
   const auto qf = q.tail(nf_), af = a.tail(nf_);
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 s = firstMomentAt(q);
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
@@ -332,20 +375,60 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   const Mat3 ws = skew(w), Om = ws * ws;
   const Vec3 sp = inv_.sBar * pf;
   Q.head<3>() -= A * (Om * s + 2.0 * ws * sp);
-  Mat3 G;
-  for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + bilinear(inv_.sKL[k][l], pf, qf);
-  }
-  Q.segment<3>(3) -= w.cross(inertiaAt(q) * w) + 2.0 * (G.trace() * w - G * w);
   auto Qf = Q.tail(nf_);
+  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated; issue 24): the
+  // quadratic parts of J (qf^T S_kl qf) and G (qf'^T S_kl qf), and into Q_f -Om_kl S_kl qf
+  // (with S_lk qf = S_kl^T qf; Om symmetric) and the Coriolis term 2 w_i W_i qf'.
+  Mat3 quadratic = Mat3::Zero(), Gq = Mat3::Zero();
   for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) {
-      // int rho N_k^T u_l dV = positionShape[l].row(k)^T + S_kl qf
-      Qf.noalias() -= Om(k, l) * inv_.positionShape[l].row(k).transpose();
-      addProduct(inv_.sKL[k][l], qf, -Om(k, l), Qf);
+    for (int l = k; l < 3; ++l) {
+      const SpMat& S = inv_.sKL[k][l];
+      const double om = Om(k, l);
+      double jq = 0.0, gkl = 0.0, glk = 0.0;
+      if (k == l) {
+        for (int j = 0; j < S.outerSize(); ++j) {
+          const double qj = qf[j];
+          for (SpMat::InnerIterator it(S, j); it; ++it) {
+            const int i = static_cast<int>(it.row());
+            const double t = it.value() * qj;
+            jq += qf[i] * t;
+            gkl += pf[i] * t;
+            Qf[i] -= om * t;
+          }
+        }
+      } else {
+        const SkewPair wp = skewPairOf(k, l);
+        const double c = 2.0 * w[wp.index] * wp.sign;  // 2 w_i (S_kl - S_kl^T) qf'
+        for (int j = 0; j < S.outerSize(); ++j) {
+          const double qj = qf[j], pj = pf[j];
+          double fj = 0.0;  // into Q_f[j]: -(om S^T qf)_j - (c S^T qf')_j
+          for (SpMat::InnerIterator it(S, j); it; ++it) {
+            const int i = static_cast<int>(it.row());
+            const double sv = it.value(), qi = qf[i], pi = pf[i];
+            jq += qi * sv * qj;
+            gkl += pi * sv * qj;
+            glk += qi * sv * pj;  // qf'^T S_lk qf = qf^T S_kl qf'
+            Qf[i] += sv * (c * pj - om * qj);
+            fj -= sv * (om * qi + c * pi);
+          }
+          Qf[j] += fj;
+        }
+      }
+      quadratic(k, l) = jq;
+      Gq(k, l) = gkl;
+      if (k != l) Gq(l, k) = glk;
     }
   }
-  for (int i = 0; i < 3; ++i) addProduct(w_[i], pf, 2.0 * w[i], Qf);
+  const Mat3 J = secondMomentFrom(qf, quadratic);
+  Mat3 G;
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + Gq(k, l);
+  }
+  Q.segment<3>(3) -= w.cross(J.trace() * w - J * w) + 2.0 * (G.trace() * w - G * w);
+  // int rho N_k^T u_l dV = positionShape[l].row(k)^T + S_kl qf: the constant part
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) Qf.noalias() -= Om(k, l) * inv_.positionShape[l].row(k).transpose();
+  }
   // elastic and damping forces
   if (model_) {
     model_->addStrainEnergyGradient(qf, -1.0, Qf);  // -dU/dq_f (K_ff q_f when linear)
@@ -359,7 +442,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
                                           const MatrixSink& dQdv) const {
   const auto qf = q.tail(nf_), pf = v.tail(nf_);
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 s = firstMomentAt(q);
   const Vec3 w = v.segment<3>(3);
   const Mat3 ws = skew(w), Om = ws * ws;
@@ -433,7 +516,7 @@ void FfrBody3d::addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) co
 
 void FfrBody3d::addGravityJacobian(const ConstVecRef& q, const Vec3& g, const MatrixSink& K) const {
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 gb = A.transpose() * g;
   const Mat3 gs = skew(gb);
   K.addBlock(3, 3, Mat34(skew(firstMomentAt(q)) * gs * Rinv));
@@ -496,14 +579,27 @@ int FfrBody3d::resolvePoint(const Vec3& point, const std::string& user) const {
   throw InputError(os.str());
 }
 
-const FfrPoint3d& FfrBody3d::node(const Vec3& point, int pointId) const {
-  if (pointId >= 0 && pointId < static_cast<int>(inv_.points.size())) return inv_.points[pointId];
-  return inv_.points[resolvePoint(point, "attachment")];  // not resolved: found by its coordinates
+int FfrBody3d::nodeIndex(const Vec3& point, int pointId) const {
+  if (pointId >= 0 && pointId < static_cast<int>(inv_.points.size())) return pointId;
+  return resolvePoint(point, "attachment");  // not resolved: found by its coordinates
+}
+
+FfrBody3d::NodeMotion FfrBody3d::nodeMotion(const Vec3& point, int pointId, const ConstVecRef& qf) const {
+  // u = u0 + N qf, theta = Ntheta qf over the node's support only (O(1) per node of a
+  // nodal mesh, not O(nf))
+  const int k = nodeIndex(point, pointId);
+  const FfrPoint3d& pt = inv_.points[k];
+  NodeMotion m{pt, pt.position, Vec3::Zero()};
+  for (int c : nodeSupport_[k]) {
+    m.u += pt.shape.col(c) * qf[c];
+    m.theta += pt.rotationShape.col(c) * qf[c];
+  }
+  return m;
 }
 
 std::vector<int> FfrBody3d::pointSupport(const Vec3& point, int pointId) const {
   std::vector<int> cols = {0, 1, 2, 3, 4, 5};
-  for (int e : FfrInvariants3d::support(node(point, pointId))) cols.push_back(6 + e);
+  for (int e : nodeSupport_[nodeIndex(point, pointId)]) cols.push_back(6 + e);
   return cols;
 }
 
@@ -511,11 +607,12 @@ void FfrBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int poi
                                 const std::vector<int>* qcols, FrameKinematics& out) const {
   // r = R + A u, u = u0 + N qf;  r' = R' - A u~ w + A N qf';
   // A_node = A (I + theta~), theta = Ntheta qf;  omega_node = A (w + Ntheta qf')  (first order)
-  const FfrPoint3d& pt = node(point, pointId);
   const auto qf = q.tail(nf_);
+  const NodeMotion m = nodeMotion(point, pointId, qf);
+  const FfrPoint3d& pt = m.point;
+  const Vec3& u = m.u;
+  const Vec3& theta = m.theta;
   const Mat3 A = rotationOf(q);
-  const Vec3 u = pt.position + pt.shape * qf;
-  const Vec3 theta = pt.rotationShape * qf;
   out.r = q.head<3>() + A * u;
   out.A = A * (Mat3::Identity() + skew(theta));
   const int nv = cols ? static_cast<int>(cols->size()) : numVelocities();
@@ -536,7 +633,7 @@ void FfrBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int poi
       out.Jw.col(a) = A * pt.rotationShape.col(c - 6);
     }
   }
-  const Mat34 Rinv = rotationInverse(q);
+  const Mat34 Rinv = eulerRateInverse(q);
   out.Tinv.resize(nv, nq);
   for (int i = 0; i < nv; ++i) {
     for (int j = 0; j < nq; ++j) out.Tinv(i, j) = tinvEntry(Rinv, cols ? (*cols)[i] : i, qcols ? (*qcols)[j] : j);
@@ -548,11 +645,12 @@ void FfrBody3d::addFrameCurvature(const ConstVecRef& q, const Vec3& point, int p
                                   Eigen::Ref<MatX> out) const {
   // Jr^T wr + Jw^T ww = [wr; u~ br + bw; N^T br + Ntheta^T bw], br = A^T wr, bw = A^T ww;
   // d(A^T c)/dpi = (A^T c)~, dpi = Rinv dp; du/dqf = N.
-  const FfrPoint3d& pt = node(point, pointId);
   const auto qf = q.tail(nf_);
+  const NodeMotion m = nodeMotion(point, pointId, qf);
+  const FfrPoint3d& pt = m.point;
+  const Vec3& u = m.u;
   const Mat3 A = rotationOf(q);
-  const Mat34 Rinv = rotationInverse(q);
-  const Vec3 u = pt.position + pt.shape * qf;
+  const Mat34 Rinv = eulerRateInverse(q);
   const Vec3 br = A.transpose() * wr, bw = A.transpose() * ww;
   const Mat3 brs = skew(br), bws = skew(bw);
   const Mat34 rot = (skew(u) * brs + bws) * Rinv;  // rows theta, columns p

@@ -70,8 +70,8 @@ class FfrBody3d final : public Body {
   double mass() const override { return inv_.mass; }
 
   bool velocitiesAreCoordinateRates() const override { return false; }
-  void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const override;
-  void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const override;
+  void addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const override;
+  void addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const override;
   void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const override;
   void addCoordinateRateJacobian(const ConstVecRef& q, const ConstVecRef& w, const MatrixSink& K) const override;
   void applyIncrement(const ConstVecRef& q, const ConstVecRef& dv, Eigen::Ref<VecX> out) const override;
@@ -125,9 +125,17 @@ class FfrBody3d final : public Body {
   Mat3 inertiaAt(const ConstVecRef& q) const;
 
  private:
-  const FfrPoint3d& node(const Vec3& point, int pointId) const;
+  int nodeIndex(const Vec3& point, int pointId) const;
+  /// A node and its motion at q_f: u = u0 + N q_f, theta = Ntheta q_f.
+  struct NodeMotion {
+    const FfrPoint3d& point;
+    Vec3 u, theta;
+  };
+  NodeMotion nodeMotion(const Vec3& point, int pointId, const ConstVecRef& qf) const;
   /// J(q_f) = int rho u u^T dV.
   Mat3 secondMomentAt(const ConstVecRef& qf) const;
+  /// J(q_f) from its quadratic part, (qf^T S_kl qf) in the upper triangle (k <= l).
+  Mat3 secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const;
   /// dJ/dq_f,k.
   Mat3 secondMomentDerivative(const ConstVecRef& qf, int k) const;
   /// Column k of Y(q_f) = int rho u~ N dV.
@@ -139,6 +147,7 @@ class FfrBody3d final : public Body {
   FrameState3d initial_;
   VecX qf0_, qf0dot_;
   Mat3X x0_;                 // int rho u0~ N dV (3 x nf), constant
+  std::vector<std::vector<int>> nodeSupport_;  // per node: the elastic coordinates its shapes use
   std::array<SpMat, 3> w_;   // W_x = S_yz - S_zy, W_y = S_zx - S_xz, W_z = S_xy - S_yx (skew):
                              // int rho (N a) x (N b) dV = (a^T W_i b)_i
 };

@@ -1,17 +1,13 @@
 #include "bodies/rigid_body_3d.hpp"
 
+#include "bodies/euler_frame_rates.hpp"
+
 #include <Eigen/Eigenvalues>
 
 #include "core/errors.hpp"
 
 namespace flexmbd {
 namespace {
-
-/// T+ of the rotation block: 2 L(p) / |p|^2 (3 x 4), the body-axes rotation of an increment dp.
-Mat34 rotationInverse(const ConstVecRef& q) {
-  const Vec4 p = q.segment<4>(3);
-  return (2.0 / p.squaredNorm()) * quaternionL(p);
-}
 
 /// Selects the used columns of a full row block (cols null: all).
 template <class Full, class Out>
@@ -79,16 +75,12 @@ VecX RigidBody3d::initialVelocities() const {
   return v;
 }
 
-void RigidBody3d::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
-  T.setZero(7, 6);
-  T.topLeftCorner<3, 3>().setIdentity();
-  T.bottomRightCorner<4, 3>() = 0.5 * quaternionL(q.segment<4>(3)).transpose();
+void RigidBody3d::addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const {
+  addEulerFrameRateMatrix(q, 0, T);
 }
 
-void RigidBody3d::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
-  Tinv.setZero(6, 7);
-  Tinv.topLeftCorner<3, 3>().setIdentity();
-  Tinv.bottomRightCorner<3, 4>() = rotationInverse(q);
+void RigidBody3d::addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const {
+  addEulerFrameRateInverse(q, 0, Tinv);
 }
 
 void RigidBody3d::addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
@@ -173,7 +165,7 @@ void RigidBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int, 
   selectColumns(Jw, cols, out.Jw);
   Eigen::Matrix<double, 6, 7> Tinv = Eigen::Matrix<double, 6, 7>::Zero();
   Tinv.topLeftCorner<3, 3>().setIdentity();
-  Tinv.bottomRightCorner<3, 4>() = rotationInverse(q);
+  Tinv.bottomRightCorner<3, 4>() = eulerRateInverse(q);
   if (!cols && !qcols) {
     out.Tinv = Tinv;
     return;
@@ -192,7 +184,7 @@ void RigidBody3d::addFrameCurvature(const ConstVecRef& q, const Vec3& point, int
   // rotation dpi, and dpi = T+ dp: the rotation rows' derivative is (u~ (A^T wr)~ + (A^T ww)~) T+.
   const Mat3 A = rotationOf(q);
   const Eigen::Matrix<double, 3, 4> block =
-      (skew(point) * skew(A.transpose() * wr) + skew(A.transpose() * ww)) * rotationInverse(q);
+      (skew(point) * skew(A.transpose() * wr) + skew(A.transpose() * ww)) * eulerRateInverse(q);
   const int nv = cols ? static_cast<int>(cols->size()) : 6, nq = qcols ? static_cast<int>(qcols->size()) : 7;
   for (int i = 0; i < nv; ++i) {
     const int vi = cols ? (*cols)[i] : i;

@@ -50,8 +50,8 @@ class RigidBody3d final : public Body {
   const Mat3& inertia() const { return props_.inertia; }
 
   bool velocitiesAreCoordinateRates() const override { return false; }
-  void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const override;
-  void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const override;
+  void addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const override;
+  void addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const override;
   void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const override;
   void addCoordinateRateJacobian(const ConstVecRef& q, const ConstVecRef& w, const MatrixSink& K) const override;
   void applyIncrement(const ConstVecRef& q, const ConstVecRef& dv, Eigen::Ref<VecX> out) const override;

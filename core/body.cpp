@@ -1,5 +1,6 @@
 #include "core/body.hpp"
 
+#include <algorithm>
 #include <numeric>
 
 #include "core/errors.hpp"
@@ -13,14 +14,24 @@ std::vector<int> Body::pointSupport(const Vec3& point, int pointId) const {
   return all;
 }
 
-void Body::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
+void Body::addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const {
   (void)q;
-  T.setIdentity(numCoordinates(), numVelocities());
+  for (int k = 0; k < std::min(numCoordinates(), numVelocities()); ++k) T.add(k, k, 1.0);
+}
+
+void Body::addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const {
+  (void)q;
+  for (int k = 0; k < std::min(numCoordinates(), numVelocities()); ++k) Tinv.add(k, k, 1.0);
+}
+
+void Body::coordinateRateMatrix(const ConstVecRef& q, MatX& T) const {
+  T.setZero(numCoordinates(), numVelocities());
+  addCoordinateRateMatrix(q, MatrixSink(T));
 }
 
 void Body::coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const {
-  (void)q;
-  Tinv.setIdentity(numVelocities(), numCoordinates());
+  Tinv.setZero(numVelocities(), numCoordinates());
+  addCoordinateRateInverse(q, MatrixSink(Tinv));
 }
 
 void Body::frameKinematics(const ConstVecRef&, const Vec3&, int, const std::vector<int>*, const std::vector<int>*,

@@ -35,12 +35,19 @@ class Body {
   // ----- the kinematic equation q' = T(q) v (docs/spatial.md) ---------------------
   /// True when T = I (planar bodies): the assembly then takes its fast paths.
   virtual bool velocitiesAreCoordinateRates() const { return true; }
-  /// T(q) (nq x nv), into T (resized). Default: the identity.
-  virtual void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const;
+  /// T(q) (nq x nv): its structural non-zeros only, added into T (the same entries at
+  /// every q; a flexible body's elastic part is the identity, so a large body writes
+  /// O(nq) entries, never a dense nq x nv block). Default: the identity.
+  virtual void addCoordinateRateMatrix(const ConstVecRef& q, const MatrixSink& T) const;
   /// A left inverse T+(q) (nv x nq, T+ T = I) with ker T+ the directions along which no
   /// material point moves (a quaternion's length): the derivative of any body-point
-  /// quantity f(q) is f_q = (f_q T) T+ = G T+. Into Tinv (resized). Default: the identity.
-  virtual void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const;
+  /// quantity f(q) is f_q = (f_q T) T+ = G T+. Structural non-zeros only, added into
+  /// Tinv. Default: the identity.
+  virtual void addCoordinateRateInverse(const ConstVecRef& q, const MatrixSink& Tinv) const;
+  /// Dense T(q) (nq x nv) into T (resized): for small models and tests.
+  void coordinateRateMatrix(const ConstVecRef& q, MatX& T) const;
+  /// Dense T+(q) (nv x nq) into Tinv (resized): for small models and tests.
+  void coordinateRateInverse(const ConstVecRef& q, MatX& Tinv) const;
   /// out += T(q) w.
   virtual void addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
     (void)q;

@@ -31,8 +31,9 @@ class DaeProblem {
   /// Per unknown: 1 if it takes part in the local error test (differential), 0 if not
   /// (multipliers and other algebraic variables).
   virtual VecX differentialIds() const = 0;
-  /// Elimination groups for KLU's constrained ordering (see klu_ordering.hpp); size n.
-  /// Default: one group (KLU's own ordering).
+  /// Elimination groups for KLU's constrained orderings (integrators/klu_ordering.hpp),
+  /// size n: 0 elastic unknowns, 1 frame unknowns, 2 multipliers. Default: none (KLU's
+  /// own ordering).
   virtual std::vector<int64_t> eliminationGroups() const { return {}; }
 
   /// Scratch for residual() and jacobian(), made once per integrator (or thread).

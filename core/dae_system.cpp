@@ -99,7 +99,8 @@ struct ForceScratch {
 /// DaeSystem's scratch: one per integrator, so that evaluations allocate nothing.
 struct DaeSystemScratch final : DaeScratch {
   std::vector<VecX> bodyForce;  ///< per body, its generalised forces
-  std::vector<MatX> T, Tinv;    ///< per body T(q) and T+(q) (T != I only)
+  /// Per body the values of T(q) and T+(q) in DaeSystem's rate patterns (T != I only).
+  std::vector<std::vector<double>> T, Tinv;
   std::vector<ConstraintScratch> constraints;
   std::vector<ForceScratch> forces;
   VecX qPlus, qMinus;           ///< perturbed coordinates (index-1 Jacobian)
@@ -126,9 +127,36 @@ void coordinateRates(const System& sys, const double* q, const double* v, VecX& 
   }
 }
 
+/// Entry (row, col) of a matrix stored as `values` in `pattern` (0 outside it).
+double entryOf(const SparsePattern& pattern, const std::vector<double>& values, int row, int col) {
+  const int64_t k = pattern.find(row, col);
+  return k < 0 ? 0.0 : values[k];
+}
+
+/// The pattern of what `write` adds into an n x n sink (recorded once, values ignored).
+template <class Write>
+SparsePattern recordPattern(int n, Write&& write) {
+  std::vector<Eigen::Triplet<double>> written;
+  JacobianSink recorder = JacobianSink::recorder(&written);
+  write(MatrixSink(recorder, 0, 0));
+  std::vector<std::pair<int, int>> entries;
+  entries.reserve(written.size());
+  for (const auto& e : written) entries.emplace_back(e.row(), e.col());
+  return SparsePattern(n, std::move(entries));
+}
+
+/// values = the entries `write` adds, in `pattern` (zeroed first; allocation-free).
+template <class Write>
+void fillPattern(const SparsePattern& pattern, std::vector<double>& values, Write&& write) {
+  std::fill(values.begin(), values.end(), 0.0);
+  JacobianSink sink = JacobianSink::sparse(values.data(), pattern);
+  write(MatrixSink(sink, 0, 0));
+}
+
 /// Tl (nq_l x nv_l) and Til (nv_l x nq_l): T and T+ of a constraint's bodies restricted to
 /// its used coordinates and velocities, block by body slot (S.T, S.Tinv filled before).
-void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, const DaeSystemScratch& S, MatX& Tl,
+void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, const DaeSystemScratch& S,
+                       const std::vector<SparsePattern>& Tp, const std::vector<SparsePattern>& Tip, MatX& Tl,
                        MatX& Til) {
   const BodyStates states = sys.constraintStates(ci, q);
   int nql = 0, nvl = 0;
@@ -147,8 +175,8 @@ void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, c
     const bool identity = st.body.velocitiesAreCoordinateRates();  // S.T[b] is not filled then
     for (size_t i = 0; i < qc.size(); ++i) {
       for (size_t j = 0; j < vc.size(); ++j) {
-        Tl(r + i, c + j) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : S.T[b](qc[i], vc[j]);
-        Til(c + j, r + i) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : S.Tinv[b](vc[j], qc[i]);
+        Tl(r + i, c + j) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : entryOf(Tp[b], S.T[b], qc[i], vc[j]);
+        Til(c + j, r + i) = identity ? (qc[i] == vc[j] ? 1.0 : 0.0) : entryOf(Tip[b], S.Tinv[b], vc[j], qc[i]);
       }
     }
     r += static_cast<int>(qc.size());
@@ -204,11 +232,23 @@ DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisat
   L.mu = formulation == Formulation::Ggl ? L.nq + L.nv + L.m : -1;
   L.size = L.nq + L.nv + (formulation == Formulation::Ggl ? 2 : 1) * L.m;
 
-  // The pattern is what the assembly writes, recorded once at the initial state.
+  // T and T+ of the bodies with T != I, then the pattern of what the assembly writes,
+  // recorded once at the initial state.
+  const VecX q0 = sys.initialCoordinates();
+  ratePattern_.resize(sys.numBodies());
+  rateInversePattern_.resize(sys.numBodies());
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const Body& body = sys.body(bi);
+    if (body.velocitiesAreCoordinateRates() || body.numCoordinates() == 0) continue;
+    const auto qb = q0.segment(sys.coordinateOffset(bi), body.numCoordinates());
+    const int n = std::max(body.numCoordinates(), body.numVelocities());
+    ratePattern_[b] = recordPattern(n, [&](const MatrixSink& T) { body.addCoordinateRateMatrix(qb, T); });
+    rateInversePattern_[b] = recordPattern(n, [&](const MatrixSink& T) { body.addCoordinateRateInverse(qb, T); });
+  }
   std::vector<Eigen::Triplet<double>> written;
   JacobianSink recorder = JacobianSink::recorder(&written);
   VecX y, yp;
-  const VecX q0 = sys.initialCoordinates();
   packState(q0, VecX::Zero(L.nv), VecX::Zero(L.nv), VecX::Zero(L.m), y, yp);
   jacobian(0.0, y.data(), yp.data(), 1.0, recorder);
   std::vector<std::pair<int, int>> entries;
@@ -227,7 +267,7 @@ VecX DaeSystem::differentialIds() const {
 std::vector<int64_t> DaeSystem::eliminationGroups() const {
   const DaeLayout& L = layout_;
   std::vector<int64_t> groups(L.size, 0);
-  for (int k = L.lambda; k < L.size; ++k) groups[k] = 1;
+  for (int k = L.lambda; k < L.size; ++k) groups[k] = 2;
   for (int f : sys_.frameCoordinates()) groups[L.q + f] = 1;
   for (int f : sys_.frameVelocities()) groups[L.v + f] = 1;
   return groups;
@@ -246,8 +286,8 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     const BodyIndex bi(b);
     s->bodyForce.emplace_back(sys.numVelocities(bi));
     if (!identityT && !sys.body(bi).velocitiesAreCoordinateRates()) {  // T and T+ only where T != I
-      s->T[b].setZero(sys.numCoordinates(bi), sys.numVelocities(bi));
-      s->Tinv[b].setZero(sys.numVelocities(bi), sys.numCoordinates(bi));
+      s->T[b].assign(ratePattern_[b].nonZeros(), 0.0);
+      s->Tinv[b].assign(rateInversePattern_[b].nonZeros(), 0.0);
     }
   }
   s->constraints.resize(sys.numConstraints());
@@ -455,10 +495,16 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
     if (identityT || body.velocitiesAreCoordinateRates()) {
       for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.v + voff + k, -1.0);
     } else {
-      body.coordinateRateMatrix(qb, S.T[b]);
-      body.coordinateRateInverse(qb, S.Tinv[b]);
-      const MatX& T = S.T[b];
-      for (int j = 0; j < nvb; ++j) J.addColumn(L.v + voff + j, L.q + qoff, nullptr, T.col(j).data(), nqb, -1.0);
+      fillPattern(ratePattern_[b], S.T[b], [&](const MatrixSink& T) { body.addCoordinateRateMatrix(qb, T); });
+      fillPattern(rateInversePattern_[b], S.Tinv[b],
+                  [&](const MatrixSink& T) { body.addCoordinateRateInverse(qb, T); });
+      // -T into F_q's velocity columns, its structural non-zeros only
+      const SparsePattern& Tp = ratePattern_[b];
+      for (int j = 0; j < nvb; ++j) {
+        for (int64_t k = Tp.colStart()[j]; k < Tp.colStart()[j + 1]; ++k) {
+          J.add(L.q + qoff + static_cast<int>(Tp.rowIndex()[k]), L.v + voff + j, -S.T[b][k]);
+        }
+      }
     }
     // each body writes its structural non-zeros only (sparse for large flexible bodies)
     const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);
@@ -496,7 +542,7 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
     const ConstraintEvaluation& ev = cs.ev;
     con.evaluate(sys.constraintStates(ci, q.data()), true, cs.ev);
     gather(cols, v.data(), cs.vl);
-    if (!identityT) localRateMatrices(sys, ci, q.data(), S, cs.Tl, cs.Til);
+    if (!identityT) localRateMatrices(sys, ci, q.data(), S, ratePattern_, rateInversePattern_, cs.Tl, cs.Til);
     // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
     cs.Hx.setZero();
     for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];

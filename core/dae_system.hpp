@@ -78,7 +78,8 @@ class DaeSystem final : public DaeProblem {
 
   /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
   /// the positions and velocities of elastic coordinates, 1 for frame coordinates
-  /// (coupled to their whole body) and multipliers (zero diagonal), to be eliminated last.
+  /// (coupled to their whole body), 2 for multipliers (zero diagonal); KluOrdering
+  /// (integrators/klu_ordering.hpp) chooses which go last.
   std::vector<int64_t> eliminationGroups() const override;
 
   /// y and y' from positions, velocities, accelerations and multipliers (mu = 0).
@@ -98,6 +99,11 @@ class DaeSystem final : public DaeProblem {
   DaeLayout layout_;
   SparsePattern pattern_;
   VecX metric_;  ///< D of the GGL stabilisation (nv)
+  /// Per body with T != I: the structural non-zeros of T (nq x nv) and T+ (nv x nq), each in
+  /// a square pattern of size nq (empty for T = I). Built once: a body's T is sparse (the
+  /// identity on elastic coordinates), and assembling it densely made the Jacobian pattern
+  /// of a spatial flexible body quadratic in its mesh (issue 24).
+  std::vector<SparsePattern> ratePattern_, rateInversePattern_;
 };
 
 }  // namespace flexmbd

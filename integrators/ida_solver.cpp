@@ -40,7 +40,7 @@ struct IdaSolver::Impl {
   SUNMatrix A = nullptr;
   SUNLinearSolver LS = nullptr;
   bool sparse = false;
-  std::vector<int64_t> kluGroups;  // CAMD constraint set, read by camdOrdering
+  KluOrdering kluOrdering;  // holds the CAMD constraint set KLU's ordering callback reads
   // An exception thrown by the model inside a callback: IDA is told to stop (an
   // unrecoverable failure of the callback) and advance() rethrows it with its type.
   std::exception_ptr pending;
@@ -164,8 +164,8 @@ IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const Vec
     if (!d.A) throw SolverError("SUNSparseMatrix failed", t0, 0.0);
     d.LS = SUNLinSol_KLU(d.yy, d.A, d.ctx);
     if (!d.LS) throw SolverError("creating the linear solver failed", t0, 0.0);
-    d.kluGroups = dae.eliminationGroups();
-    configureKluOrdering(*SUNLinSol_KLUGetCommon(d.LS), d.kluGroups);
+    d.kluOrdering = KluOrdering::choose(dae, t0, y0, yp0, kOrderingTrialCj);
+    d.kluOrdering.configure(*SUNLinSol_KLUGetCommon(d.LS));
   } else {
     d.A = SUNDenseMatrix(n, n, d.ctx);
     if (!d.A) throw SolverError("SUNDenseMatrix failed", t0, 0.0);

@@ -178,10 +178,10 @@ class DenseNewtonAlgebra final : public NewtonAlgebra {
 
 class KluCommon {
  public:
-  /// KLU defaults with the engine's ordering; `groups` must outlive this object.
-  explicit KluCommon(const std::vector<int64_t>& groups) {
+  /// KLU defaults with the engine's ordering; `ordering` must outlive this object.
+  explicit KluCommon(const KluOrdering& ordering) {
     klu_l_defaults(&common_);
-    configureKluOrdering(common_, groups);
+    ordering.configure(common_);
   }
   KluCommon(const KluCommon&) = delete;
   KluCommon& operator=(const KluCommon&) = delete;
@@ -254,7 +254,8 @@ class KluNumeric {
 
 class KluNewtonAlgebra final : public NewtonAlgebra {
  public:
-  explicit KluNewtonAlgebra(const DaeProblem& dae)
+  /// The KLU ordering is chosen by trial factorisations at (t0, y0, y0') (KluOrdering).
+  KluNewtonAlgebra(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0)
       : pattern_(dae.pattern()),
         n_(pattern_.size()),
         Ap_(pattern_.colStart().begin(), pattern_.colStart().end()),
@@ -264,8 +265,8 @@ class KluNewtonAlgebra final : public NewtonAlgebra {
         E1_(Ai_.size()),
         E2_(2 * Ai_.size()),
         cb_(2 * static_cast<size_t>(n_)),
-        groups_(dae.eliminationGroups()),
-        common_(groups_),
+        ordering_(KluOrdering::choose(dae, t0, y0, yp0, kOrderingTrialCj)),
+        common_(ordering_),
         symbolic_(n_, Ap_.data(), Ai_.data(), common_.get()),
         real_(false, common_.get()),
         complex_(true, common_.get()) {
@@ -316,7 +317,7 @@ class KluNewtonAlgebra final : public NewtonAlgebra {
   std::vector<SuiteSparse_long> Ap_, Ai_;
   std::vector<double> J0_, M0_, E1_, E2_, cb_;
   // destroyed in reverse order: the factors, the analysis, then the settings and groups
-  std::vector<int64_t> groups_;
+  KluOrdering ordering_;  // before common_: holds the CAMD constraint set its ordering callback reads
   KluCommon common_;
   KluSymbolic symbolic_;
   KluNumeric real_, complex_;
@@ -409,7 +410,7 @@ struct Radau5Solver::Impl {
     LinearSolverKind kind = o.linearSolver;
     if (kind == LinearSolverKind::Automatic) kind = n <= kDenseSizeLimit ? LinearSolverKind::Dense : LinearSolverKind::Klu;
     sparse = kind == LinearSolverKind::Klu;
-    if (sparse) la = std::make_unique<KluNewtonAlgebra>(dae);
+    if (sparse) la = std::make_unique<KluNewtonAlgebra>(dae, t0, y0, yp0);
     else la = std::make_unique<DenseNewtonAlgebra>(n);
 
     t = t0;
