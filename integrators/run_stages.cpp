@@ -150,13 +150,14 @@ double defaultMinStepSize(const SolverSettings& settings) {
 
 IntegratorChoice chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings) {
   IntegratorChoice choice;
+  choice.kind = settings.integrator;
   IntegratorOptions& o = choice.options;
   o.rtol = settings.rtol;
   o.atol = absoluteTolerances(dae, settings);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
-  if (settings.integrator == IntegratorKind::Ida && settings.formulation != Formulation::Index1) {
+  if (choice.kind == IntegratorKind::Ida && settings.formulation != Formulation::Index1) {
     // Damped modes outside the A(alpha) sectors of BDF4/5 set off bursts of error-test
     // failures that strand IDA at order 1 with GGL (docs/formulations.md; index 1 measured unaffected)
     const BdfOrderLimit limit = stableBdfOrder(sys, settings.maxOrder);
@@ -171,6 +172,14 @@ IntegratorChoice chooseIntegratorOptions(const System& sys, const DaeSystem& dae
 }
 
 // --- integrate and hand over -------------------------------------------------------
+
+RunState startIntegrator(const RunContext& ctx, const RunStart& start, IntegratorKind kind) {
+  RunState state;
+  state.kind = kind;
+  state.restart(ctx.dae, ctx.outputs.t0, start.y0, start.yp0, ctx.options);
+  state.usedKlu = state.integrator->usesKlu();
+  return state;
+}
 
 bool StepWindow::complete() const { return steps >= kTrapWindow; }
 

@@ -61,6 +61,7 @@ std::optional<RunFailure> recordInitialOutput(OutputRecorder& recorder, const Da
 
 /// The integrator's options for a run, and why its BDF order is limited.
 struct IntegratorChoice {
+  IntegratorKind kind = IntegratorKind::Ida;  ///< the integrator the run starts with (settings.integrator)
   IntegratorOptions options;
   std::string orderLimit;  ///< why options.maxOrder is below settings.maxOrder ("" if it is not)
 };
@@ -75,6 +76,10 @@ IntegratorChoice chooseIntegratorOptions(const System& sys, const DaeSystem& dae
 double defaultMinStepSize(const SolverSettings& settings);
 
 // --- integrate and hand over -------------------------------------------------------
+
+/// The run's state at its start: the chosen integrator from the consistent initial
+/// values. @throws as makeIntegrator.
+RunState startIntegrator(const RunContext& ctx, const RunStart& start, IntegratorKind kind);
 
 /// The running integrator's steps and error-test failures since its window began.
 struct StepWindow {

@@ -62,7 +62,7 @@ struct RunContext {
   double modelSize;   ///< System::characteristicLength()
   double startRatio;  ///< smallest/largest singular value of G at the start (1 without constraints)
   /// Where the DAE integrator stops at a singular position, the run may cross it with
-  /// ALI3-P (settings.crossSingular; the crossing is planar, q' = v, so far).
+  /// ALI3-P (mayCrossSingularPositions).
   bool mayCross;
 };
 

@@ -10,6 +10,7 @@
 #include "integrators/output_recorder.hpp"
 #include "integrators/run_stages.hpp"
 #include "integrators/run_state.hpp"
+#include "integrators/singular_crossing.hpp"
 
 namespace flexmbd {
 namespace {
@@ -154,15 +155,15 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
 
   // choose
   const IntegratorChoice choice = chooseIntegratorOptions(sys, dae, settings);
-  const IntegratorOptions& options = choice.options;
-  const bool mayCross = settings.crossSingular && settings.integrator != IntegratorKind::AugmentedLagrangian &&
-                        dae.layout().m > 0 && sys.velocitiesAreCoordinateRates();
-  const RunContext ctx{sys,     dae, settings, options, OutputSchedule(t0, tEnd, settings.outputStep),
-                       start.modelSize, start.startRatio, mayCross};
-  RunState state;
-  state.kind = settings.integrator;
-  state.restart(dae, t0, start.y0, start.yp0, options);
-  state.usedKlu = state.integrator->usesKlu();
+  const RunContext ctx{sys,
+                       dae,
+                       settings,
+                       choice.options,
+                       OutputSchedule(t0, tEnd, settings.outputStep),
+                       start.modelSize,
+                       start.startRatio,
+                       mayCrossSingularPositions(sys, settings, choice.kind)};
+  RunState state = startIntegrator(ctx, start, choice.kind);
 
   // integrate output by output, handing over and crossing; diagnose an early end
   ProgressReporter progress(settings.progress, t0, tEnd);

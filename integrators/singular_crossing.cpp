@@ -79,6 +79,11 @@ AugmentedLagrangianOptions crossingOptions(const RunContext& ctx, double regular
 
 }  // namespace
 
+bool mayCrossSingularPositions(const System& sys, const SolverSettings& settings, IntegratorKind kind) {
+  return settings.crossSingular && kind != IntegratorKind::AugmentedLagrangian && sys.numConstraintEquations() > 0 &&
+         sys.velocitiesAreCoordinateRates();
+}
+
 double constraintConditioning(const MatX& G) {
   if (G.rows() == 0) return 1.0;
   const VecX sv = Eigen::JacobiSVD<MatX>(G).singularValues();

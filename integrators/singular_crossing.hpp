@@ -12,6 +12,11 @@
 
 namespace flexmbd {
 
+/// A run may cross singular positions with ALI3-P: the settings allow it
+/// (crossSingular), the run is not on ALI3-P already, the model has constraints, and its
+/// velocities are its coordinates' rates (ALI3-P is planar, q' = v, so far).
+bool mayCrossSingularPositions(const System& sys, const SolverSettings& settings, IntegratorKind kind);
+
 /// What singularityDiagnosis measured: the message, and whether it found the mechanism at
 /// or approaching a singular position (the cases the augmented-Lagrangian bridge crosses).
 struct SingularityDiagnosis {

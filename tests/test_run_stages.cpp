@@ -223,6 +223,7 @@ TEST(ChooseIntegratorOptions, DampedRodLimitsIdasOrderOnlyForGglAndIndex3) {
   {
     const DaeSystem dae(s.system, s.solver.formulation);
     const IntegratorChoice c = chooseIntegratorOptions(s.system, dae, s.solver);
+    EXPECT_EQ(c.kind, IntegratorKind::Ida);
     EXPECT_EQ(c.options.maxOrder, 3);
     EXPECT_EQ(c.orderLimit, stableBdfOrder(s.system, 5).reason());
     EXPECT_FALSE(c.orderLimit.empty());
@@ -294,6 +295,20 @@ TEST(PlanCrossing, CrossesWhereGIsFarWorseConditionedThanAtTheStartButNotADiverg
   EXPECT_FALSE(planCrossing(notAllowed, state, outputs, failure).has_value());
   outputs.largestCoordinate = 101.0;
   EXPECT_FALSE(planCrossing(worse, state, outputs, failure).has_value());
+}
+
+TEST(PlanCrossing, OnlyConstrainedPlanarRunsNotOnAli3pMayCross) {
+  const System sys = pendulum();
+  SolverSettings st;
+  EXPECT_TRUE(mayCrossSingularPositions(sys, st, IntegratorKind::Ida));
+  EXPECT_TRUE(mayCrossSingularPositions(sys, st, IntegratorKind::Radau5));
+  EXPECT_FALSE(mayCrossSingularPositions(sys, st, IntegratorKind::AugmentedLagrangian));
+  st.crossSingular = false;
+  EXPECT_FALSE(mayCrossSingularPositions(sys, st, IntegratorKind::Ida));
+  System free;
+  addRigidBody(free, "bar", RigidBodyProperties(), FrameState2d());
+  free.finalize();
+  EXPECT_FALSE(mayCrossSingularPositions(free, SolverSettings(), IntegratorKind::Ida));  // nothing to lose rank
 }
 
 // --- finish ------------------------------------------------------------------------
