@@ -15,6 +15,10 @@ namespace flexmbd {
 /// diverged: no mechanism of the scene reaches 100 times its own size.
 inline constexpr double kDivergedSize = 100.0;
 
+/// `largest`, the largest |position or elastic coordinate|, exceeds kDivergedSize times
+/// the model size (false for NaN).
+inline bool hasDiverged(double largest, double modelSize) { return largest > kDivergedSize * modelSize; }
+
 /// What the outputs of a run showed so far.
 struct RecordedOutputs {
   double tReached = 0.0;    ///< time of the last output passed to the callback
@@ -28,7 +32,7 @@ struct RecordedOutputs {
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
 
   /// A coordinate output so far exceeds kDivergedSize times the model size.
-  bool diverged(double modelSize) const { return largestCoordinate > kDivergedSize * modelSize; }
+  bool diverged(double modelSize) const { return hasDiverged(largestCoordinate, modelSize); }
 };
 
 /// Records the outputs of one run of a system.

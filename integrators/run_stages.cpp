@@ -248,7 +248,7 @@ void integrateOutputs(const RunContext& ctx, RunState& state, OutputRecorder& re
 // --- diagnose ----------------------------------------------------------------------
 
 std::string divergenceReport(double largest, double modelSize, double t) {
-  if (!(largest > kDivergedSize * modelSize)) return "";
+  if (!hasDiverged(largest, modelSize)) return "";
   std::ostringstream os;
   os.precision(3);
   os << "; the solution diverged: a coordinate reached " << largest << " at t = " << formatTime(t) << ", "
