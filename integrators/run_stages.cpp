@@ -148,8 +148,8 @@ double defaultMinStepSize(const SolverSettings& settings) {
   return std::min(kDefaultMinStepFraction * (settings.tEnd - settings.tStart), kDefaultMinStepSeconds);
 }
 
-IntegratorChoice chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings) {
-  IntegratorChoice choice;
+ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings) {
+  ChosenIntegrator choice;
   choice.kind = settings.integrator;
   IntegratorOptions& o = choice.options;
   o.rtol = settings.rtol;
@@ -333,7 +333,7 @@ SimulationSummary summaryAtStart(const RunStart& start, const RecordedOutputs& o
   return s;
 }
 
-SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& outputs, const IntegratorChoice& choice,
+SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& outputs, const ChosenIntegrator& choice,
                                 const RunState& state, const std::optional<RunFailure>& failure, double span) {
   SimulationSummary s = summaryOfOutputs(start, outputs);
   s.usedKlu = state.usedKlu;

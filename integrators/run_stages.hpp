@@ -59,8 +59,8 @@ std::optional<RunFailure> recordInitialOutput(OutputRecorder& recorder, const Da
 
 // --- choose ------------------------------------------------------------------------
 
-/// The integrator's options for a run, and why its BDF order is limited.
-struct IntegratorChoice {
+/// The integrator a run starts with, its options, and why its BDF order is limited.
+struct ChosenIntegrator {
   IntegratorKind kind = IntegratorKind::Ida;  ///< the integrator the run starts with (settings.integrator)
   IntegratorOptions options;
   std::string orderLimit;  ///< why options.maxOrder is below settings.maxOrder ("" if it is not)
@@ -70,7 +70,7 @@ struct IntegratorChoice {
 /// order lowered where damped elastic modes lie outside the stable sectors of BDF4/5
 /// (GGL and index 3; stableBdfOrder), min_step (default defaultMinStepSize).
 /// @pre settings validated; dae built on sys.
-IntegratorChoice chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings);
+ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings);
 
 /// Default min_step: 1e-12 of the span, at most 1e-12 s.
 double defaultMinStepSize(const SolverSettings& settings);
@@ -154,7 +154,7 @@ SimulationSummary summaryAtStart(const RunStart& start, const RecordedOutputs& o
 /// and warnings of constraint violations beyond 1e-3 of the model size (positions) or of
 /// the velocity scale (velocities: the largest speed output, at least the model size
 /// over the span). cpuSeconds is left to the caller.
-SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& outputs, const IntegratorChoice& choice,
+SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& outputs, const ChosenIntegrator& choice,
                                 const RunState& state, const std::optional<RunFailure>& failure, double span);
 
 }  // namespace flexmbd

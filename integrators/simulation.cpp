@@ -154,7 +154,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   }
 
   // choose
-  const IntegratorChoice choice = chooseIntegratorOptions(sys, dae, settings);
+  const ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings);
   const RunContext ctx{sys,
                        dae,
                        settings,

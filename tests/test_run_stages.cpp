@@ -222,7 +222,7 @@ TEST(ChooseIntegratorOptions, DampedRodLimitsIdasOrderOnlyForGglAndIndex3) {
   Scene s = testmodels::elasticSliderCrank(4, 1.0, 0, 2.0, 1e-7, 1e-10, 3.1e-5);
   {
     const DaeSystem dae(s.system, s.solver.formulation);
-    const IntegratorChoice c = chooseIntegratorOptions(s.system, dae, s.solver);
+    const ChosenIntegrator c = chooseIntegratorOptions(s.system, dae, s.solver);
     EXPECT_EQ(c.kind, IntegratorKind::Ida);
     EXPECT_EQ(c.options.maxOrder, 3);
     EXPECT_EQ(c.orderLimit, stableBdfOrder(s.system, 5).reason());
@@ -232,7 +232,7 @@ TEST(ChooseIntegratorOptions, DampedRodLimitsIdasOrderOnlyForGglAndIndex3) {
   s.solver.formulation = Formulation::Index1;
   {
     const DaeSystem dae(s.system, s.solver.formulation);
-    const IntegratorChoice c = chooseIntegratorOptions(s.system, dae, s.solver);
+    const ChosenIntegrator c = chooseIntegratorOptions(s.system, dae, s.solver);
     EXPECT_EQ(c.options.maxOrder, 5);
     EXPECT_EQ(c.orderLimit, "");
   }
@@ -319,7 +319,7 @@ TEST(FinishSummary, WarnsOfViolationsAboveAThousandthOfTheScale) {
   RecordedOutputs outputs;
   outputs.maxPositionViolation = 1e-3;  // at the threshold: no warning
   outputs.maxVelocityViolation = 2e-4;  // velocity scale max(0 speed, 1 m / 10 s) = 0.1: threshold 1e-4
-  const IntegratorChoice choice;
+  const ChosenIntegrator choice;
   const RunState state;
   SimulationSummary s = finishSummary(start, outputs, choice, state, std::nullopt, 10.0);
   EXPECT_TRUE(s.ok);
