@@ -226,12 +226,13 @@ std::string divergenceReport(double largest, double modelSize, double t) {
 /// violation of 1.87 m, status ok).
 constexpr double kMaxRelativeTolerance = 1e-2;
 /// Finest tolerances accepted: rtol 1e-14 (about 50 round-offs, IDA cannot meet less);
-/// absolute ones 1e-15 of the model size (positions of the size carry round-off of 1e-16
-/// of it): finer ones cannot be met and only make IDA shrink its step until max_steps.
+/// atol 1e-15 of the model size (positions of the size carry round-off of 1e-16 of it):
+/// finer ones cannot be met and only make IDA shrink its step until max_steps. The class
+/// tolerances are raised to their floors instead (classTolerances).
 /// Velocity tolerances have no floor: their scale is the model's time scale, not known
 /// here (slow modes of stiff chains use atol_velocity 1e-16, tests/test_stability.cpp).
 constexpr double kMinRelativeTolerance = 1e-14;
-constexpr double kMinToleranceFractionOfSize = 1e-15;
+constexpr double kMinToleranceFractionOfSize = kRoundOffFractionOfSize;
 constexpr double kMaxToleranceFractionOfSize = 1e-2;
 constexpr double kMaxAngleTolerance = 1e-2;
 /// Warning thresholds: position constraint violation above 1e-3 of the model size,
@@ -256,22 +257,17 @@ void checkTolerancesForModel(const SolverSettings& s, double L) {
   check(s.rtol >= kMinRelativeTolerance, "rtol", "at least 1e-14 (finer is below round-off)", s.rtol);
   const double minAbs = kMinToleranceFractionOfSize * L;
   const std::string fineBound = "at least 1e-15 of the model size " + num(L) + " (finer is below round-off)";
-  for (const auto& [key, value] : {std::pair<const char*, std::optional<double>>{"atol", s.atol},
-                                   {"atol_elastic", s.atolElastic}, {"atol_angle", s.atolAngle}}) {
-    if (value) check(*value >= (std::string(key) == "atol_angle" ? kMinToleranceFractionOfSize : minAbs), key,
-                     std::string(key) == "atol_angle" ? "at least 1e-15 rad (finer is below round-off)" : fineBound,
-                     *value);
-  }
+  // finer atol_angle, atol_elastic (a scene's ratio scaled by --atol) are raised to the floor (classTolerances)
+  check(s.atol >= minAbs, "atol", fineBound, s.atol);
   const double maxLength = kMaxToleranceFractionOfSize * L;
   const std::string lengthBound = "at most 1e-2 of the model size " + num(L) + ": " + num(maxLength) +
                                   " (coarser cannot resolve the motion)";
   check(s.atol <= maxLength, "atol", lengthBound, s.atol);
   if (s.atolElastic) check(*s.atolElastic <= maxLength, "atol_elastic", lengthBound, *s.atolElastic);
+  // unset, atol_angle is atol / L <= 1e-2 rad by the bound on atol above
   if (s.atolAngle) {
     check(*s.atolAngle <= kMaxAngleTolerance, "atol_angle", "at most 1e-2 rad (coarser cannot resolve the motion)",
           *s.atolAngle);
-  } else {
-    check(s.atol <= kMaxAngleTolerance, "atol", "at most 1e-2 (it is also the tolerance of angles, in rad)", s.atol);
   }
 }
 
@@ -373,25 +369,8 @@ void SolverSettings::validate() const {
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
 }
 
-/// Multipliers: large, so that the algebraic variables (already out of the error test)
-/// stay out of the Newton convergence test too.
-constexpr double kAtolMultiplier = 1e10;
-
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
-  const DaeLayout& L = dae.layout();
-  const System& sys = dae.system();
-  const double position = settings.atol;
-  const double angle = settings.atolAngle.value_or(position);
-  const double elastic = settings.atolElastic.value_or(position);
-  const double velocityRatio = settings.atolVelocity.value_or(position) / position;
-  const auto ofKind = [&](CoordinateKind kind) {
-    return kind == CoordinateKind::Position ? position : kind == CoordinateKind::Angle ? angle : elastic;
-  };
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds(), vkinds = sys.velocityKinds();
-  VecX atol = VecX::Constant(L.size, kAtolMultiplier);
-  for (int k = 0; k < L.nq; ++k) atol[L.q + k] = ofKind(kinds[k]);
-  for (int k = 0; k < L.nv; ++k) atol[L.v + k] = ofKind(vkinds[k]) * velocityRatio;
-  return atol;
+  return absoluteTolerances(dae, classTolerances(settings, modelScales(dae.system(), settings)));
 }
 
 SimulationSummary simulate(const System& sys, const SolverSettings& settings,
@@ -491,9 +470,11 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     return summary;
   }
 
+  summary.scales = modelScales(sys, init.v, t0, tEnd);
+  summary.tolerances = classTolerances(settings, summary.scales);
   IntegratorOptions o;
   o.rtol = settings.rtol;
-  o.atol = absoluteTolerances(dae, settings);
+  o.atol = absoluteTolerances(dae, summary.tolerances);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
