@@ -229,8 +229,9 @@ constexpr double kMaxRelativeTolerance = 1e-2;
 /// atol 1e-15 of the model size (positions of the size carry round-off of 1e-16 of it):
 /// finer ones cannot be met and only make IDA shrink its step until max_steps. The class
 /// tolerances are raised to their floors instead (classTolerances).
-/// Velocity tolerances have no floor: their scale is the model's time scale, not known
-/// here (slow modes of stiff chains use atol_velocity 1e-16, tests/test_stability.cpp).
+/// Velocity tolerances are not refused: their floor, 1e-15 of the model's speed scale, is
+/// applied by classTolerances (slow modes of stiff chains use atol_velocity 1e-16,
+/// tests/test_stability.cpp).
 constexpr double kMinRelativeTolerance = 1e-14;
 constexpr double kMinToleranceFractionOfSize = kRoundOffFractionOfSize;
 constexpr double kMaxToleranceFractionOfSize = 1e-2;

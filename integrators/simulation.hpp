@@ -20,8 +20,8 @@ struct SolverSettings {
   double rtol = 1e-8;
   /// Absolute tolerances by coordinate class (integrators/tolerances.hpp): frame
   /// positions (m); unset classes default relative to atol and the model's sizes
-  /// (classTolerances): angles atol / L, velocities atol / T, elastic coordinates
-  /// atol s_e / L; velocities of angles and elastic coordinates: their class's tolerance
+  /// (classTolerances): angles atol / L, velocities atol / (1 s), elastic coordinates
+  /// atol; velocities of angles and elastic coordinates: their class's tolerance
   /// times atolVelocity / atol. overrideTolerances changes rtol/atol keeping the ratios.
   double atol = 1e-10;
   std::optional<double> atolVelocity;

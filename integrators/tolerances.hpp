@@ -20,10 +20,16 @@ struct ModelScales {
   /// V0 (m/s): largest speed at the start: frame speeds, angular rates times L, the speed
   /// sqrt(|g| L) of a fall through L; at least L / (t_end - t_start).
   double speed = 1.0;
-  double timeScale = 1.0;  ///< T = L / V0 (s), at most t_end - t_start
+  double timeScale = 1.0;  ///< T = L / V0 (s), at most t_end - t_start (reported: the default velocity tolerance uses 1 s, tolerances.cpp)
   /// s_e (m): the largest over the flexible bodies of the mass-weighted RMS deflection
   /// of their lowest elastic mode under the acceleration L / T^2, quasi-statically:
-  /// (L / T^2) / omega_1^2. 0 for a model without elastic coordinates.
+  /// (L / T^2) / omega_1^2. 0 for a model without elastic coordinates (or without
+  /// elastic matrices: spatial flexible bodies). The scale of the elastic round-off floor
+  /// and a guide for atol_elastic (about rtol times the coordinates' expected size); not
+  /// the default's scale: atol s_e / L falls like 1 / E on a stiffening rod, and the
+  /// modal crank's steps grew from 1,988 to 21,223 from E x 1 to E x 1e4
+  /// (tests/test_stability.cpp, StiffRod), where atol keeps them flat; on Simeon's crank
+  /// s_e = 6.2e-3 m overestimates the deflections (2e-4 m and less) 30 to 1000 times.
   double elasticSize = 0.0;
   std::string elasticBody;  ///< the body of s_e ("" if none)
   double lowestFrequency = 0.0;  ///< its omega_1 (rad/s), 0 if none
@@ -68,9 +74,9 @@ inline constexpr double kRoundOffFractionOfSpeed = 1e-15;
 /// Effective tolerances of `s` for a model of scales `m`: the classes `s` sets as given,
 /// the others by default relative to atol and the model's sizes:
 ///   angle    = atol / L             (a rotation that moves a point at distance L by atol)
-///   velocity = atol / T             (a speed error that moves it by atol within T)
-///   elastic  = atol * s_e / L       (the relative accuracy of the frame positions for a
-///              deflection of size s_e), at most atol; atol without elastic coordinates;
+///   velocity = atol / (1 s)         (a speed error that moves it by atol within 1 s)
+///   elastic  = atol                 (a nodal or modal coordinate moves material points by
+///              its own value; see ModelScales::elasticSize for why not atol s_e / L);
 /// angular and elastic rates: angle and elastic times velocity / atol. Each raised to
 /// its round-off floor.
 ClassTolerances classTolerances(const SolverSettings& s, const ModelScales& m);

@@ -33,7 +33,10 @@ double engineDigits(Formulation f, IntegratorKind integrator, double tol) {
   Scene s = bariScene();
   s.solver.formulation = f;
   s.solver.integrator = integrator;
+  // as the classic codes' runs: rtol = atol = tol for positions, angles and velocities
+  // (set: the angles' default is atol / L since issue 24), elastic coordinates 1e-3 tol
   s.solver.rtol = s.solver.atol = tol;
+  s.solver.atolAngle = s.solver.atolVelocity = tol;
   s.solver.atolElastic = 1e-3 * tol;
   s.solver.outputStep = bari::kEndTime;
   s.solver.progress = false;

@@ -35,16 +35,19 @@ Result runSliderCrank(Formulation f, double tEnd) {
 
 TEST(Formulations, AllThreeAgreeOnTheRigidSliderCrank) {
   // Each formulation at rtol 1e-8 over one revolution. Positions are in the error test
-  // of all three: they agree with the closed form to 1e-6 (100 rtol, allowing for the
-  // index-1 drift). Index 3 keeps the velocities out of the error test (they are
-  // index-2 variables there), so its velocities are only ~1e-5 accurate.
+  // of all three: GGL and index 3 agree with the closed form to 1e-6 (100 rtol). Index 1
+  // drifts (nothing pulls g back to 0): its error follows the drift max |g|, 1.0e-6 to
+  // 1.1e-6 here, which depends on the step sequence (slider error 2.2e-7 with
+  // atol_angle = atol, 1.08e-6 with the default atol / L since issue 24, |g| 1.02e-6 and
+  // 1.11e-6): 2e-6 for it.
   constexpr double kPositionTolerance = 1e-6;
+  constexpr double kPositionToleranceIndex1 = 2e-6;
   constexpr double kVelocityToleranceIndex2Or1 = 1e-6;
   constexpr double kVelocityToleranceIndex3 = 1e-4;
   for (Formulation f : {Formulation::Ggl, Formulation::Index3, Formulation::Index1}) {
     const Result r = runSliderCrank(f, 2 * M_PI);
     ASSERT_TRUE(r.summary.ok) << toString(f) << ": " << r.summary.message;
-    EXPECT_LT(r.maxPosError, kPositionTolerance) << toString(f);
+    EXPECT_LT(r.maxPosError, f == Formulation::Index1 ? kPositionToleranceIndex1 : kPositionTolerance) << toString(f);
     EXPECT_LT(r.maxVelError, f == Formulation::Index3 ? kVelocityToleranceIndex3 : kVelocityToleranceIndex2Or1)
         << toString(f);
     std::printf("[ measured ] %-6s steps %5ld  |x - x_exact| %.2e  |v - v_exact| %.2e  |g| %.2e  |Gv+gt| %.2e\n",

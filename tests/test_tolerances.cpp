@@ -91,8 +91,8 @@ TEST(Tolerances, DefaultsFollowTheModelsSizes) {
   const ClassTolerances t = classTolerances(settings, m);
   EXPECT_EQ(t.position, 1e-8);
   EXPECT_DOUBLE_EQ(t.angle, 1e-8 / kL);
-  EXPECT_DOUBLE_EQ(t.velocity, 1e-8 / m.timeScale);
-  EXPECT_DOUBLE_EQ(t.elastic, 1e-8 * m.elasticSize / kL);
+  EXPECT_DOUBLE_EQ(t.velocity, 1e-8);  // atol per second
+  EXPECT_EQ(t.elastic, 1e-8);  // a nodal or modal coordinate is a length (tolerances.hpp)
   EXPECT_DOUBLE_EQ(t.angularVelocity, t.angle * t.velocity / t.position);
   EXPECT_DOUBLE_EQ(t.elasticVelocity, t.elastic * t.velocity / t.position);
   // the scene's own keys stand as given
@@ -145,24 +145,18 @@ TEST(Tolerances, ClassTolerancesStopAtTheirRoundOffFloors) {
 TEST(Tolerances, TighterTolerancesGiveMoreAccurateElasticCoordinates) {
   // The rod's elastic coordinates q1..q4 (1e-5 to 2e-4) against the published reference
   // at t = 0.1, rtol 1e-5, 1e-7, 1e-9 with atol = rtol / 100 set as the command line
-  // does. With the scene's atol_elastic (scaled with atol) each 100-fold tightening must
-  // gain at least one digit: measured 3.07, 4.51, 6.21 (gains 1.4, 1.7); before the
-  // override scaled atol_elastic the gains were 0.3 and 0.15 (the class stayed at the
-  // scene's 1e-9). With the default atol_elastic (atol s_e / L: s_e overestimates this
-  // rod's deflections 30 to 1000 times, so it is looser) at least 0.3 digits: measured
-  // 3.13, 3.76, 5.42 (gains 0.6, 1.7).
-  for (const bool sceneKey : {true, false}) {
-    Scene scene = loadScene(kBari);
-    if (!sceneKey) scene.solver.atolElastic.reset();
-    const double minGainPer100x = sceneKey ? 1.0 : 0.3;
-    double previous = -1.0;
-    for (double rtol : {1e-5, 1e-7, 1e-9}) {
-      const double digits = elasticDigits(runBari(scene, rtol, rtol / 100));
-      std::printf("[ measured ] atol_elastic %s, rtol %.0e: elastic digits %.2f\n",
-                  sceneKey ? "of the scene" : "default", rtol, digits);
-      if (previous >= 0.0) EXPECT_GT(digits, previous + minGainPer100x) << "rtol " << rtol;
-      previous = digits;
-    }
+  // does (the scene's atol_elastic, 1e-3 atol, scaled with atol). Each 100-fold
+  // tightening must gain at least one digit: measured 3.07, 4.51, 6.21 (gains 1.4, 1.7).
+  // Before the override scaled atol_elastic the gains were 0.3 and 0.15: the class
+  // stayed at the scene's 1e-9.
+  constexpr double kMinDigitsPer100x = 1.0;
+  const Scene scene = loadScene(kBari);
+  double previous = -1.0;
+  for (double rtol : {1e-5, 1e-7, 1e-9}) {
+    const double digits = elasticDigits(runBari(scene, rtol, rtol / 100));
+    std::printf("[ measured ] rtol %.0e, atol rtol / 100: elastic digits %.2f\n", rtol, digits);
+    if (previous >= 0.0) EXPECT_GT(digits, previous + kMinDigitsPer100x) << "rtol " << rtol;
+    previous = digits;
   }
 }
 
@@ -181,8 +175,8 @@ TEST_F(Cli, AtolScalesTheScenesElasticTolerance) {
     const auto t = effective(options);
     EXPECT_DOUBLE_EQ(t.at("position").get<double>(), 1e-8) << options;
     EXPECT_DOUBLE_EQ(t.at("elastic").get<double>(), 1e-11) << options;
-    // unset in the scene: atol / T and atol / L
-    EXPECT_DOUBLE_EQ(t.at("velocity").get<double>(), 1e-8 / t.at("time_scale").get<double>()) << options;
+    // unset in the scene: atol per second and atol / L
+    EXPECT_DOUBLE_EQ(t.at("velocity").get<double>(), 1e-8) << options;
     EXPECT_DOUBLE_EQ(t.at("angle").get<double>(), 1e-8 / t.at("length_scale").get<double>()) << options;
   }
   EXPECT_DOUBLE_EQ(effective("--rtol 1e-8").at("rtol").get<double>(), 1e-8);
