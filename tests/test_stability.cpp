@@ -130,6 +130,9 @@ constexpr double kSweepRtol = 1e-6, kSweepAtol = 1e-8, kSweepAtolVelocity = 1e-2
 /// at order 5, which since the GGL stabilisation leaves the elastic coordinates alone
 /// takes 131 steps at E x 1e4 instead of 173,541).
 constexpr double kAtTolerance = 3e-6;
+/// At BDF order 5 and E x 1e4: 2.1e-6 with atol_angle = atol, 4.0e-6 since the angles'
+/// default is atol / L (2.2 atol for this 0.45 m model; issue 24): still a few rtol.
+constexpr double kAtToleranceOrder5 = 6e-6;
 /// With BDF2 (A-stable) the step size is set by the crank motion, which does not depend
 /// on E; the start-up transient is resolved once. Allow a factor 1.5 for step-size
 /// heuristics between the runs of the sweep (measured: steps fall as E grows).
@@ -168,7 +171,7 @@ TEST(StiffRod, NodalRodWithAxialModesTo1e7RadPerSecondApproachesTheRigidSliderCr
     std::printf("[ measured ] nodal 2 el., max order 5, E x %.0e: slider error vs rigid %.3e, %ld steps, %.2f s\n",
                 e, r.sliderError, r.steps, r.seconds);
     ASSERT_TRUE(r.ok) << r.message;
-    if (e > 1) EXPECT_LT(r.sliderError, kAtTolerance);
+    if (e > 1) EXPECT_LT(r.sliderError, kAtToleranceOrder5);
   }
 }
 
