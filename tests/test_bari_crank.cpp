@@ -37,8 +37,8 @@ double engineDigits(Formulation f, IntegratorKind integrator, double tol, std::o
   // as the classic codes' runs: rtol = atol = tol for positions, angles and velocities
   // (set: the angles' default is atol / L since issue 24), elastic coordinates 1e-3 atol
   s.solver.rtol = tol;
-  s.solver.atol = s.solver.atolVelocity = atol.value_or(tol);
-  s.solver.atolAngle = s.solver.atol;
+  s.solver.atol = atol.value_or(tol);
+  s.solver.atolAngle = s.solver.atolVelocity = s.solver.atol;
   s.solver.atolElastic = 1e-3 * s.solver.atol;
   s.solver.outputStep = bari::kEndTime;
   s.solver.progress = false;
