@@ -65,9 +65,15 @@ const char* const kUsage =
     "options of run:\n"
     "  --out DIR    output directory (created if needed; required)\n"
     "  --t-end T    end time, overrides solver.t_end of the scene\n"
-    "  --rtol R     relative tolerance, overrides solver.rtol\n"
-    "  --atol A     absolute tolerance of positions, overrides solver.atol (and of\n"
-    "               velocities too unless the scene sets solver.atol_velocity)\n"
+    "  --rtol R     relative tolerance, overrides solver.rtol; without --atol it also\n"
+    "               scales every absolute tolerance by R / solver.rtol\n"
+    "  --atol A     absolute tolerance of frame positions (m), overrides solver.atol and\n"
+    "               scales the class tolerances the scene sets (atol_angle, atol_elastic,\n"
+    "               atol_velocity) by A / solver.atol; unset classes follow atol by their\n"
+    "               defaults: angles atol (in rad), velocities atol per second,\n"
+    "               elastic coordinates atol (docs/scene-format.md).\n"
+    "               So tightening either tightens every output; summary.json lists the\n"
+    "               tolerances used under \"tolerances\"\n"
     "  --format F   results file: csv (default, DIR/results.csv) or hdf5 (DIR/results.h5:\n"
     "               dataset /results, rows x columns, and /columns, the CSV header names)\n"
     "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView;\n"
@@ -224,8 +230,7 @@ int runCommand(const Options& o) {
       }
       s.tEnd = *o.tEnd;
     }
-    if (o.rtol) s.rtol = *o.rtol;
-    if (o.atol) s.atol = *o.atol;
+    overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (integrators/tolerances.hpp)
     s.progress = !o.quiet;
     checkSolverSettings(s);
   } catch (const std::exception& e) {

@@ -148,12 +148,15 @@ double defaultMinStepSize(const SolverSettings& settings) {
   return std::min(kDefaultMinStepFraction * (settings.tEnd - settings.tStart), kDefaultMinStepSeconds);
 }
 
-ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings) {
+ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings,
+                                         const ModelScales* scales) {
   ChosenIntegrator choice;
   choice.kind = settings.integrator;
+  choice.scales = scales ? *scales : modelScales(sys, settings);
+  choice.tolerances = classTolerances(settings, choice.scales);
   IntegratorOptions& o = choice.options;
   o.rtol = settings.rtol;
-  o.atol = absoluteTolerances(dae, settings);
+  o.atol = absoluteTolerances(dae, choice.tolerances);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
@@ -339,6 +342,8 @@ SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& ou
   s.usedKlu = state.usedKlu;
   s.maxOrder = choice.options.maxOrder;
   s.orderLimit = choice.orderLimit;
+  s.scales = choice.scales;
+  s.tolerances = choice.tolerances;
   s.integratorSwitch = state.integratorSwitch;
   s.singularCrossings = state.crossings;
   s.stats = state.totalStats();

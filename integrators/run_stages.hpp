@@ -15,6 +15,7 @@
 #include "integrators/initial_conditions.hpp"
 #include "integrators/output_recorder.hpp"
 #include "integrators/run_state.hpp"
+#include "integrators/tolerances.hpp"
 
 namespace flexmbd {
 
@@ -64,13 +65,18 @@ struct ChosenIntegrator {
   IntegratorKind kind = IntegratorKind::Ida;  ///< the integrator the run starts with (settings.integrator)
   IntegratorOptions options;
   std::string orderLimit;  ///< why options.maxOrder is below settings.maxOrder ("" if it is not)
+  ModelScales scales;          ///< the model's sizes the default class tolerances follow
+  ClassTolerances tolerances;  ///< the absolute tolerances by coordinate class (options.atol)
 };
 
 /// Stage "choose": tolerances by coordinate class (absoluteTolerances), IDA's highest BDF
 /// order lowered where damped elastic modes lie outside the stable sectors of BDF4/5
 /// (GGL and index 3; stableBdfOrder), min_step (default defaultMinStepSize).
 /// @pre settings validated; dae built on sys.
-ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings);
+/// `scales`: the model's scales at the consistent initial state (modelScales(sys, v0, t0,
+/// t_end)); null: modelScales(sys, settings), at the scene's initial velocities.
+ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings,
+                                         const ModelScales* scales = nullptr);
 
 /// Default min_step: 1e-12 of the span, at most 1e-12 s.
 double defaultMinStepSize(const SolverSettings& settings);

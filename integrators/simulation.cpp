@@ -30,12 +30,14 @@ void requireSetting(bool ok, const std::string& key, const std::string& expected
 /// violation of 1.87 m, status ok).
 constexpr double kMaxRelativeTolerance = 1e-2;
 /// Finest tolerances accepted: rtol 1e-14 (about 50 round-offs, IDA cannot meet less);
-/// absolute ones 1e-15 of the model size (positions of the size carry round-off of 1e-16
-/// of it): finer ones cannot be met and only make IDA shrink its step until max_steps.
-/// Velocity tolerances have no floor: their scale is the model's time scale, not known
-/// here (slow modes of stiff chains use atol_velocity 1e-16, tests/test_stability.cpp).
+/// atol 1e-15 of the model size (positions of the size carry round-off of 1e-16 of it):
+/// finer ones cannot be met and only make IDA shrink its step until max_steps. The class
+/// tolerances are raised to their floors instead (classTolerances).
+/// Velocity tolerances are not refused: their floor, 1e-15 of the model's speed scale, is
+/// applied by classTolerances (slow modes of stiff chains use atol_velocity 1e-16,
+/// tests/test_stability.cpp).
 constexpr double kMinRelativeTolerance = 1e-14;
-constexpr double kMinToleranceFractionOfSize = 1e-15;
+constexpr double kMinToleranceFractionOfSize = kRoundOffFractionOfSize;
 constexpr double kMaxToleranceFractionOfSize = 1e-2;
 constexpr double kMaxAngleTolerance = 1e-2;
 
@@ -48,12 +50,8 @@ void checkTolerancesForModel(const SolverSettings& s, double L) {
   check(s.rtol >= kMinRelativeTolerance, "rtol", "at least 1e-14 (finer is below round-off)", s.rtol);
   const double minAbs = kMinToleranceFractionOfSize * L;
   const std::string fineBound = "at least 1e-15 of the model size " + formatValue(L) + " (finer is below round-off)";
-  for (const auto& [key, value] : {std::pair<const char*, std::optional<double>>{"atol", s.atol},
-                                   {"atol_elastic", s.atolElastic}, {"atol_angle", s.atolAngle}}) {
-    if (value) check(*value >= (std::string(key) == "atol_angle" ? kMinToleranceFractionOfSize : minAbs), key,
-                     std::string(key) == "atol_angle" ? "at least 1e-15 rad (finer is below round-off)" : fineBound,
-                     *value);
-  }
+  // finer atol_angle, atol_elastic (a scene's ratio scaled by --atol) are raised to the floor (classTolerances)
+  check(s.atol >= minAbs, "atol", fineBound, s.atol);
   const double maxLength = kMaxToleranceFractionOfSize * L;
   const std::string lengthBound = "at most 1e-2 of the model size " + formatValue(L) + ": " + formatValue(maxLength) +
                                   " (coarser cannot resolve the motion)";
@@ -112,25 +110,8 @@ void SolverSettings::validate() const {
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
 }
 
-/// Multipliers: large, so that the algebraic variables (already out of the error test)
-/// stay out of the Newton convergence test too.
-constexpr double kAtolMultiplier = 1e10;
-
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
-  const DaeLayout& L = dae.layout();
-  const System& sys = dae.system();
-  const double position = settings.atol;
-  const double angle = settings.atolAngle.value_or(position);
-  const double elastic = settings.atolElastic.value_or(position);
-  const double velocityRatio = settings.atolVelocity.value_or(position) / position;
-  const auto ofKind = [&](CoordinateKind kind) {
-    return kind == CoordinateKind::Position ? position : kind == CoordinateKind::Angle ? angle : elastic;
-  };
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds(), vkinds = sys.velocityKinds();
-  VecX atol = VecX::Constant(L.size, kAtolMultiplier);
-  for (int k = 0; k < L.nq; ++k) atol[L.q + k] = ofKind(kinds[k]);
-  for (int k = 0; k < L.nv; ++k) atol[L.v + k] = ofKind(vkinds[k]) * velocityRatio;
-  return atol;
+  return absoluteTolerances(dae, classTolerances(settings, modelScales(dae.system(), settings)));
 }
 
 // The pipeline of a run: start, choose, integrate (handing over, crossing), diagnose,
@@ -153,8 +134,9 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     return summaryAtStart(start, recorder.recorded(), *stop);
   }
 
-  // choose
-  const ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings);
+  // choose: the tolerances by coordinate class from the model's scales at the start
+  const ModelScales scales = modelScales(sys, init.v, t0, tEnd);
+  const ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings, &scales);
   const RunContext ctx{sys,
                        dae,
                        settings,

@@ -10,6 +10,7 @@
 
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
+#include "integrators/tolerances.hpp"
 
 namespace flexmbd {
 
@@ -17,10 +18,11 @@ struct SolverSettings {
   Formulation formulation = Formulation::Ggl;
   IntegratorKind integrator = IntegratorKind::Ida;
   double rtol = 1e-8;
-  /// Absolute tolerances by coordinate class (see absoluteTolerances): frame positions;
-  /// angles (default atol); elastic coordinates (default atol: a nodal or modal
-  /// coordinate moves material points by its own value); velocities of each class: its
-  /// position tolerance times atolVelocity / atol (atolVelocity defaults to atol).
+  /// Absolute tolerances by coordinate class (integrators/tolerances.hpp): frame
+  /// positions (m); unset classes default relative to atol and the model's sizes
+  /// (classTolerances): angles atol / L, velocities atol / (1 s), elastic coordinates
+  /// atol; velocities of angles and elastic coordinates: their class's tolerance
+  /// times atolVelocity / atol. overrideTolerances changes rtol/atol keeping the ratios.
   double atol = 1e-10;
   std::optional<double> atolVelocity;
   std::optional<double> atolAngle;
@@ -50,7 +52,8 @@ struct SolverSettings {
 };
 
 /// Absolute tolerance of every unknown of the DAE for these settings: per coordinate
-/// class (frame positions, angles, elastic coordinates) and their velocities;
+/// class (frame positions, angles, elastic coordinates) and their velocities, the
+/// defaults from the model's scales at its consistent initial state (classTolerances);
 /// multipliers out of the error and convergence tests.
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings);
 
@@ -95,6 +98,8 @@ struct SimulationSummary {
   std::string orderLimit;        ///< why it is below the settings' max_order ("" if it is not)
   int initialPositionIterations = 0;
   double modelSize = 1.0;        ///< System::characteristicLength(): the scale of the warnings
+  ModelScales scales;            ///< the model's sizes the default class tolerances follow
+  ClassTolerances tolerances;    ///< the tolerances the run used, by coordinate class
   std::vector<InitialCorrection> initialCorrections;  ///< bodies the initialisation moved
   /// Results that may not mean what they seem: large initial corrections, constraint
   /// violations beyond a fraction of the model size (one line each).

@@ -300,6 +300,28 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
 
 namespace {
 
+/// The tolerances the run used per coordinate class and the model scales their defaults
+/// follow (null before the run computed them: a failed initialisation).
+nlohmann::ordered_json tolerancesObject(const SimulationSummary& summary) {
+  const ClassTolerances& t = summary.tolerances;
+  if (!(t.position > 0.0)) return nullptr;
+  const ModelScales& m = summary.scales;
+  nlohmann::ordered_json j;
+  j["rtol"] = t.rtol;
+  j["position"] = t.position;
+  j["angle"] = t.angle;
+  j["elastic"] = t.elastic;
+  j["velocity"] = t.velocity;
+  j["angular_velocity"] = t.angularVelocity;
+  j["elastic_velocity"] = t.elasticVelocity;
+  j["length_scale"] = m.length;
+  j["time_scale"] = m.timeScale;
+  j["elastic_size"] = m.elasticSize;
+  j["elastic_body"] = m.elasticBody.empty() ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(m.elasticBody);
+  j["lowest_elastic_frequency"] = m.lowestFrequency;
+  return j;
+}
+
 nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Scene& scene) {
   const SolverSettings& s = scene.solver;
   const IntegratorStats& st = summary.stats;
@@ -353,7 +375,9 @@ nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Sce
   j["order_limit"] = summary.orderLimit.empty() ? nlohmann::json() : nlohmann::json(summary.orderLimit);
   j["rtol"] = s.rtol;
   j["atol"] = s.atol;
-  j["atol_velocity"] = s.atolVelocity ? *s.atolVelocity : s.atol;
+  j["atol_velocity"] = summary.tolerances.position > 0.0 ? summary.tolerances.velocity
+                                                          : s.atolVelocity.value_or(s.atol);
+  j["tolerances"] = tolerancesObject(summary);
   j["t_start"] = s.tStart;
   j["t_end"] = s.tEnd;
   j["output_step"] = s.outputStep;

@@ -128,7 +128,9 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
 /// error_test_failures, linear_setups, last_step_size, initial_position_iterations,
 /// cpu_seconds, max_position_violation, max_velocity_violation, energy_start and
 /// energy_end (null when absent), formulation, linear_solver ("dense"/"klu"), rtol,
-/// atol, atol_velocity, t_start, t_end, output_step, scene (the scene name).
+/// atol, atol_velocity (the one used), tolerances (per class and the model scales of
+/// their defaults, SimulationSummary::tolerances and ::scales; null if the run failed
+/// before it started), t_start, t_end, output_step, scene (the scene name).
 /// Creates `dir` if needed; the file is replaced atomically (written beside, renamed).
 void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene);
 

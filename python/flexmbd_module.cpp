@@ -317,6 +317,18 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def(py::init<>())
       .def_readwrite("rtol", &SolverSettings::rtol)
       .def_readwrite("atol", &SolverSettings::atol)
+      // class tolerances: None = the default relative to atol and the model's sizes
+      .def_readwrite("atol_angle", &SolverSettings::atolAngle)
+      .def_readwrite("atol_elastic", &SolverSettings::atolElastic)
+      .def_readwrite("atol_velocity", &SolverSettings::atolVelocity)
+      .def(
+          "override_tolerances",
+          [](SolverSettings& s, std::optional<double> rtol, std::optional<double> atol) {
+            overrideTolerances(s, rtol, atol);
+          },
+          py::arg("rtol") = py::none(), py::arg("atol") = py::none(),
+          "rtol and/or atol as the command line's --rtol/--atol: every absolute tolerance set is scaled by "
+          "atol / self.atol (rtol alone: rtol / self.rtol), so the classes keep their ratios")
       .def_readwrite("t_start", &SolverSettings::tStart)
       .def_readwrite("t_end", &SolverSettings::tEnd)
       .def_readwrite("output_step", &SolverSettings::outputStep)

@@ -149,6 +149,8 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
         if (!(*o.tEnd > scene.massless.tStart)) throw InputError("option --t-end must be > t_start");
         scene.massless.tEnd = *o.tEnd;
       }
+      // --rtol alone scales atol by the same factor, as for multibody scenes (overrideTolerances)
+      if (o.rtol && !o.atol) scene.massless.cvode.atol *= *o.rtol / scene.massless.cvode.rtol;
       if (o.rtol) scene.massless.cvode.rtol = *o.rtol;
       if (o.atol) scene.massless.cvode.atol = *o.atol;
     }

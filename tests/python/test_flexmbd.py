@@ -242,3 +242,21 @@ def test_craig_bampton_rod_from_python_carries_the_axial_force():
     # pinned-pinned holds node 0's two translations and node 8's transverse one: the
     # interface keeps node 0's slope, node 8's axial displacement and slope (3 modes)
     assert cb.num_elastic == 3 + 2 and normal.num_elastic == 2
+
+
+def test_tolerance_overrides_scale_every_class_as_the_command_line():
+    # examples/bari_slider_crank.json sets atol 1e-6, atol_elastic 1e-9: override_tolerances
+    # (the command line's --atol) keeps their ratio; unset classes (None) follow atol by
+    # their defaults, which summary["tolerances"] lists with the model scales.
+    scene = flexmbd.load_scene(example("bari_slider_crank.json"), overrides={"solver.t_end": 0.001})
+    s = scene.solver
+    assert s.atol_elastic == 1e-9 and s.atol_angle is None and s.atol_velocity is None
+    s.override_tolerances(atol=1e-8)
+    assert s.atol == 1e-8 and math.isclose(s.atol_elastic, 1e-11, rel_tol=1e-12) and s.rtol == 1e-6
+    t = scene.run().summary["tolerances"]
+    assert math.isclose(t["elastic"], 1e-11, rel_tol=1e-12)
+    assert math.isclose(t["angle"], 1e-8 / t["length_scale"], rel_tol=1e-12)
+    assert math.isclose(t["velocity"], 1e-8, rel_tol=1e-12)  # atol per second
+    s.override_tolerances(rtol=1e-8)  # rtol alone: every absolute tolerance by the same factor
+    assert s.rtol == 1e-8 and math.isclose(s.atol, 1e-10, rel_tol=1e-12)
+    assert math.isclose(s.atol_elastic, 1e-13, rel_tol=1e-12)
