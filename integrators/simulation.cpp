@@ -18,6 +18,7 @@
 #include "integrators/augmented_lagrangian_integrator.hpp"
 #include "integrators/bdf_stability.hpp"
 #include "integrators/initial_conditions.hpp"
+#include "integrators/integrator_choice.hpp"
 
 namespace flexmbd {
 namespace {
@@ -33,8 +34,8 @@ void requireSetting(bool ok, const std::string& key, const std::string& expected
 /// Progress on stderr for runs longer than a few seconds, when stderr is a terminal.
 class ProgressReporter {
  public:
-  ProgressReporter(bool enabled, double t0, double tEnd)
-      : enabled_(enabled && isatty(STDERR_FILENO)), t0_(t0), tEnd_(tEnd),
+  ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator)
+      : enabled_(enabled && isatty(STDERR_FILENO)), t0_(t0), tEnd_(tEnd), integrator_(std::move(integrator)),
         start_(std::chrono::steady_clock::now()), last_(start_) {}
   void update(double t, long steps) {
     if (!enabled_) return;
@@ -43,7 +44,7 @@ class ProgressReporter {
     if (elapsed < 2.0 || std::chrono::duration<double>(now - last_).count() < 0.5) return;
     last_ = now;
     shown_ = true;
-    std::fprintf(stderr, "\r  t = %.6g / %.6g (%5.1f%%), %ld steps, %.0f steps/s   ", t, tEnd_,
+    std::fprintf(stderr, "\r  %s: t = %.6g / %.6g (%5.1f%%), %ld steps, %.0f steps/s   ", integrator_.c_str(), t, tEnd_,
                  100.0 * (t - t0_) / (tEnd_ - t0_), steps, steps / elapsed);
     std::fflush(stderr);
   }
@@ -54,6 +55,7 @@ class ProgressReporter {
  private:
   bool enabled_;
   double t0_, tEnd_;
+  std::string integrator_;  // the integrator chosen, named in the progress line
   std::chrono::steady_clock::time_point start_, last_;
   bool shown_ = false;
 };
@@ -338,6 +340,14 @@ double defaultMinStepSize(const SolverSettings& s) {
   return std::min(kDefaultMinStepFraction * (s.tEnd - s.tStart), kDefaultMinStepSeconds);
 }
 
+ElasticStart parseElasticStart(const std::string& name) {
+  if (name == "given") return ElasticStart::Given;
+  if (name == "quasi_static") return ElasticStart::QuasiStatic;
+  throw InputError("solver.elastic_start: unknown elastic start '" + name + "' (expected one of: given, quasi_static)");
+}
+
+std::string toString(ElasticStart s) { return s == ElasticStart::QuasiStatic ? "quasi_static" : "given"; }
+
 void SolverSettings::validate() const {
   requireSetting(rtol > 0.0 && std::isfinite(rtol), "rtol", "a positive number", rtol);
   requireSetting(atol > 0.0 && std::isfinite(atol), "atol", "a positive number", atol);
@@ -371,6 +381,10 @@ void SolverSettings::validate() const {
   requireSetting(maxOrder >= 1 && maxOrder <= 5, "max_order", "an integer from 1 to 5",
                  static_cast<double>(maxOrder));
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
+  if (quasiStaticAbove) {
+    requireSetting(*quasiStaticAbove > 0.0 && std::isfinite(*quasiStaticAbove), "quasi_static_above",
+                   "a positive circular frequency (rad/s)", *quasiStaticAbove);
+  }
 }
 
 /// Multipliers: large, so that the algebraic variables (already out of the error test)
@@ -402,14 +416,19 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   const std::clock_t cpuStart = std::clock();
   const double t0 = settings.tStart, tEnd = settings.tEnd;
 
-  const ConsistentState init =
-      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
+  SimulationSummary summary;
+  // choose: the integrator and its error weights from the model (integrators/integrator_choice.hpp)
+  const IntegratorChoice choice = chooseIntegrator(sys, settings);
+  summary.integrator = choice.kind;
+  summary.integratorReason = choice.reason;
+  const ConsistentState init = elasticStartState(
+      sys, settings, computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities()),
+      summary.elasticStart);
   const DaeSystem dae(sys, settings.formulation);
   const DaeLayout& L = dae.layout();
   VecX y0, yp0;
   dae.packState(init.q, init.v, init.a, init.lambda, y0, yp0);
 
-  SimulationSummary summary;
   summary.initialPositionIterations = init.positionIterations;
   const double modelSize = sys.characteristicLength();
   summary.modelSize = modelSize;
@@ -494,10 +513,11 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   IntegratorOptions o;
   o.rtol = settings.rtol;
   o.atol = absoluteTolerances(dae, settings);
+  applyEnergyVelocityWeights(choice, L, o.atol);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
-  if (settings.integrator == IntegratorKind::Ida && settings.formulation != Formulation::Index1) {
+  if (choice.kind == IntegratorKind::Ida && settings.formulation != Formulation::Index1) {
     // Damped modes outside the A(alpha) sectors of BDF4/5 set off bursts of error-test
     // failures that strand IDA at order 1 with GGL (docs/formulations.md; index 1 measured unaffected)
     const BdfOrderLimit limit = stableBdfOrder(sys, settings.maxOrder);
@@ -509,12 +529,12 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   o.minStepSize = settings.minStepSize.value_or(defaultMinStepSize(settings));
   o.linearSolver = settings.linearSolver;
   o.finiteDifferenceJacobian = settings.finiteDifferenceJacobian;
-  IntegratorKind kind = settings.integrator;  // the one running (IDA may hand over to Radau IIA)
+  IntegratorKind kind = choice.kind;  // the one running (IDA may hand over to Radau IIA)
   std::unique_ptr<DaeIntegrator> integrator = makeIntegrator(kind, dae, t0, y0, yp0, o);
   summary.usedKlu = integrator->usesKlu();
   IntegratorStats finished;  // statistics of the integrators a crossing replaced, and of the crossings
 
-  ProgressReporter progress(settings.progress, t0, tEnd);
+  ProgressReporter progress(settings.progress, t0, tEnd, toString(choice.kind));
   // Output times t0 + k dt; the last one is exactly t_end (IDASetStopTime).
   const long nOut = std::max(1L, static_cast<long>(std::ceil((tEnd - t0) / settings.outputStep - 1e-9)));
   const auto outputTime = [&](long k) { return k == nOut ? tEnd : std::min(tEnd, t0 + k * settings.outputStep); };
@@ -603,7 +623,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     return last;
   };
   // the crossing runs on ALI3-P, which is planar (q' = v) so far
-  const bool mayCross = settings.crossSingular && settings.integrator != IntegratorKind::AugmentedLagrangian && L.m > 0 &&
+  const bool mayCross = settings.crossSingular && choice.kind != IntegratorKind::AugmentedLagrangian && L.m > 0 &&
                         sys.velocitiesAreCoordinateRates();
   int restarts = 0;  // consecutive failures just after a crossing
   try {

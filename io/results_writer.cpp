@@ -345,7 +345,11 @@ nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Sce
   }
   j["singular_crossings"] = crossings;
   j["formulation"] = toString(s.formulation);
-  j["integrator"] = toString(s.integrator);
+  j["integrator"] = toString(summary.integrator);
+  j["integrator_requested"] = toString(s.integrator);
+  j["integrator_reason"] = summary.integratorReason;
+  j["elastic_start"] = summary.elasticStart.empty() ? nlohmann::ordered_json(nullptr)
+                                                    : nlohmann::ordered_json(summary.elasticStart);
   j["integrator_switch"] = summary.integratorSwitch.empty() ? nlohmann::ordered_json(nullptr)
                                                             : nlohmann::ordered_json(summary.integratorSwitch);
   j["linear_solver"] = summary.usedKlu ? "klu" : "dense";
