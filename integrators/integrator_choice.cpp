@@ -1,5 +1,6 @@
 #include "integrators/integrator_choice.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -27,43 +28,47 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
     c.reason = "given in the settings";
     return c;
   }
+  c.kind = IntegratorKind::Ida;
   if (settings.finiteDifferenceJacobian || settings.maxOrder != 5) {
-    c.kind = IntegratorKind::Ida;
     c.reason = std::string("IDA's own option ") + (settings.finiteDifferenceJacobian ? "fd_jacobian" : "max_order") +
                " given: ida";
+    return c;
+  }
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  if (std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) == kinds.end()) {
+    c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
     return c;
   }
   std::vector<std::string> skipped;
   const std::vector<BodyModes> modes = elasticModes(sys, &skipped, false);
   const double nyquist = outputNyquistFrequency(settings);
-  const BodyModes* fastest = nullptr;
+  const BodyModes* fastest = nullptr;  // the nodal body with the highest frequency above the Nyquist frequency
+  double topModal = 0.0;               // the highest frequency of the other bodies
   for (const BodyModes& m : modes) {
-    if (m.omega[m.size() - 1] > nyquist) {
-      c.energyWeights.push_back({m.name, m.velocityOffset, m.coordinateOffset, m.size(), m.omega[m.size() - 1]});
-      if (!fastest || m.omega[m.size() - 1] > fastest->omega[fastest->size() - 1]) fastest = &m;
+    const double top = m.omega[m.size() - 1];
+    if (!m.nodal || top <= nyquist) {
+      topModal = std::max(topModal, top);
+      continue;
     }
+    c.energyWeights.push_back({m.name, m.velocityOffset, m.coordinateOffset, m.size(), top});
+    if (!fastest || top > fastest->omega[fastest->size() - 1]) fastest = &m;
   }
   if (!fastest) {
-    c.kind = IntegratorKind::Ida;
-    if (modes.empty() && skipped.empty()) {
-      c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
-    } else if (modes.empty()) {
-      c.reason = "elastic bodies too large to analyse (" + std::to_string(skipped.size()) +
-                 ", above " + std::to_string(kMaxElasticModesSize) + " coordinates): ida";
+    if (modes.empty()) {
+      c.reason = "elastic bodies without a modal analysis (spatial, or above " + std::to_string(kMaxElasticModesSize) +
+                 " elastic coordinates): ida";
     } else {
-      double top = 0.0;
-      for (const BodyModes& m : modes) top = std::max(top, m.omega[m.size() - 1]);
-      c.reason = "every elastic mode (up to " + fmt(top) + " rad/s) below the output Nyquist frequency " +
-                 fmt(nyquist) + " rad/s, resolved like the motion: ida (variable-order BDF)";
+      c.reason = "no nodal body with modes above the output Nyquist frequency " + fmt(nyquist) +
+                 " rad/s (elastic modes up to " + fmt(topModal) +
+                 " rad/s, kept by the model: each one is content): ida (variable-order BDF)";
     }
     return c;
   }
   c.kind = IntegratorKind::Radau5;
-  const double top = fastest->omega[fastest->size() - 1];
-  c.reason = "body '" + fastest->name + "' has elastic modes up to " + fmt(top) +
+  c.reason = "nodal body '" + fastest->name + "' has elastic modes up to " + fmt(fastest->omega[fastest->size() - 1]) +
              " rad/s, above the output Nyquist frequency " + fmt(nyquist) +
-             " rad/s: radau5 (L-stable, damps the modes it does not resolve), elastic velocity errors weighed in "
-             "energy (atol of q_f' = omega_max x atol of q_f)";
+             " rad/s: radau5 (L-stable: damps the mesh modes it does not resolve), elastic velocity errors weighed "
+             "in energy (atol of q_f' = omega_max x atol of q_f)";
   return c;
 }
 

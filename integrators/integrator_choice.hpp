@@ -15,7 +15,9 @@ namespace flexmbd {
 
 /// Elastic velocities of one body weighed in energy: their absolute tolerance is omega
 /// times that of the body's elastic coordinates (a velocity error dv of a mode of
-/// frequency omega becomes the displacement error dv / omega).
+/// frequency omega becomes the displacement error dv / omega). With omega the body's
+/// highest frequency this is exact in energy for its fastest mode and looser for slower
+/// ones, whose displacements the position test holds (accuracy measured: docs/formulations.md).
 struct EnergyVelocityWeight {
   std::string body;
   int velocityOffset = 0;    ///< first elastic velocity of the body in v
