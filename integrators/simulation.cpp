@@ -455,6 +455,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
     startRatio = constraintConditioning(G0);
   }
   double tOutput = t0;  // the output being evaluated
+  ModalParticipation participation(sys);  // modal content of the flexible bodies at the outputs
   auto emit = [&](double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v) {
     tOutput = t;
     OutputSample s;
@@ -486,6 +487,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
       if (!summary.energyStart) summary.energyStart = E;
       summary.energyEnd = E;
     }
+    participation.add(s.q, s.v);
     summary.tReached = t;
     if (onOutput) onOutput(s);
     last = std::move(s);
@@ -737,6 +739,8 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
                                ", more than 1e-3 of the velocity scale " + num(velocityScale) +
                                ": the results are not accurate (tighten atol and rtol)");
   }
+  summary.modalParticipation = participation.result();
+  for (const std::string& w : participation.warnings()) summary.warnings.push_back(w);
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
   if (summary.ok) summary.message = "reached t_end";
   return summary;

@@ -10,6 +10,7 @@
 
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
+#include "integrators/modal_participation.hpp"
 
 namespace flexmbd {
 
@@ -126,6 +127,9 @@ struct SimulationSummary {
   std::string integratorReason;
   /// The quasi-static elastic start made (one line), or "" when the elastic state was as given.
   std::string elasticStart;
+  /// Per flexible body (at most 400 elastic coordinates): the largest amplitude and energy
+  /// of each mode over the outputs and the modes that carry the motion (issue 24, item 4).
+  std::vector<BodyParticipation> modalParticipation;
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run
