@@ -293,6 +293,10 @@ int runCommand(const Options& o) {
   std::cout << "flexmbd: ok: t = " << fmt(summary.tReached, kNumberDigits) << " reached, " << summary.stats.steps
             << " steps, " << fmt(summary.cpuSeconds, kNumberDigits) << " s CPU; results in "
             << writer->resultsPath().string() << std::endl;
+  if (scene->solver.integrator == IntegratorKind::Automatic) {
+    std::cout << "flexmbd: integrator " << toString(summary.integrator) << " (auto: " << summary.integratorReason << ")"
+              << std::endl;
+  }
   return kExitOk;
 }
 

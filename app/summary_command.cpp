@@ -155,6 +155,14 @@ void printSummary(const ordered_json& j, const std::string& path) {
     if (!m.empty()) r.line("method", m);
     if (r.has("order_limit")) r.line("order limit", text(r["order_limit"]));
     else r.shown({"order_limit"});
+    if (r.has("integrator_reason")) {
+      const std::string requested = r.has("integrator_requested") ? text(r["integrator_requested"]) : "";
+      r.line("integrator choice", (requested.empty() ? "" : requested + ": ") + text(r["integrator_reason"]));
+    } else {
+      r.shown({"integrator_reason", "integrator_requested"});
+    }
+    if (r.has("elastic_start")) r.line("elastic start", text(r["elastic_start"]));
+    else r.shown({"elastic_start"});
   }
 
   // ----- accuracy -----

@@ -30,6 +30,7 @@ std::string toString(IntegratorKind k) {
     case IntegratorKind::Ida: return "ida";
     case IntegratorKind::Radau5: return "radau5";
     case IntegratorKind::AugmentedLagrangian: return "ali3p";
+    case IntegratorKind::Automatic: return "auto";
   }
   return "?";
 }
@@ -38,7 +39,8 @@ IntegratorKind parseIntegrator(const std::string& name) {
   if (name == "ida") return IntegratorKind::Ida;
   if (name == "radau5") return IntegratorKind::Radau5;
   if (name == "ali3p") return IntegratorKind::AugmentedLagrangian;
-  throw InputError("solver.integrator: unknown integrator '" + name + "' (expected one of: ida, radau5, ali3p)");
+  if (name == "auto") return IntegratorKind::Automatic;
+  throw InputError("solver.integrator: unknown integrator '" + name + "' (expected one of: auto, ida, radau5, ali3p)");
 }
 
 std::unique_ptr<DaeIntegrator> makeIntegrator(IntegratorKind kind, const DaeProblem& dae, double t0,
@@ -51,6 +53,8 @@ std::unique_ptr<DaeIntegrator> makeIntegrator(IntegratorKind kind, const DaeProb
       if (!model) throw InputError("solver.integrator: ali3p integrates the engine's own models only");
       return std::make_unique<AugmentedLagrangianSolver>(*model, t0, y0, yp0, options);
     }
+    case IntegratorKind::Automatic:
+      throw InputError("solver.integrator: \"auto\" is resolved by the run (chooseIntegrator), not an integrator");
   }
   throw InputError("solver.integrator: unknown integrator kind");
 }

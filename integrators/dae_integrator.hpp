@@ -52,9 +52,12 @@ enum class IntegratorKind {
   /// Index-3 augmented Lagrangian with projections, trapezoidal rule (order 2), stays
   /// regular at singular positions (integrators/augmented_lagrangian_integrator.hpp)
   AugmentedLagrangian,
+  /// Chosen by the run from the model (integrators/integrator_choice.hpp): a setting, not
+  /// an integrator (makeIntegrator refuses it).
+  Automatic,
 };
 std::string toString(IntegratorKind k);
-/// "ida", "radau5", "ali3p". @throws InputError otherwise.
+/// "ida", "radau5", "ali3p", "auto". @throws InputError otherwise.
 IntegratorKind parseIntegrator(const std::string& name);
 
 /// A DAE integrator started from consistent y0, y0' at t0.

@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/bdf_stability.hpp"
+#include "integrators/integrator_choice.hpp"
 #include "integrators/singular_crossing.hpp"
 
 namespace flexmbd {
@@ -151,12 +152,15 @@ double defaultMinStepSize(const SolverSettings& settings) {
 ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae, const SolverSettings& settings,
                                          const ModelScales* scales) {
   ChosenIntegrator choice;
-  choice.kind = settings.integrator;
+  const IntegratorChoice picked = chooseIntegrator(sys, settings);
+  choice.kind = picked.kind;
+  choice.reason = picked.reason;
   choice.scales = scales ? *scales : modelScales(sys, settings);
   choice.tolerances = classTolerances(settings, choice.scales);
   IntegratorOptions& o = choice.options;
   o.rtol = settings.rtol;
   o.atol = absoluteTolerances(dae, choice.tolerances);
+  applyEnergyVelocityWeights(picked, dae.layout(), o.atol);
   o.maxSteps = settings.maxSteps;
   o.maxStepSize = settings.maxStepSize;
   o.maxOrder = settings.maxOrder;
@@ -342,6 +346,8 @@ SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& ou
   s.usedKlu = state.usedKlu;
   s.maxOrder = choice.options.maxOrder;
   s.orderLimit = choice.orderLimit;
+  s.integrator = choice.kind;
+  s.integratorReason = choice.reason;
   s.scales = choice.scales;
   s.tolerances = choice.tolerances;
   s.integratorSwitch = state.integratorSwitch;

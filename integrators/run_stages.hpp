@@ -62,14 +62,19 @@ std::optional<RunFailure> recordInitialOutput(OutputRecorder& recorder, const Da
 
 /// The integrator a run starts with, its options, and why its BDF order is limited.
 struct ChosenIntegrator {
-  IntegratorKind kind = IntegratorKind::Ida;  ///< the integrator the run starts with (settings.integrator)
+  /// The integrator the run starts with: settings.integrator, or the automatic choice
+  /// (chooseIntegrator, integrators/integrator_choice.hpp), never Automatic.
+  IntegratorKind kind = IntegratorKind::Ida;
+  std::string reason;  ///< why this integrator (one line)
   IntegratorOptions options;
   std::string orderLimit;  ///< why options.maxOrder is below settings.maxOrder ("" if it is not)
   ModelScales scales;          ///< the model's sizes the default class tolerances follow
   ClassTolerances tolerances;  ///< the absolute tolerances by coordinate class (options.atol)
 };
 
-/// Stage "choose": tolerances by coordinate class (absoluteTolerances), IDA's highest BDF
+/// Stage "choose": the integrator (chooseIntegrator: as given, or chosen from the model
+/// with its energy weights of elastic velocities), tolerances by coordinate class
+/// (absoluteTolerances), IDA's highest BDF
 /// order lowered where damped elastic modes lie outside the stable sectors of BDF4/5
 /// (GGL and index 3; stableBdfOrder), min_step (default defaultMinStepSize).
 /// @pre settings validated; dae built on sys.

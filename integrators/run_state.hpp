@@ -38,7 +38,8 @@ struct OutputSchedule {
 /// Progress on stderr for runs longer than a few seconds, when stderr is a terminal.
 class ProgressReporter {
  public:
-  ProgressReporter(bool enabled, double t0, double tEnd);
+  /// `integrator`: the integrator chosen, named in the progress line.
+  ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator);
   ProgressReporter(const ProgressReporter&) = delete;
   ProgressReporter& operator=(const ProgressReporter&) = delete;
   /// Shows t and the steps taken, at most twice a second, after the first 2 s.
@@ -48,6 +49,7 @@ class ProgressReporter {
  private:
   bool enabled_;
   double t0_, tEnd_;
+  std::string integrator_;
   std::chrono::steady_clock::time_point start_, last_;
   bool shown_ = false;
 };

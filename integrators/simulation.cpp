@@ -7,6 +7,8 @@
 
 #include "core/errors.hpp"
 #include "integrators/initial_conditions.hpp"
+#include "integrators/integrator_choice.hpp"
+#include "integrators/modal_participation.hpp"
 #include "integrators/output_recorder.hpp"
 #include "integrators/run_stages.hpp"
 #include "integrators/run_state.hpp"
@@ -108,7 +110,19 @@ void SolverSettings::validate() const {
   requireSetting(maxOrder >= 1 && maxOrder <= 5, "max_order", "an integer from 1 to 5",
                  static_cast<double>(maxOrder));
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
+  if (quasiStaticAbove) {
+    requireSetting(*quasiStaticAbove > 0.0 && std::isfinite(*quasiStaticAbove), "quasi_static_above",
+                   "a positive circular frequency (rad/s)", *quasiStaticAbove);
+  }
 }
+
+ElasticStart parseElasticStart(const std::string& name) {
+  if (name == "given") return ElasticStart::Given;
+  if (name == "quasi_static") return ElasticStart::QuasiStatic;
+  throw InputError("solver.elastic_start: unknown elastic start '" + name + "' (expected one of: given, quasi_static)");
+}
+
+std::string toString(ElasticStart s) { return s == ElasticStart::QuasiStatic ? "quasi_static" : "given"; }
 
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
   return absoluteTolerances(dae, classTolerances(settings, modelScales(dae.system(), settings)));
@@ -124,17 +138,25 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   const std::clock_t cpuStart = std::clock();
   const double t0 = settings.tStart, tEnd = settings.tEnd;
 
-  // start: the consistent state, what it corrected, the first output
-  const ConsistentState init =
-      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
+  // start: the consistent state (the elastic one quasi-static if asked), what it
+  // corrected, the first output; the modal content of the flexible bodies at every output
+  std::string elasticStart;
+  const ConsistentState init = elasticStartState(
+      sys, settings, computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities()),
+      elasticStart);
   const DaeSystem dae(sys, settings.formulation);
   const RunStart start = startRun(dae, init, t0);
-  OutputRecorder recorder(sys, start.modelSize, onOutput);
+  ModalParticipation participation(sys);
+  OutputRecorder recorder(sys, start.modelSize, [&](const OutputSample& s) {
+    participation.add(s.q, s.v);
+    if (onOutput) onOutput(s);
+  });
   if (const std::optional<RunFailure> stop = recordInitialOutput(recorder, dae.layout(), start, t0)) {
     return summaryAtStart(start, recorder.recorded(), *stop);
   }
 
-  // choose: the tolerances by coordinate class from the model's scales at the start
+  // choose: the integrator (integrators/integrator_choice.hpp) and its tolerances by
+  // coordinate class from the model's scales at the start
   const ModelScales scales = modelScales(sys, init.v, t0, tEnd);
   const ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings, &scales);
   const RunContext ctx{sys,
@@ -148,11 +170,14 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   RunState state = startIntegrator(ctx, start, choice.kind);
 
   // integrate output by output, handing over and crossing; diagnose an early end
-  ProgressReporter progress(settings.progress, t0, tEnd);
+  ProgressReporter progress(settings.progress, t0, tEnd, toString(choice.kind));
   const std::optional<RunFailure> failure = integrateAndDiagnose(ctx, state, recorder, progress);
 
   // finish
   SimulationSummary summary = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
+  summary.elasticStart = elasticStart;
+  summary.modalParticipation = participation.result();
+  for (const std::string& w : participation.warnings()) summary.warnings.push_back(w);
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
   return summary;
 }

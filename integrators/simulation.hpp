@@ -11,12 +11,27 @@
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
 #include "integrators/tolerances.hpp"
+#include "integrators/modal_participation.hpp"
 
 namespace flexmbd {
 
+/// How the elastic coordinates start (docs/formulations.md): as given (default: undeformed
+/// and at rest relative to the frame, or the scene's values), or with the fast modes at
+/// their quasi-static deflection and rate (integrators/quasi_static_start.hpp).
+enum class ElasticStart { Given, QuasiStatic };
+/// "given", "quasi_static". @throws InputError otherwise.
+ElasticStart parseElasticStart(const std::string& name);
+std::string toString(ElasticStart s);
+
 struct SolverSettings {
   Formulation formulation = Formulation::Ggl;
-  IntegratorKind integrator = IntegratorKind::Ida;
+  /// Automatic: chosen from the model at the start (chooseIntegrator,
+  /// integrators/integrator_choice.hpp); the choice and its reason are in the summary.
+  IntegratorKind integrator = IntegratorKind::Automatic;
+  ElasticStart elasticStart = ElasticStart::Given;
+  /// QuasiStatic: the modes above this circular frequency (rad/s) start quasi-statically.
+  /// Unset: the Nyquist frequency of the output step, pi / outputStep.
+  std::optional<double> quasiStaticAbove;
   double rtol = 1e-8;
   /// Absolute tolerances by coordinate class (integrators/tolerances.hpp): frame
   /// positions (m); unset classes default relative to atol and the model's sizes
@@ -111,6 +126,15 @@ struct SimulationSummary {
   /// "at t = ... from ida to radau5: N error-test failures in the last M steps" when IDA
   /// rejected nearly every step and Radau IIA took the rest of the run; "" otherwise.
   std::string integratorSwitch;
+  /// The integrator the run started with (settings.integrator, or the automatic choice)
+  /// and why (one line: "given in the settings", or what chooseIntegrator measured).
+  IntegratorKind integrator = IntegratorKind::Ida;
+  std::string integratorReason;
+  /// The quasi-static elastic start made (one line), or "" when the elastic state was as given.
+  std::string elasticStart;
+  /// Per flexible body (at most 400 elastic coordinates): the largest amplitude and energy
+  /// of each mode over the outputs and the modes that carry the motion (issue 24, item 4).
+  std::vector<BodyParticipation> modalParticipation;
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run

@@ -366,8 +366,21 @@ nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Sce
     crossings.push_back({{"t_failure", c.tFailure}, {"t_start", c.tStart}, {"t_end", c.tEnd}, {"steps", c.steps}});
   }
   j["singular_crossings"] = crossings;
+  nlohmann::ordered_json participation = nlohmann::ordered_json::array();
+  for (const BodyParticipation& b : summary.modalParticipation) {
+    nlohmann::ordered_json modes = nlohmann::ordered_json::array();
+    for (const ModeParticipation& m : b.modes) {
+      modes.push_back({{"omega", m.omega}, {"max_amplitude", m.maxAmplitude}, {"max_energy", m.maxEnergy}});
+    }
+    participation.push_back({{"body", b.body}, {"nodal", b.nodal}, {"carrying", b.carrying}, {"modes", modes}});
+  }
+  j["modal_participation"] = participation;
   j["formulation"] = toString(s.formulation);
-  j["integrator"] = toString(s.integrator);
+  j["integrator"] = toString(summary.integrator);
+  j["integrator_requested"] = toString(s.integrator);
+  j["integrator_reason"] = summary.integratorReason;
+  j["elastic_start"] = summary.elasticStart.empty() ? nlohmann::ordered_json(nullptr)
+                                                    : nlohmann::ordered_json(summary.elasticStart);
   j["integrator_switch"] = summary.integratorSwitch.empty() ? nlohmann::ordered_json(nullptr)
                                                             : nlohmann::ordered_json(summary.integratorSwitch);
   j["linear_solver"] = summary.usedKlu ? "klu" : "dense";

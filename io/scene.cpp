@@ -377,7 +377,7 @@ SolverSettings parseSolver(const json& j) {
     try {
       s.integrator = parseIntegrator(name);
     } catch (const InputError&) {
-      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: ida, radau5, ali3p)");
+      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: auto, ida, radau5, ali3p)");
     }
   }
   if (r.has("formulation")) {
@@ -388,6 +388,15 @@ SolverSettings parseSolver(const json& j) {
       r.fail("unknown formulation " + inQuotes(f) + " (expected one of: ggl, index3, index1)");
     }
   }
+  if (r.has("elastic_start")) {
+    const std::string e = r.string("elastic_start");
+    try {
+      s.elasticStart = parseElasticStart(e);
+    } catch (const InputError&) {
+      r.fail("unknown elastic start " + inQuotes(e) + " (expected one of: given, quasi_static)");
+    }
+  }
+  if (r.has("quasi_static_above")) s.quasiStaticAbove = r.number("quasi_static_above");
   if (r.has("linear_solver")) {
     const std::string ls = r.string("linear_solver");
     try {

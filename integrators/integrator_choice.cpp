@@ -1,0 +1,96 @@
+#include "integrators/integrator_choice.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "integrators/elastic_modes.hpp"
+#include "integrators/quasi_static_start.hpp"
+
+namespace flexmbd {
+namespace {
+
+std::string fmt(double x) {
+  std::ostringstream os;
+  os.precision(3);
+  os << x;
+  return os.str();
+}
+
+}  // namespace
+
+double outputNyquistFrequency(const SolverSettings& settings) { return M_PI / settings.outputStep; }
+
+IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& settings) {
+  IntegratorChoice c;
+  if (settings.integrator != IntegratorKind::Automatic) {
+    c.kind = settings.integrator;
+    c.reason = "given in the settings";
+    return c;
+  }
+  c.kind = IntegratorKind::Ida;
+  if (settings.finiteDifferenceJacobian || settings.maxOrder != 5) {
+    c.reason = std::string("IDA's own option ") + (settings.finiteDifferenceJacobian ? "fd_jacobian" : "max_order") +
+               " given: ida";
+    return c;
+  }
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  if (std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) == kinds.end()) {
+    c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
+    return c;
+  }
+  std::vector<std::string> skipped;
+  const std::vector<BodyModes> modes = elasticModes(sys, &skipped, false);
+  const double nyquist = outputNyquistFrequency(settings);
+  const BodyModes* fastest = nullptr;  // the nodal body with the highest frequency above the Nyquist frequency
+  double topModal = 0.0;               // the highest frequency of the other bodies
+  for (const BodyModes& m : modes) {
+    const double top = m.omega[m.size() - 1];
+    if (!m.nodal || top <= nyquist) {
+      topModal = std::max(topModal, top);
+      continue;
+    }
+    c.energyWeights.push_back({m.name, m.velocityOffset, m.coordinateOffset, m.size(), top});
+    if (!fastest || top > fastest->omega[fastest->size() - 1]) fastest = &m;
+  }
+  if (!fastest) {
+    if (modes.empty()) {
+      c.reason = "elastic bodies without a modal analysis (spatial, or above " + std::to_string(kMaxElasticModesSize) +
+                 " elastic coordinates): ida";
+    } else {
+      c.reason = "no nodal body with modes above the output Nyquist frequency " + fmt(nyquist) +
+                 " rad/s (elastic modes up to " + fmt(topModal) +
+                 " rad/s, kept by the model: each one is content): ida (variable-order BDF)";
+    }
+    return c;
+  }
+  c.kind = IntegratorKind::Radau5;
+  c.reason = "nodal body '" + fastest->name + "' has elastic modes up to " + fmt(fastest->omega[fastest->size() - 1]) +
+             " rad/s, above the output Nyquist frequency " + fmt(nyquist) +
+             " rad/s: radau5 (L-stable: damps the mesh modes it does not resolve), elastic velocity errors weighed "
+             "in energy (atol of q_f' = omega_max x atol of q_f)";
+  return c;
+}
+
+void applyEnergyVelocityWeights(const IntegratorChoice& choice, const DaeLayout& layout, VecX& atol) {
+  for (const EnergyVelocityWeight& w : choice.energyWeights) {
+    for (int i = 0; i < w.size; ++i) {
+      double& v = atol[layout.v + w.velocityOffset + i];
+      v = std::max(v, w.omega * atol[layout.q + w.coordinateOffset + i]);  // dv / omega is a displacement error
+    }
+  }
+}
+
+ConsistentState elasticStartState(const System& sys, const SolverSettings& settings, const ConsistentState& init,
+                                  std::string& report) {
+  report.clear();
+  if (settings.elasticStart != ElasticStart::QuasiStatic) return init;
+  const double cutoff = settings.quasiStaticAbove.value_or(outputNyquistFrequency(settings));
+  const QuasiStaticStart qs = quasiStaticElasticStart(sys, settings.tStart, init, elasticModes(sys), cutoff);
+  report = "quasi-static: " + std::to_string(qs.modes) + " elastic modes above " + fmt(cutoff) +
+           " rad/s started at their quasi-static deflection and rate (" + std::to_string(qs.iterations) +
+           " iterations, remaining modal acceleration / omega^2 " + fmt(qs.residual) + ")";
+  return qs.state;
+}
+
+}  // namespace flexmbd
