@@ -39,6 +39,7 @@ struct RecordedOutputs {
 class OutputRecorder {
  public:
   /// @pre sys is finalized; sys and onOutput outlive the recorder (onOutput may be empty).
+  /// @pre `onOutput` outlives the recorder (it is held by reference).
   OutputRecorder(const System& sys, double modelSize, const OutputCallback& onOutput);
   OutputRecorder(const OutputRecorder&) = delete;
   OutputRecorder& operator=(const OutputRecorder&) = delete;

@@ -147,10 +147,11 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   const DaeSystem dae(sys, settings.formulation);
   const RunStart start = startRun(dae, init, t0);
   ModalParticipation participation(sys);
-  OutputRecorder recorder(sys, start.modelSize, [&](const OutputSample& s) {
+  const OutputCallback recordParticipation = [&](const OutputSample& s) {  // outlives the recorder
     participation.add(s.q, s.v);
     if (onOutput) onOutput(s);
-  });
+  };
+  OutputRecorder recorder(sys, start.modelSize, recordParticipation);
   if (const std::optional<RunFailure> stop = recordInitialOutput(recorder, dae.layout(), start, t0)) {
     return summaryAtStart(start, recorder.recorded(), *stop);
   }
