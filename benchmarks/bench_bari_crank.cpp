@@ -25,12 +25,6 @@ using namespace flexmbd::bench;
 
 namespace {
 
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
 struct Config {
   std::string name;
   bool engine = true;

@@ -12,49 +12,22 @@
 #include <nlohmann/json.hpp>
 
 #include "benchmarks/bench_common.hpp"
+#include "benchmarks/bench_scenes.hpp"
 #include "core/dae_system.hpp"
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
-
-#include <time.h>
 
 using namespace flexmbd;
 using namespace flexmbd::bench;
 
 namespace {
 
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-constexpr double kLinkLength = 0.3;
 
 nlohmann::json chainScene(int links, int modes, double span, IntegratorKind kind) {
-  using json = nlohmann::json;
-  json bodies = json::array(), joints = json::array();
-  for (int k = 0; k < links; ++k) {
-    const std::string name = "link" + std::to_string(k + 1);
-    bodies.push_back({{"name", name},
-                      {"type", "flexible"},
-                      {"position", {kLinkLength * k, 0.0}},
-                      {"section", {{"width", 0.008}, {"height", 0.008}, {"youngs_modulus", 2e11}, {"density", 7870}}},
-                      {"beam", {{"length", kLinkLength}, {"elements", 4}}},
-                      {"reference", {{"type", "pinned_pinned"}}},
-                      {"modes", modes}});
-    joints.push_back({{"name", "J" + std::to_string(k + 1)},
-                      {"type", "revolute"},
-                      {"bodies", {k == 0 ? std::string("ground") : "link" + std::to_string(k), name}},
-                      {"points", {{k == 0 ? 0.0 : kLinkLength, 0.0}, {0.0, 0.0}}}});
-  }
-  return {{"name", "flexible pendulum chain"},
-          {"gravity", {0.0, -9.81}},
-          {"bodies", bodies},
-          {"joints", joints},
-          {"solver",
-           {{"rtol", 1e-6}, {"atol", 1e-8}, {"t_end", span}, {"output_step", span}, {"integrator", toString(kind)},
-            {"max_steps", 100000000}}}};
+  nlohmann::json j = testmodels::flexibleChainJson(links, modes);
+  j["solver"] = {{"rtol", 1e-6}, {"atol", 1e-8}, {"t_end", span}, {"output_step", span},
+                 {"integrator", toString(kind)}, {"max_steps", 100000000}};
+  return j;
 }
 
 struct Row {
@@ -71,16 +44,11 @@ Row runCase(int links, int modes, double span, IntegratorKind kind, int repeat) 
     Scene s = parseScene(chainScene(links, modes, span, kind));
     s.solver.progress = false;
     r.size = DaeSystem(s.system, s.solver.formulation).layout().size;
-    const double c0 = cpuSeconds();
-    double started = NAN;
-    const SimulationSummary sum = simulate(s.system, s.solver, [&](const OutputSample&) {
-      if (std::isnan(started)) started = cpuSeconds();
-    });
-    const double end = cpuSeconds();
-    setup.push_back(started - c0);
-    cpu.push_back(end - started);
-    r.ok = sum.ok;
-    r.stats = sum.stats;
+    const TimedRun t = timedSimulate(s.system, s.solver);
+    setup.push_back(t.setup);
+    cpu.push_back(t.integration);
+    r.ok = t.summary.ok;
+    r.stats = t.summary.stats;
   }
   r.setup = median(setup);
   r.cpu = median(cpu);

@@ -56,11 +56,6 @@ void runCase(Case& c, double rtol, double span, LinearSolverKind solver) {
   c.nonZeros = dae.pattern().nonZeros();
 }
 
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 /// Midpoint deflection of the rod at the checkpoints of one run (first entry t = 0).
 struct DeflectionRun {

@@ -76,6 +76,25 @@ inline void setRun(SolverSettings& solver, double rtol, double atol, double span
 
 inline std::string sourcePath(const std::string& rel) { return std::string(FLEXMBD_SOURCE_DIR) + "/" + rel; }
 
+/// A run timed in two parts: the set-up (consistent state, DAE pattern, up to the output at
+/// t_start) and the integration after it, both process CPU time [s].
+struct TimedRun {
+  SimulationSummary summary;
+  double setup = 0.0, integration = 0.0;
+};
+inline TimedRun timedSimulate(const System& sys, const SolverSettings& settings) {
+  TimedRun r;
+  const double c0 = cpuSeconds();
+  double started = NAN;  // CPU time at the first output
+  r.summary = simulate(sys, settings, [&](const OutputSample&) {
+    if (std::isnan(started)) started = cpuSeconds();
+  });
+  const double end = cpuSeconds();
+  r.setup = started - c0;
+  r.integration = end - started;
+  return r;
+}
+
 /// Body-frame position of a material point of a flexible body: u0 + N q_f.
 inline Vec2 ffrMaterialPoint(const System& sys, const std::string& body, const FfrPoint& p, const VecX& q) {
   const BodyIndex b = sys.findBody(body);

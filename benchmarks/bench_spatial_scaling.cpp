@@ -13,23 +13,17 @@
 #include <nlohmann/json.hpp>
 
 #include "benchmarks/bench_common.hpp"
+#include "benchmarks/bench_scenes.hpp"
 #include "core/dae_system.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
-
-#include <time.h>
 
 using namespace flexmbd;
 using namespace flexmbd::bench;
 
 namespace {
 
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 /// Peak resident memory of this process [MB] (Linux /proc/self/status, VmHWM).
 double peakMemoryMb() {
@@ -41,21 +35,9 @@ double peakMemoryMb() {
   return NAN;
 }
 
-nlohmann::json baseScene() {
-  std::ifstream in(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_slider_crank_elastic.json");
-  if (!in) throw std::runtime_error("cannot read examples/spatial_slider_crank_elastic.json");
-  return nlohmann::json::parse(in);
-}
-
 /// The example scene with `elements` rod elements (and `modes` modes if > 0).
-Scene sceneWith(const nlohmann::json& base, int elements, int modes, double span, IntegratorKind kind) {
-  nlohmann::json j = base;
-  for (auto& b : j["bodies"]) {
-    if (b["name"] == "rod") {
-      b["beam"]["elements"] = elements;
-      if (modes > 0) b["modes"] = modes;
-    }
-  }
+Scene sceneWith(int elements, int modes, double span, IntegratorKind kind) {
+  nlohmann::json j = testmodels::spatialElasticCrankJson(elements, modes);
   j["solver"]["t_end"] = span;
   j["solver"]["output_step"] = span;
   j["solver"]["integrator"] = toString(kind);
@@ -73,23 +55,18 @@ struct Row {
   bool ok = false;
 };
 
-Row runCase(const nlohmann::json& base, int elements, int modes, double span, IntegratorKind kind, int repeat) {
+Row runCase(int elements, int modes, double span, IntegratorKind kind, int repeat) {
   Row r;
   r.elements = elements;
   std::vector<double> cpu, setup;
   for (int rep = 0; rep < repeat; ++rep) {
-    Scene s = sceneWith(base, elements, modes, span, kind);
+    Scene s = sceneWith(elements, modes, span, kind);
     r.size = DaeSystem(s.system, s.solver.formulation).layout().size;
-    const double c0 = cpuSeconds();
-    double started = NAN;  // CPU time at the first output (t = 0): the set-up before the steps
-    const SimulationSummary sum = simulate(s.system, s.solver, [&](const OutputSample&) {
-      if (std::isnan(started)) started = cpuSeconds();
-    });
-    const double end = cpuSeconds();
-    setup.push_back(started - c0);
-    cpu.push_back(end - started);
-    r.ok = sum.ok;
-    r.stats = sum.stats;
+    const TimedRun t = timedSimulate(s.system, s.solver);
+    setup.push_back(t.setup);
+    cpu.push_back(t.integration);
+    r.ok = t.summary.ok;
+    r.stats = t.summary.stats;
   }
   r.cpu = median(cpu);
   r.setup = median(setup);
@@ -121,7 +98,6 @@ int main(int argc, char** argv) {
   std::vector<IntegratorKind> kinds;
   for (const std::string& n : integratorNames) kinds.push_back(parseIntegrator(n));
   if (kinds.empty()) kinds = {IntegratorKind::Ida, IntegratorKind::Radau5};
-  const nlohmann::json base = baseScene();
   CsvWriter csv(opt.csvPath("bench_spatial_scaling.csv"),
                 {"integrator", "elements", "modes", "dae_size", "steps", "residuals", "jacobians", "setup_seconds",
                  "cpu_seconds",
@@ -134,7 +110,7 @@ int main(int argc, char** argv) {
   for (IntegratorKind kind : kinds) {
     std::vector<double> lx, ly;
     for (int n = minElements; n <= maxElements; n *= 2) {
-      const Row r = runCase(base, n, modes, span, kind, opt.repeat);
+      const Row r = runCase(n, modes, span, kind, opt.repeat);
       const double mb = peakMemoryMb();
       std::printf("%-7s %5d %6d %8ld %8ld %6ld %9.3f %9.3f %11.1f %11.2f %12.4g %8.1f%s\n", toString(kind).c_str(), n,
                   r.size, r.stats.steps, r.stats.residualEvals, r.stats.jacobianEvals, r.setup, r.cpu, 1e6 * r.perStep,

@@ -13,42 +13,15 @@
 #include "integrators/initial_conditions.hpp"
 #include "integrators/klu_ordering.hpp"
 #include "io/scene.hpp"
-#include "tests/ffr3d_crank_models.hpp"
+#include "tests/ffr_test_models.hpp"
 
 using namespace flexmbd;
 
 namespace {
 
-/// The spatial elastic slider crank of the examples with `elements` rod elements.
-Scene spatialCrank(int elements) {
-  std::ifstream in(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_slider_crank_elastic.json");
-  nlohmann::json j = nlohmann::json::parse(in);
-  for (auto& b : j["bodies"]) {
-    if (b["name"] == "rod") b["beam"]["elements"] = elements;
-  }
-  return parseScene(j);
-}
+Scene spatialCrank(int elements) { return parseScene(testmodels::spatialElasticCrankJson(elements)); }
 
-/// A planar pendulum chain of `links` steel links (0.3 m, 4 elements, 4 modes each).
-Scene chain(int links) {
-  using json = nlohmann::json;
-  json bodies = json::array(), joints = json::array();
-  for (int k = 0; k < links; ++k) {
-    const std::string name = "link" + std::to_string(k + 1);
-    bodies.push_back({{"name", name},
-                      {"type", "flexible"},
-                      {"position", {0.3 * k, 0.0}},
-                      {"section", {{"width", 0.008}, {"height", 0.008}, {"youngs_modulus", 2e11}, {"density", 7870}}},
-                      {"beam", {{"length", 0.3}, {"elements", 4}}},
-                      {"reference", {{"type", "pinned_pinned"}}},
-                      {"modes", 4}});
-    joints.push_back({{"name", "J" + std::to_string(k + 1)},
-                      {"type", "revolute"},
-                      {"bodies", {k == 0 ? std::string("ground") : "link" + std::to_string(k), name}},
-                      {"points", {{k == 0 ? 0.0 : 0.3, 0.0}, {0.0, 0.0}}}});
-  }
-  return parseScene(json{{"gravity", {0.0, -9.81}}, {"bodies", bodies}, {"joints", joints}});
-}
+Scene chain(int links) { return parseScene(testmodels::flexibleChainJson(links)); }
 
 /// The DAE of a scene at its consistent initial state, and the ordering KLU gets.
 struct Factored {
