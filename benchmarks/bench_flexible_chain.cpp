@@ -31,6 +31,7 @@ nlohmann::json chainScene(int links, int modes, double span, IntegratorKind kind
 }
 
 struct Row {
+  std::string fills;  ///< nnz(L + U) per KLU ordering candidate (orderingFills)
   int size = 0;
   double setup = 0, cpu = 0;
   IntegratorStats stats;
@@ -44,6 +45,7 @@ Row runCase(int links, int modes, double span, IntegratorKind kind, int repeat) 
     Scene s = parseScene(chainScene(links, modes, span, kind));
     s.solver.progress = false;
     r.size = DaeSystem(s.system, s.solver.formulation).layout().size;
+    if (r.fills.empty()) r.fills = orderingFills(s.system);  // untimed
     const TimedRun t = timedSimulate(s.system, s.solver);
     setup.push_back(t.setup);
     cpu.push_back(t.integration);
@@ -80,7 +82,7 @@ int main(int argc, char** argv) {
   if (kinds.empty()) kinds = {IntegratorKind::Ida, IntegratorKind::Radau5};
   CsvWriter csv(opt.csvPath("bench_flexible_chain.csv"),
                 {"integrator", "links", "modes", "dae_size", "steps", "residuals", "jacobians", "setup_seconds",
-                 "cpu_seconds", "us_per_step", "cpu_per_simulated_second", "ok"});
+                 "cpu_seconds", "us_per_step", "cpu_per_simulated_second", "ok", "factor_nnz_klu_mult_frames"});
   std::printf("Planar pendulum chain of flexible links (%d modes each), span %g s, rtol 1e-6, GGL, KLU\n", modes, span);
   std::printf("%-7s %5s %6s %8s %8s %6s %9s %9s %11s %12s\n", "integr.", "links", "size", "steps", "resid.", "jac.",
               "setup [s]", "cpu [s]", "us/step", "s/sim. s");
@@ -92,11 +94,13 @@ int main(int argc, char** argv) {
       std::printf("%-7s %5d %6d %8ld %8ld %6ld %9.3f %9.3f %11.1f %12.4g%s\n", toString(kind).c_str(), n, r.size,
                   r.stats.steps, r.stats.residualEvals, r.stats.jacobianEvals, r.setup, r.cpu, 1e6 * perStep,
                   r.cpu / span, r.ok ? "" : "  (failed)");
+      std::printf("        nnz(L + U) klu / camd multipliers last / camd frames and multipliers last: %s\n",
+                  r.fills.c_str());
       std::fflush(stdout);
       csv.row({toString(kind), std::to_string(n), std::to_string(modes), std::to_string(r.size),
                std::to_string(r.stats.steps), std::to_string(r.stats.residualEvals),
                std::to_string(r.stats.jacobianEvals), fmt(r.setup), fmt(r.cpu), fmt(1e6 * perStep),
-               fmt(r.cpu / span), r.ok ? "1" : "0"});
+               fmt(r.cpu / span), r.ok ? "1" : "0", r.fills});
       lx.push_back(std::log(n));
       lstep.push_back(std::log(perStep));
       lsim.push_back(std::log(r.cpu / span));

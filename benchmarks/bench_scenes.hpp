@@ -26,6 +26,8 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "core/system_evaluation.hpp"
+#include "integrators/initial_conditions.hpp"
+#include "integrators/klu_ordering.hpp"
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
 #include "tests/ffr_test_models.hpp"
@@ -93,6 +95,21 @@ inline TimedRun timedSimulate(const System& sys, const SolverSettings& settings)
   r.setup = started - c0;
   r.integration = end - started;
   return r;
+}
+
+/// nnz(L + U) of the GGL iteration matrix at the consistent initial state (cj of the
+/// engine's trials) with each KLU ordering candidate (KluOrdering::trials), as
+/// "klu / camd multipliers last / camd frames and multipliers last".
+inline std::string orderingFills(const System& sys) {
+  const ConsistentState init = computeConsistentState(sys, 0.0, sys.initialCoordinates(), sys.initialVelocities());
+  const DaeSystem dae(sys, Formulation::Ggl);
+  VecX y, yp;
+  dae.packState(init.q, init.v, init.a, init.lambda, y, yp);
+  std::string out;
+  for (const KluOrdering& o : KluOrdering::trials(dae, 0.0, y, yp, kOrderingTrialCj)) {
+    out += (out.empty() ? "" : "/") + std::to_string(o.factorNonZeros());
+  }
+  return out;
 }
 
 /// Body-frame position of a material point of a flexible body: u0 + N q_f.

@@ -49,6 +49,7 @@ Scene sceneWith(int elements, int modes, double span, IntegratorKind kind) {
 }
 
 struct Row {
+  std::string fills;  ///< nnz(L + U) per KLU ordering candidate (orderingFills)
   int elements = 0, size = 0;
   double cpu = 0, setup = 0, perStep = 0, perResidual = 0;  ///< cpu: integration only
   IntegratorStats stats;
@@ -62,6 +63,7 @@ Row runCase(int elements, int modes, double span, IntegratorKind kind, int repea
   for (int rep = 0; rep < repeat; ++rep) {
     Scene s = sceneWith(elements, modes, span, kind);
     r.size = DaeSystem(s.system, s.solver.formulation).layout().size;
+    if (r.fills.empty()) r.fills = orderingFills(s.system);  // untimed
     const TimedRun t = timedSimulate(s.system, s.solver);
     setup.push_back(t.setup);
     cpu.push_back(t.integration);
@@ -101,7 +103,7 @@ int main(int argc, char** argv) {
   CsvWriter csv(opt.csvPath("bench_spatial_scaling.csv"),
                 {"integrator", "elements", "modes", "dae_size", "steps", "residuals", "jacobians", "setup_seconds",
                  "cpu_seconds",
-                 "us_per_step", "us_per_residual_eval", "cpu_per_simulated_second", "peak_mb", "ok"});
+                 "us_per_step", "us_per_residual_eval", "cpu_per_simulated_second", "peak_mb", "ok", "factor_nnz_klu_mult_frames"});
   std::printf("Spatial elastic slider crank (examples/spatial_slider_crank_elastic.json), rod %s, span %g s, "
               "rtol 1e-6, GGL, KLU; CPU per step includes residuals, Jacobians, factorisations and solves\n",
               modes > 0 ? (std::to_string(modes) + " modes").c_str() : "nodal", span);
@@ -115,11 +117,13 @@ int main(int argc, char** argv) {
       std::printf("%-7s %5d %6d %8ld %8ld %6ld %9.3f %9.3f %11.1f %11.2f %12.4g %8.1f%s\n", toString(kind).c_str(), n,
                   r.size, r.stats.steps, r.stats.residualEvals, r.stats.jacobianEvals, r.setup, r.cpu, 1e6 * r.perStep,
                   1e6 * r.perResidual, r.cpu / span, mb, r.ok ? "" : "  (failed)");
+      std::printf("        nnz(L + U) klu / camd multipliers last / camd frames and multipliers last: %s\n",
+                  r.fills.c_str());
       std::fflush(stdout);
       csv.row({toString(kind), std::to_string(n), std::to_string(modes), std::to_string(r.size),
                std::to_string(r.stats.steps), std::to_string(r.stats.residualEvals),
                std::to_string(r.stats.jacobianEvals), fmt(r.setup), fmt(r.cpu), fmt(1e6 * r.perStep), fmt(1e6 * r.perResidual),
-               fmt(r.cpu / span), fmt(mb), r.ok ? "1" : "0"});
+               fmt(r.cpu / span), fmt(mb), r.ok ? "1" : "0", r.fills});
       lx.push_back(std::log(r.size));
       ly.push_back(std::log(r.perStep));
     }

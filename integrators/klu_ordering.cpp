@@ -54,24 +54,32 @@ int64_t trialFill(const KluOrdering& ordering, int64_t n, std::vector<int64_t>& 
 
 }  // namespace
 
-KluOrdering KluOrdering::choose(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, double cj) {
+std::vector<KluOrdering> KluOrdering::trials(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0,
+                                             double cj) {
   const std::vector<int64_t> groups = dae.eliminationGroups();
-  if (std::find(groups.begin(), groups.end(), 0) == groups.end()) return KluOrdering();
+  if (std::find(groups.begin(), groups.end(), 0) == groups.end()) return {KluOrdering()};
   const SparsePattern& p = dae.pattern();
   std::vector<int64_t> Ap(p.colStart().begin(), p.colStart().end()), Ai(p.rowIndex().begin(), p.rowIndex().end());
   std::vector<double> values(Ai.size(), 0.0);
   JacobianSink sink = JacobianSink::sparse(values.data(), p);
   dae.jacobian(t0, y0.data(), yp0.data(), cj, sink);
-  KluOrdering best;
-  best.factorNonZeros_ = trialFill(best, p.size(), Ap, Ai, values);
+  std::vector<KluOrdering> out;
+  out.push_back(KluOrdering());
   for (Kind kind : {Kind::MultipliersLast, Kind::FramesAndMultipliersLast}) {
-    KluOrdering candidate(kind, constraintsFor(kind, groups));
-    candidate.factorNonZeros_ = trialFill(candidate, p.size(), Ap, Ai, values);
-    if (candidate.factorNonZeros_ >= 0 && (best.factorNonZeros_ < 0 || candidate.factorNonZeros_ < best.factorNonZeros_)) {
-      best = std::move(candidate);
-    }
+    out.push_back(KluOrdering(kind, constraintsFor(kind, groups)));
   }
-  return best;
+  for (KluOrdering& o : out) o.factorNonZeros_ = trialFill(o, p.size(), Ap, Ai, values);
+  return out;
+}
+
+KluOrdering KluOrdering::choose(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, double cj) {
+  std::vector<KluOrdering> all = trials(dae, t0, y0, yp0, cj);
+  size_t best = 0;
+  for (size_t k = 1; k < all.size(); ++k) {
+    const int64_t fill = all[k].factorNonZeros_, bestFill = all[best].factorNonZeros_;
+    if (fill >= 0 && (bestFill < 0 || fill < bestFill)) best = k;
+  }
+  return std::move(all[best]);
 }
 
 void KluOrdering::configure(klu_l_common& common) const {

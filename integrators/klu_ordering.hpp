@@ -20,10 +20,9 @@ namespace flexmbd {
 ///   - KLU's own: block-triangular form, then AMD, pivot threshold 1e-3;
 ///   - CAMD with the multipliers last (pivot threshold 1e-6);
 ///   - CAMD with the frame coordinates and the multipliers last (pivot threshold 1e-6).
-/// A large flexible body fills quadratically with KLU's own (256 elements: nnz(L + U)
-/// 291,637 against 28,663 with the CAMD orders), a chain of flexible links quadratically
-/// with frames-and-multipliers-last (64 links: 467,435 against 54,065 with KLU's own),
-/// issue 24. Models without elastic coordinates (DaeProblem::eliminationGroups() without
+/// A large flexible body fills quadratically with KLU's own, a chain of flexible links
+/// quadratically with frames-and-multipliers-last (issue 24; the fills of every candidate:
+/// bench_spatial_scaling and bench_flexible_chain). Models without elastic coordinates (DaeProblem::eliminationGroups() without
 /// a group 0) keep KLU's own without trials.
 class KluOrdering {
  public:
@@ -34,6 +33,10 @@ class KluOrdering {
   /// Factors J = dF/dy + cj dF/dy' at (t0, y0, y0') with each candidate (allocates; once
   /// per integrator).
   static KluOrdering choose(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, double cj);
+  /// Every candidate with its trial fill (factorNonZeros, -1 where KLU failed), in the
+  /// order above; KLU's own alone (without a trial) for models without elastic
+  /// coordinates. choose() keeps the sparsest; the benchmarks print them all.
+  static std::vector<KluOrdering> trials(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, double cj);
 
   /// Sets `common`'s ordering, pivot threshold and block-triangular form. This object must
   /// outlive every klu_l_analyze with `common` (it holds the CAMD constraint set).
