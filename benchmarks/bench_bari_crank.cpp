@@ -18,6 +18,7 @@
 #include "benchmarks/bench_common.hpp"
 #include "benchmarks/problems/bari_crank.hpp"
 #include "integrators/initial_conditions.hpp"
+#include "integrators/radau_solver.hpp"
 #include "io/scene.hpp"
 
 using namespace flexmbd;
@@ -30,6 +31,7 @@ struct Config {
   bool engine = true;
   Formulation formulation = Formulation::Ggl;
   IntegratorKind integrator = IntegratorKind::Ida;
+  RadauStages stages{};  // the Radau IIA orders (integrator Radau5 or Radau)
 };
 
 struct Run {
@@ -57,10 +59,12 @@ struct EngineModel {
 };
 
 /// One timed integration from 0 to 0.1; CPU seconds of set-up + integration.
-double integrate(const DaeProblem& dae, IntegratorKind kind, const VecX& y0, const VecX& yp0,
+double integrate(const DaeProblem& dae, const Config& c, const VecX& y0, const VecX& yp0,
                  const IntegratorOptions& o, VecX& yEnd, IntegratorStats& stats) {
   const double c0 = cpuSeconds();
-  const auto integrator = makeIntegrator(kind, dae, 0.0, y0, yp0, o);
+  const bool radau = c.integrator == IntegratorKind::Radau5 || c.integrator == IntegratorKind::Radau;
+  const auto integrator = radau ? std::make_unique<RadauSolver>(dae, 0.0, y0, yp0, o, c.stages)
+                                : makeIntegrator(c.integrator, dae, 0.0, y0, yp0, o);
   integrator->advance(bari::kEndTime, bari::kEndTime);
   const double c1 = cpuSeconds();
   yEnd = integrator->y();
@@ -119,6 +123,13 @@ int main(int argc, char** argv) {
       {"engine_index1_radau5", true, Formulation::Index1, IntegratorKind::Radau5},
       {"hand_ida", false, Formulation::Ggl, IntegratorKind::Ida},
       {"hand_radau5", false, Formulation::Ggl, IntegratorKind::Radau5},
+      {"engine_index1_radau9", true, Formulation::Index1, IntegratorKind::Radau5, {5, 5, 5}},
+      {"engine_index1_radau13", true, Formulation::Index1, IntegratorKind::Radau5, {7, 7, 7}},
+      {"engine_index1_radau", true, Formulation::Index1, IntegratorKind::Radau, {3, 7, 3}},
+      {"engine_ggl_radau", true, Formulation::Ggl, IntegratorKind::Radau, {3, 7, 3}},
+      {"hand_radau9", false, Formulation::Ggl, IntegratorKind::Radau5, {5, 5, 5}},
+      {"hand_radau13", false, Formulation::Ggl, IntegratorKind::Radau5, {7, 7, 7}},
+      {"hand_radau", false, Formulation::Ggl, IntegratorKind::Radau, {3, 7, 3}},
   };
   if (!only.empty()) {
     std::vector<Config> kept;
@@ -166,14 +177,14 @@ int main(int argc, char** argv) {
             o.atol = absoluteTolerances(dae, s);
             VecX y0, yp0;
             dae.packState(engine.init.q, engine.init.v, engine.init.a, engine.init.lambda, y0, yp0);
-            r.cpu.push_back(integrate(dae, c.integrator, y0, yp0, o, yEnd, r.stats));
+            r.cpu.push_back(integrate(dae, c, y0, yp0, o, yEnd, r.stats));
             r.scd = bari::significantDigits(engine.positions(yEnd));
           } else {
             VecX atol = VecX::Constant(hand.size(), 1e10);  // w, lambda: algebraic
             atol.head(14).setConstant(tol);
             o.atol = atol;
             o.linearSolver = LinearSolverKind::Dense;  // 24 dense unknowns, as the classic codes
-            r.cpu.push_back(integrate(hand, c.integrator, handY0, handYp0, o, yEnd, r.stats));
+            r.cpu.push_back(integrate(hand, c, handY0, handYp0, o, yEnd, r.stats));
             r.scd = bari::significantDigits(bari::HandCodedCrank::positions(yEnd));
           }
         } catch (const std::exception& e) {
@@ -200,7 +211,7 @@ int main(int argc, char** argv) {
       std::printf("%-22s %8.0e %6.2f %10.3f %9ld %9ld %7ld %7ld %6ld %6ld%s\n", c.name.c_str(), tol,
                   r.ok ? r.scd : std::nan(""), ms, r.stats.steps, r.stats.residualEvals, r.stats.jacobianEvals,
                   r.stats.linearSetups, r.stats.errorTestFailures, r.stats.nonlinearConvFailures,
-                  r.ok ? "" : ("  FAILED: " + r.message.substr(0, 120)).c_str());
+                  r.ok ? "" : ("  FAILED: " + r.message).c_str());
       csv.row({c.name, sci(tol), fmt(r.scd), fmt(ms), std::to_string(r.stats.steps),
                std::to_string(r.stats.residualEvals), std::to_string(r.stats.jacobianEvals),
                std::to_string(r.stats.linearSetups), std::to_string(r.stats.errorTestFailures),

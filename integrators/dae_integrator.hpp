@@ -48,7 +48,8 @@ struct IntegratorStats {
 /// The time integrators.
 enum class IntegratorKind {
   Ida,     ///< SUNDIALS IDA: variable-order BDF (orders 1..5)
-  Radau5,  ///< Radau IIA of order 5, three stages (integrators/radau5_solver.hpp)
+  Radau5,  ///< Radau IIA of order 5, three stages (integrators/radau_solver.hpp)
+  Radau,   ///< Radau IIA of orders 5, 9 and 13, the order chosen per step (integrators/radau_solver.hpp)
   /// Index-3 augmented Lagrangian with projections, trapezoidal rule (order 2), stays
   /// regular at singular positions (integrators/augmented_lagrangian_integrator.hpp)
   AugmentedLagrangian,
@@ -57,7 +58,7 @@ enum class IntegratorKind {
   Automatic,
 };
 std::string toString(IntegratorKind k);
-/// "ida", "radau5", "ali3p", "auto". @throws InputError otherwise.
+/// "ida", "radau", "radau5", "ali3p", "auto". @throws InputError otherwise.
 IntegratorKind parseIntegrator(const std::string& name);
 
 /// A DAE integrator started from consistent y0, y0' at t0.

@@ -377,7 +377,7 @@ SolverSettings parseSolver(const json& j) {
     try {
       s.integrator = parseIntegrator(name);
     } catch (const InputError&) {
-      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: auto, ida, radau5, ali3p)");
+      r.fail("unknown integrator " + inQuotes(name) + " (expected one of: auto, ida, radau, radau5, ali3p)");
     }
   }
   if (r.has("formulation")) {
