@@ -94,16 +94,20 @@ TEST(IntegratorChoice, IdaOptionsKeepIda) {
   EXPECT_EQ(chooseIntegrator(s.system, s.solver).kind, IntegratorKind::Ida);
 }
 
-TEST(IntegratorChoice, ModalBodiesKeepIda) {
+TEST(IntegratorChoice, ModalBodiesGetIdaBelowAndRadauAboveTheOutputNyquistFrequency) {
   // The demo's 2-mode rod: modes up to 5.1e3 rad/s, below the Nyquist frequency 1.35e4 of
-  // its output step; Simeon's crank: a modal body (given invariants) whose modes (up to
-  // 2.5e4 rad/s) lie above its Nyquist frequency (3.1e3), kept with IDA all the same.
+  // its output step: IDA. Simeon's crank: a modal body (given invariants) whose modes (up
+  // to 2.5e4 rad/s) lie above its Nyquist frequency (3.1e3), kept by the model, so to be
+  // resolved over many periods: the variable-order Radau IIA.
   const Scene modal = exampleScene("slider_crank_elastic_demo_modal.json");
-  EXPECT_EQ(chooseIntegrator(modal.system, modal.solver).kind, IntegratorKind::Ida);
+  const IntegratorChoice m = chooseIntegrator(modal.system, modal.solver);
+  EXPECT_EQ(m.kind, IntegratorKind::Ida);
+  EXPECT_NE(m.reason.find("below the output Nyquist frequency"), std::string::npos) << m.reason;
   const Scene bari = exampleScene("bari_slider_crank.json");
   const IntegratorChoice c = chooseIntegrator(bari.system, bari.solver);
-  EXPECT_EQ(c.kind, IntegratorKind::Ida);
-  EXPECT_NE(c.reason.find("no nodal body"), std::string::npos) << c.reason;
+  EXPECT_EQ(c.kind, IntegratorKind::Radau);
+  EXPECT_NE(c.reason.find("kept by the model"), std::string::npos) << c.reason;
+  EXPECT_TRUE(c.energyWeights.empty());  // modes that are content keep their velocity tolerances
 }
 
 TEST(IntegratorChoice, NodalRodWithModesAboveTheOutputNyquistFrequencyGetsRadau) {
