@@ -29,8 +29,10 @@ struct Offsets {
   }
 };
 
-/// scd of a run of the engine's scene to t = 0.1 at rtol = tol, atol (default tol).
-double engineDigits(Formulation f, IntegratorKind integrator, double tol, std::optional<double> atol = {}) {
+/// scd of a run of the engine's scene to t = 0.1 at rtol = tol, atol (default tol); its
+/// step count in *steps when given.
+double engineDigits(Formulation f, IntegratorKind integrator, double tol, std::optional<double> atol = {},
+                    long* steps = nullptr) {
   Scene s = bariScene();
   s.solver.formulation = f;
   s.solver.integrator = integrator;
@@ -46,6 +48,7 @@ double engineDigits(Formulation f, IntegratorKind integrator, double tol, std::o
   VecX qEnd;
   const SimulationSummary sum = simulate(s.system, s.solver, [&](const OutputSample& o) { qEnd = o.q; });
   EXPECT_TRUE(sum.ok) << sum.message;
+  if (steps) *steps = sum.stats.steps;
   return bari::significantDigits(off.positions(qEnd));
 }
 
@@ -145,6 +148,22 @@ TEST(BariCrank, GglReachesEightDigitsAtTightTolerances) {
   const double scd = engineDigits(Formulation::Ggl, IntegratorKind::Ida, 1e-12, 1e-14);
   std::printf("[ measured ] engine ggl IDA rtol 1e-12, atol 1e-14: scd %.2f\n", scd);
   EXPECT_GT(scd, kTightDigits);
+}
+
+TEST(BariCrank, HigherRadauOrdersReachTheReferenceInFarFewerSteps) {
+  // The rod's undamped modes (up to 2.5e4 rad/s, 390 periods of the fastest in 0.1 s) are
+  // resolved, not damped, at these tolerances: orders 9 and 13 take far longer steps than
+  // order 5 for the same accuracy. Measured at tol 1e-8 (GGL): radau5 15,500 steps, scd
+  // 7.9; radau 1,500 steps, scd 8.8 (bench_bari_crank). Bounds: a fifth of the steps, and
+  // no digit lost beyond 0.3 (the scd of neighbouring tolerances differ by about 1).
+  constexpr double kStepRatio = 5.0, kDigitSlack = 0.3;
+  long steps5 = 0, steps = 0;
+  const double scd5 = engineDigits(Formulation::Ggl, IntegratorKind::Radau5, 1e-8, {}, &steps5);
+  const double scd = engineDigits(Formulation::Ggl, IntegratorKind::Radau, 1e-8, {}, &steps);
+  std::printf("[ measured ] engine ggl tol 1e-8: radau5 %ld steps, scd %.2f; radau %ld steps, scd %.2f\n", steps5, scd5,
+              steps, scd);
+  EXPECT_LT(kStepRatio * steps, steps5);
+  EXPECT_GT(scd, scd5 - kDigitSlack);
 }
 
 TEST(BariCrank, AbsoluteTolerancesByCoordinateClass) {
