@@ -90,15 +90,24 @@ VecX FfrBody2d::initialVelocities() const {
   return v;
 }
 
-Eigen::Matrix3d FfrBody2d::frameMass(const ConstVecRef& q) const {
+namespace {
+
+/// The frame-frame mass block at the rotation A = A(theta) the caller has computed.
+template <class Qf>
+Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const Mat2& A, const Qf& qf) {
   // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T m_ff qf
-  const auto qf = q.tail(numElastic());
-  const Vec2 sas = perp(rotation(q[2]) * (inv_.firstMoment + inv_.sBar * qf));
+  const Vec2 sas = perp(A * (inv.firstMoment + inv.sBar * qf));
   Eigen::Matrix3d M;
-  M << inv_.mass, 0.0, sas.x(),  //
-      0.0, inv_.mass, sas.y(),   //
-      sas.x(), sas.y(), inv_.polarMoment + 2.0 * inv_.i1.dot(qf) + bilinear(inv_.mff, qf, qf);
+  M << inv.mass, 0.0, sas.x(),  //
+      0.0, inv.mass, sas.y(),   //
+      sas.x(), sas.y(), inv.polarMoment + 2.0 * inv.i1.dot(qf) + bilinear(inv.mff, qf, qf);
   return M;
+}
+
+}  // namespace
+
+Eigen::Matrix3d FfrBody2d::frameMass(const ConstVecRef& q) const {
+  return frameMassAt(inv_, rotation(q[2]), q.tail(numElastic()));
 }
 
 Eigen::Vector3d FfrBody2d::frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const {
@@ -113,7 +122,7 @@ void FfrBody2d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
   const int nf = numElastic();
   const auto qf = q.tail(nf);
   const Mat2 A = rotation(q[2]);
-  M.addBlock(0, 0, frameMass(q));
+  M.addBlock(0, 0, frameMassAt(inv_, A, qf));
   for (int k = 0; k < nf; ++k) M.addBlock(0, 3 + k, frameElasticMassColumn(A, qf, k));
   for (int j = 0; j < 3; ++j) {
     M.addColumn(3, j, nf, [&](int k) { return frameElasticMassColumn(A, qf, k)[j]; });
@@ -130,7 +139,7 @@ void FfrBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   Eigen::Vector3d mrf;
   mrf.head<2>() = A * (inv_.sBar * af);
   mrf[2] = inv_.j0.dot(af) + bilinear(inv_.sTilde, qf, af);
-  out.head<3>() += frameMass(q) * a.head<3>() + mrf;
+  out.head<3>() += frameMassAt(inv_, A, qf) * a.head<3>() + mrf;
   // elastic rows: M_fr a_r + m_ff a_f = S-bar^T A^T a_R + (J0 + S~^T qf) a_t + m_ff a_f
   auto of = out.tail(nf);
   of.noalias() += inv_.sBar.transpose() * (A.transpose() * a.head<2>());

@@ -20,7 +20,11 @@ namespace flexmbd {
 struct BodyState {
   BodyState(const Body& b, const double* data, const std::vector<int>* used = nullptr,
             const std::vector<int>* usedCoordinates = nullptr)
-      : body(b), q(data, b.numCoordinates()), cols(used), qcols(usedCoordinates ? usedCoordinates : used) {}
+      : BodyState(b, data, b.numCoordinates(), used, usedCoordinates) {}
+  /// The same with the body's number of coordinates known (System caches it: no virtual call).
+  BodyState(const Body& b, const double* data, int numCoordinates, const std::vector<int>* used,
+            const std::vector<int>* usedCoordinates)
+      : body(b), q(data, numCoordinates), cols(used), qcols(usedCoordinates ? usedCoordinates : used) {}
   const Body& body;
   Eigen::Map<const VecX> q;
   const std::vector<int>* cols;
@@ -60,6 +64,12 @@ class BodyStates {
            const std::vector<int>* usedCoordinates = nullptr) {
     if (n_ == kMaxBodies) throw std::logic_error("BodyStates: more than kMaxBodies bodies");
     states_[n_++].emplace(b, q, used, usedCoordinates);
+  }
+  /// The same with the body's number of coordinates given (System: cached at finalize).
+  void add(const Body& b, const double* q, int numCoordinates, const std::vector<int>* used,
+           const std::vector<int>* usedCoordinates) {
+    if (n_ == kMaxBodies) throw std::logic_error("BodyStates: more than kMaxBodies bodies");
+    states_[n_++].emplace(b, q, numCoordinates, used, usedCoordinates);
   }
   int size() const { return n_; }
   const BodyState& operator[](int k) const { return *states_[k]; }

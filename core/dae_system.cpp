@@ -20,6 +20,57 @@ double columnDot(const MatX& G, int k, const double* x) {
   return s;
 }
 
+/// The GGL residual's terms of one constraint in one pass over the columns k of its G
+/// (m x n, column-major): Fv[c_k] += G_k . lambda, DGtmu[c_k] += D_c G_k . mu, Fcv += G_k v_c.
+/// Each sum in the order of the separate loops it replaces (the same round-off).
+struct GglColumns {
+  const double* G;
+  const int* cols;
+  int n;
+  const double *lambda, *mu, *v, *metric;
+  double *Fv, *DGtmu, *Fcv;
+  /// M: the number of equations m if known at compile time (unrolled, kept in registers), else 0.
+  template <int M>
+  void run(int m) const {
+    constexpr int kCap = M > 0 ? M : 1;
+    if (M == 0) {
+      const double* g = G;
+      for (int k = 0; k < n; ++k, g += m) {
+        const int c = cols[k];
+        double gl = 0.0, gm = 0.0;
+        for (int a = 0; a < m; ++a) {
+          gl += g[a] * lambda[a];
+          gm += g[a] * mu[a];
+          Fcv[a] += g[a] * v[c];
+        }
+        Fv[c] += gl;
+        DGtmu[c] += metric[c] * gm;
+      }
+      return;
+    }
+    double l[kCap], u[kCap], f[kCap];
+    for (int a = 0; a < M; ++a) {
+      l[a] = lambda[a];
+      u[a] = mu[a];
+      f[a] = Fcv[a];
+    }
+    const double* g = G;
+    for (int k = 0; k < n; ++k, g += M) {
+      const int c = cols[k];
+      const double vk = v[c];
+      double gl = 0.0, gm = 0.0;
+      for (int a = 0; a < M; ++a) {
+        gl += g[a] * l[a];
+        gm += g[a] * u[a];
+        f[a] += g[a] * vk;
+      }
+      Fv[c] += gl;
+      DGtmu[c] += metric[c] * gm;
+    }
+    for (int a = 0; a < M; ++a) Fcv[a] = f[a];
+  }
+};
+
 /// Global indices of a constraint's or force's columns in ascending order, with where
 /// each comes from: the rows of its blocks, written by one merge walk per column
 /// (a constraint's columns are ascending within a body, not across its bodies).
@@ -105,6 +156,9 @@ struct DaeSystemScratch final : DaeScratch {
   std::vector<ForceScratch> forces;
   VecX qPlus, qMinus;           ///< perturbed coordinates (index-1 Jacobian)
   VecX DGtmu, w, Tv, TvPlus;    ///< D G^T mu and w = D G^T mu - v (nv); T v (nq)
+  /// Where the Jacobian's entries go in the DAE's pattern, in assembly order (recorded by
+  /// the first assembly, replayed by the next: no search per entry).
+  JacobianPositions positions;
 };
 
 DaeSystemScratch& scratchOf(DaeScratch& s) {
@@ -378,6 +432,8 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     S.DGtmu.setZero();
   }
   Fv.setZero();
+  // without gravity its terms are zero: not evaluated (a rotation and a pass per body)
+  const bool withGravity = sys.gravity() != Vec3::Zero();
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
     const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
@@ -388,7 +444,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     VecX& Qb = S.bodyForce[b];
     Qb.setZero();
     body.addInternalForces(qb, v.segment(voff, nvb), Qb);
-    body.addGravityForce(qb, sys.gravity(), Qb);
+    if (withGravity) body.addGravityForce(qb, sys.gravity(), Qb);
     Fv.segment(voff, nvb) -= Qb;
     body.addMassTimes(qb, vp.segment(voff, nvb), Fv.segment(voff, nvb));
   }
@@ -413,28 +469,32 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     con.evaluate(sys.constraintStates(ci, q.data()), needH, cs.ev);
     // joints prescribe nothing: their f, f', f'' stay the zeros makeScratch set
     if (sys.constraintIsDriver(ci)) con.timeFunction(t, cs.f, cs.df, cs.ddf);
-    // F_v += G^T lambda (G is m_c x n_c, a few entries: plain loops beat Eigen's GEMV)
+    // F_v += G^T lambda (G is m_c x n_c, a few entries: plain loops beat Eigen's GEMV;
+    // GGL takes it in its one pass over G below)
     const double* lambda = y + L.lambda + row;
-    for (int k = 0; k < nl; ++k) Fv[cols[k]] += columnDot(ev.G, k, lambda);
+    if (formulation_ != Formulation::Ggl) {
+      for (int k = 0; k < nl; ++k) Fv[cols[k]] += columnDot(ev.G, k, lambda);
+    }
     Eigen::Map<VecX> Fc(F + L.lambda + row, me);
     switch (formulation_) {
       case Formulation::Ggl: {
-        // F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f'
+        // F_v += G^T lambda;  F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f': one pass
+        // over the columns of G
         const double* mu = y + L.mu + row;
         if (const double period = sys.constraintPeriod(ci); period > 0.0) {
           for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
         }
-        if (identityT) {
-          for (int k = 0; k < nl; ++k) Fq[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
-        } else {
-          for (int k = 0; k < nl; ++k) S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
-        }
         Fc = ev.h - cs.f;
         double* Fcv = F + L.mu + row;
         for (int a = 0; a < me; ++a) Fcv[a] = -cs.df[a];
-        for (int k = 0; k < nl; ++k) {
-          const double vk = v[cols[k]];
-          for (int a = 0; a < me; ++a) Fcv[a] += ev.G(a, k) * vk;
+        double* DGtmu = identityT ? Fq.data() : S.DGtmu.data();  // F_q at once with T = I
+        const GglColumns pass{ev.G.data(), cols.data(), nl, lambda, mu, v.data(), metric_.data(), Fv.data(), DGtmu,
+                              Fcv};
+        switch (me) {  // the usual sizes unrolled
+          case 1: pass.run<1>(me); break;
+          case 2: pass.run<2>(me); break;
+          case 3: pass.run<3>(me); break;
+          default: pass.run<0>(me); break;
         }
         break;
       }
@@ -475,15 +535,19 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
 }
 
 template <bool IdentityT>
-void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& J,
+void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& sink,
                              DaeScratch& scratch) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
+  // into the DAE's own pattern, the entries' positions as the last assembly found them
+  JacobianSink positioned = sink.pattern() == &pattern_ ? sink.withPositions(S.positions) : sink;
+  JacobianSink& J = positioned;
   constexpr bool identityT = IdentityT;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), vp(yp + L.v, L.nv);
   // F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body; F_q = q' - T w:
   // cj I and -T (with T = I: -I)
+  const bool withGravity = sys.gravity() != Vec3::Zero();  // else its terms are zero
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
     const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
@@ -511,7 +575,7 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
     const MatrixSink cjM(J, L.v + voff, L.v + voff, cj), minusJv(J, L.v + voff, L.v + voff, -1.0);
     body.addMassMatrixDerivative(qb, vp.segment(voff, nvb), Jq);
     body.addInternalForceJacobians(qb, v.segment(voff, nvb), minusJq, minusJv);
-    body.addGravityJacobian(qb, sys.gravity(), minusJq);
+    if (withGravity) body.addGravityJacobian(qb, sys.gravity(), minusJq);
     body.addMassMatrix(qb, cjM);
   }
   for (int f = 0; f < sys.numForces(); ++f) {

@@ -255,21 +255,26 @@ VecX System::coordinateRates(const VecX& q, const VecX& v) const {
 BodyStates System::states(const std::vector<BodyIndex>& bs, const std::vector<std::vector<int>>& used,
                           const std::vector<std::vector<int>>& usedQ, const double* q) const {
   BodyStates out;
+  // indices valid after finalize (the callers' checks): no bounds checks, no virtual calls
   for (size_t slot = 0; slot < bs.size(); ++slot) {
-    out.add(body(bs[slot]), q + bodyOffset_[bs[slot].value], &used[slot], &usedQ[slot]);
+    const int b = bs[slot].value;
+    out.add(*bodies_[b], q + bodyOffset_[b], bodyNq_[b], &used[slot], &usedQ[slot]);
   }
   return out;
 }
 
 BodyStates System::constraintStates(ConstraintIndex i, const double* q) const {
-  BodyStates out = states(constraint(i).bodies(), constraintUsed_.at(i.value), constraintUsedQ_.at(i.value), q);
+  if (static_cast<size_t>(i.value) >= constraintUsed_.size()) requireFinalized("constraintStates");
+  BodyStates out =
+      states(constraints_.at(i.value)->bodies(), constraintUsed_[i.value], constraintUsedQ_[i.value], q);
   const std::vector<int>& ids = constraintPointIds_[i.value];
   out.setPointIds(ids.data(), static_cast<int>(ids.size()));
   return out;
 }
 
 BodyStates System::forceStates(ForceIndex i, const double* q) const {
-  BodyStates out = states(force(i).bodies(), forceUsed_.at(i.value), forceUsedQ_.at(i.value), q);
+  if (static_cast<size_t>(i.value) >= forceUsed_.size()) requireFinalized("forceStates");
+  BodyStates out = states(forces_.at(i.value)->bodies(), forceUsed_[i.value], forceUsedQ_[i.value], q);
   const std::vector<int>& ids = forcePointIds_[i.value];
   out.setPointIds(ids.data(), static_cast<int>(ids.size()));
   return out;

@@ -5,19 +5,31 @@
 namespace flexmbd {
 
 void makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians, PointPair& p) {
+  // d = r_j - r_i, D = [-Jr_i, Jr_j]; Jphi_i, Jphi_j on their own body's columns
   p.ni = pi.numCoordinates();
   p.nj = pj.numCoordinates();
   const int n = p.n(), ni = p.ni, nj = p.nj;
   p.d = pj.r - pi.r;
-  p.D.resize(2, n);
-  p.D.leftCols(ni) = -pi.Jr;
-  p.D.rightCols(nj) = pj.Jr;
   p.phiI = pi.phi;
   p.phiJ = pj.phi;
-  p.JphiI.setZero(n);
-  p.JphiJ.setZero(n);
-  p.JphiI.head(ni) = pi.Jphi;
-  p.JphiJ.tail(nj) = pj.Jphi;
+  // raw loops over the few columns (of sizes known only at run time): Eigen's block
+  // assignments cost more in set-up than in copying here
+  p.D.resize(2, n);
+  p.JphiI.resize(n);
+  p.JphiJ.resize(n);
+  double* D = p.D.data();
+  const double* Ji = pi.Jr.data();
+  const double* Jj = pj.Jr.data();
+  for (int k = 0; k < 2 * ni; ++k) D[k] = -Ji[k];
+  for (int k = 0; k < 2 * nj; ++k) D[2 * ni + k] = Jj[k];
+  for (int k = 0; k < ni; ++k) {
+    p.JphiI[k] = pi.Jphi[k];
+    p.JphiJ[k] = 0.0;
+  }
+  for (int k = 0; k < nj; ++k) {
+    p.JphiI[ni + k] = 0.0;
+    p.JphiJ[ni + k] = pj.Jphi[k];
+  }
   if (!withHessians) return;
   for (MatX* H : {&p.Hdx, &p.Hdy, &p.HphiI, &p.HphiJ}) H->setZero(n, n);
   p.Hdx.topLeftCorner(ni, ni) = -pi.Hrx;

@@ -670,5 +670,40 @@ INSTANTIATE_TEST_SUITE_P(Formulations, DaeJacobian,
                            return toString(info.param);
                          });
 
+TEST(JacobianPositions, ReplayedPositionsMatchSearchesAndSurviveAChangedOrder) {
+  // A 4 x 4 pattern; the same entries written with positions recorded and replayed, then
+  // in another order (and fewer), against the same writes searched entry by entry.
+  const SparsePattern p(4, {{0, 0}, {1, 0}, {3, 0}, {2, 1}, {0, 2}, {2, 2}, {3, 2}, {1, 3}, {3, 3}});
+  const auto writeA = [](JacobianSink& J) {
+    J.add(0, 0, 1.0);
+    const int rows[] = {0, 2, 3};
+    const double vals[] = {2.0, 3.0, 4.0};
+    J.addColumn(2, 0, rows, vals, 3, 0.5);
+    J.addColumnSegment(3, 1, 1, [](int) { return 5.0; }, 2.0);
+    J.add(3, 0, -1.0);
+  };
+  const auto writeB = [](JacobianSink& J) {  // another order, one entry fewer
+    J.add(2, 1, 7.0);
+    J.add(0, 0, 1.5);
+    const int rows[] = {1, 3};
+    const double vals[] = {6.0, 8.0};
+    J.addColumn(0, 0, rows, vals, 2, 1.0);
+  };
+  JacobianPositions positions;
+  for (const auto& write : {std::function<void(JacobianSink&)>(writeA), std::function<void(JacobianSink&)>(writeA),
+                            std::function<void(JacobianSink&)>(writeB), std::function<void(JacobianSink&)>(writeA)}) {
+    std::vector<double> searched(p.nonZeros(), 0.0), replayed(p.nonZeros(), 0.0);
+    JacobianSink plain = JacobianSink::sparse(searched.data(), p);
+    write(plain);
+    JacobianSink positioned = JacobianSink::sparse(replayed.data(), p).withPositions(positions);
+    write(positioned);
+    EXPECT_EQ(searched, replayed);
+  }
+  // an entry outside the pattern is still refused
+  std::vector<double> values(p.nonZeros(), 0.0);
+  JacobianSink J = JacobianSink::sparse(values.data(), p).withPositions(positions);
+  EXPECT_THROW(J.add(1, 1, 1.0), std::logic_error);
+}
+
 }  // namespace
 }  // namespace flexmbd
