@@ -1,4 +1,4 @@
-// How the engine sets up KLU for its DAE Jacobians (used by IdaSolver, Radau5Solver and
+// How the engine sets up KLU for its DAE Jacobians (used by IdaSolver, RadauSolver and
 // the micro-benchmarks, so all factor the same way).
 #pragma once
 
