@@ -271,8 +271,31 @@ DaeSystem::DaeSystem(const System& sys, Formulation formulation)
     : DaeSystem(sys, formulation, defaultStabilisationMetric(sys)) {}
 
 DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric)
-    : sys_(sys), formulation_(formulation), metric_(std::move(stabilisationMetric)) {
+    : DaeSystem(sys, formulation, std::move(stabilisationMetric), {}) {}
+
+DaeSystem::DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric, std::vector<int> released)
+    : sys_(sys), formulation_(formulation), metric_(std::move(stabilisationMetric)), released_(std::move(released)) {
   if (!sys.isFinalized()) throw InputError("DaeSystem: the system must be finalized first");
+  keptRows_.assign(sys.numConstraints(), {});
+  partial_.assign(sys.numConstraints(), 0);
+  for (size_t k = 0; k < released_.size(); ++k) {
+    const int r = released_[k];
+    if (r < 0 || r >= sys.numConstraintEquations() || (k > 0 && r <= released_[k - 1])) {
+      throw InputError("DaeSystem: released constraint equations must be ascending indices below " +
+                       std::to_string(sys.numConstraintEquations()) + ", got " + std::to_string(r));
+    }
+  }
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const ConstraintIndex ci(c);
+    const int row = sys.constraintOffset(ci), me = sys.constraint(ci).numEquations();
+    for (int a = 0; a < me; ++a) {
+      if (std::binary_search(released_.begin(), released_.end(), row + a)) {
+        partial_[c] = 1;
+      } else {
+        keptRows_[c].push_back(a);
+      }
+    }
+  }
   if (metric_.size() != sys.numVelocities() || !(metric_.minCoeff() > 0.0) || !metric_.allFinite()) {
     throw InputError("DaeSystem: the stabilisation metric must have one positive entry per velocity");
   }
@@ -361,7 +384,7 @@ std::unique_ptr<DaeScratch> DaeSystem::makeScratch() const {
     cs.dFdq.resize(me, nql);
     cs.vRows = SortedIndex(sys.constraintColumns(ci));
     cs.qRows = SortedIndex(sys.constraintCoordinateColumns(ci));
-    cs.column.resize(std::max(nl, nql));
+    cs.column.resize(std::max({nl, nql, me}));
   }
   s->forces.resize(sys.numForces());
   for (int f = 0; f < sys.numForces(); ++f) {
@@ -521,6 +544,11 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
       }
     }
   }
+  // released equations: lambda_k = 0 (and mu_k = 0) in place of their constraint rows
+  for (const int r : released_) {
+    F[L.lambda + r] = y[L.lambda + r];
+    if (L.mu >= 0) F[L.mu + r] = y[L.mu + r];
+  }
   if (!identityT) {
     S.w = S.DGtmu - v;  // F_q = q' + T (D G^T mu - v)
     for (int b = 0; b < sys.numBodies(); ++b) {
@@ -531,6 +559,17 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
       body.addCoordinateRate(q.segment(qoff, nqb), S.w.segment(sys.velocityOffset(bi), body.numVelocities()),
                              Fq.segment(qoff, nqb));
     }
+  }
+}
+
+void DaeSystem::addConstraintRows(JacobianSink& J, int c, int row0, int colOffset, const std::vector<int>& cols,
+                                  const MatX& B, VecX& buf) const {
+  if (!partial_[c]) return addRowsBlock(J, row0, colOffset, cols, B);
+  const std::vector<int>& kept = keptRows_[c];
+  const int n = static_cast<int>(kept.size());
+  for (size_t j = 0; j < cols.size(); ++j) {
+    for (int i = 0; i < n; ++i) buf[i] = B(kept[i], static_cast<Eigen::Index>(j));
+    J.addColumn(colOffset + cols[j], row0, kept.data(), buf.data(), n, 1.0);
   }
 }
 
@@ -624,7 +663,7 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
           cs.TGt.resize(nl, me);  // (D G^T)
           for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
           addBlock(J, L.q, cs.vRows, L.mu + row, cs.TGt, cs.column);
-          addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+          addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
         } else {
           const double* mu = y + L.mu + row;
           for (int k = 0; k < nl; ++k) {
@@ -639,18 +678,18 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
           addBlock(J, L.q, cs.qRows, L.mu + row, cs.TDG, cs.column);
           // F_g = h - f: dh/dq = G T+
           cs.dFdq.noalias() = ev.G * cs.Til;
-          addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
+          addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
         }
-        addRowsBlock(J, L.mu + row, L.q, qcols, cs.vH);
-        addRowsBlock(J, L.mu + row, L.v, cols, ev.G);
+        addConstraintRows(J, c, L.mu + row, L.q, qcols, cs.vH, cs.column);
+        addConstraintRows(J, c, L.mu + row, L.v, cols, ev.G, cs.column);
         break;
       }
       case Formulation::Index3:
         if (identityT) {
-          addRowsBlock(J, L.lambda + row, L.q, cols, ev.G);
+          addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
         } else {
           cs.dFdq.noalias() = ev.G * cs.Til;
-          addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
+          addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
         }
         break;
       case Formulation::Index1: {
@@ -690,11 +729,11 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
           }
           S.qPlus[qc] = S.qMinus[qc] = q[qc];
         }
-        addRowsBlock(J, L.lambda + row, L.q, qcols, cs.dFdq);
+        addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
         if (identityT) {
           cs.vH *= 2.0;
           cs.vH += cj * ev.G;
-          addRowsBlock(J, L.lambda + row, L.v, cols, cs.vH);
+          addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.vH, cs.column);
         } else {
           gather(qcols, S.Tv.data(), cs.wl);
           cs.dFdv.resize(me, nl);
@@ -704,11 +743,16 @@ void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double
             cs.dFdv.row(a) += cs.Hv.transpose();
           }
           cs.dFdv += cj * ev.G;
-          addRowsBlock(J, L.lambda + row, L.v, cols, cs.dFdv);
+          addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.dFdv, cs.column);
         }
         break;
       }
     }
+  }
+  // released equations: d(lambda_k)/d(lambda_k) = 1 (and d(mu_k)/d(mu_k) = 1)
+  for (const int r : released_) {
+    J.add(L.lambda + r, L.lambda + r, 1.0);
+    if (L.mu >= 0) J.add(L.mu + r, L.mu + r, 1.0);
   }
   if (!identityT) {
     // F_q = q' + T(q) w, w = D G^T mu - v: the dT/dq term at fixed w

@@ -55,7 +55,14 @@ class DaeSystem final : public DaeProblem {
   /// GGL with the stabilisation metric D (diagonal, nv, positive): F_q = q' - T (v - D G^T mu).
   /// The first constructor takes defaultStabilisationMetric(sys).
   DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric);
+  /// With the constraint equations `released` (ascending; redundant constraints resolved,
+  /// docs/formulations.md): each one's rows F_g (and F_gv of GGL) become lambda_k = 0
+  /// (and mu_k = 0); the size and the other rows are unchanged.
+  /// @throws InputError if a released index is out of range or not ascending.
+  DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric, std::vector<int> released);
   const VecX& stabilisationMetric() const { return metric_; }
+  /// The released constraint equations (ascending; empty: none).
+  const std::vector<int>& releasedEquations() const { return released_; }
 
   const System& system() const { return sys_; }
   Formulation formulation() const { return formulation_; }
@@ -99,6 +106,14 @@ class DaeSystem final : public DaeProblem {
   DaeLayout layout_;
   SparsePattern pattern_;
   VecX metric_;  ///< D of the GGL stabilisation (nv)
+  std::vector<int> released_;  ///< released constraint equations, ascending
+  /// Per constraint with released equations: its kept local rows (ascending); empty
+  /// vector and partial_ false for a constraint with none released.
+  std::vector<std::vector<int>> keptRows_;
+  std::vector<char> partial_;
+  /// J(row0 + i, colOffset + cols[j]) += B(i, j) over the kept rows i of constraint c.
+  void addConstraintRows(JacobianSink& J, int c, int row0, int colOffset, const std::vector<int>& cols,
+                         const MatX& B, VecX& buf) const;
   /// Per body with T != I: the structural non-zeros of T (nq x nv) and T+ (nv x nq), each in
   /// a square pattern of size nq (empty for T = I). Built once: a body's T is sparse (the
   /// identity on elastic coordinates), and assembling it densely made the Jacobian pattern

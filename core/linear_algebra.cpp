@@ -22,6 +22,28 @@ std::vector<int> dependentRows(const MatX& A, double rankTolerance) {
   return dependent;
 }
 
+MatX withoutRows(const MatX& A, const std::vector<int>& rows) {
+  MatX B(A.rows() - static_cast<Eigen::Index>(rows.size()), A.cols());
+  size_t k = 0;
+  Eigen::Index out = 0;
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    if (k < rows.size() && rows[k] == i) {
+      ++k;
+    } else {
+      B.row(out++) = A.row(i);
+    }
+  }
+  return B;
+}
+
+VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolerance) {
+  // minimum-norm solution of G^T l = b by a complete orthogonal decomposition (Golub & Van Loan, 4th ed., 5.5.4)
+  Eigen::CompleteOrthogonalDecomposition<MatX> cod;
+  cod.setThreshold(rankTolerance);
+  cod.compute(G.transpose());
+  return cod.solve(G.transpose() * lambda);
+}
+
 MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent) {
   const int r = static_cast<int>(C.rows()), n = static_cast<int>(C.cols());
   const Eigen::FullPivLU<MatX> lu(C);

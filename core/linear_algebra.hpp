@@ -20,6 +20,16 @@ inline void gather(const std::vector<int>& cols, const double* x, VecX& out) {
 /// name the constraint the user added last.
 std::vector<int> dependentRows(const MatX& A, double rankTolerance = 1e-9);
 
+/// A without the rows listed in `rows` (ascending): the independent rows of a constraint
+/// Jacobian whose dependent rows are released.
+MatX withoutRows(const MatX& A, const std::vector<int>& rows);
+
+/// The minimum-norm multipliers of the full set G (m x n) with the same resultant as
+/// lambda: argmin |l| subject to G^T l = G^T lambda (a redundant set's reactions are not
+/// unique; this choice spreads the load evenly over the dependent rows). Rows of G whose
+/// pivots fall below rankTolerance times the largest count as dependent, as in dependentRows.
+VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolerance = 1e-9);
+
 /// Basis B of the null space of the full-row-rank matrix C (r x n), chosen so that
 /// B keeps as many unit columns as possible: C = [C_d C_i] (d: r pivot columns of
 /// a full-pivoting LU), q_d = -C_d^{-1} C_i q_i, B = P [-C_d^{-1} C_i; I].

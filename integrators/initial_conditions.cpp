@@ -19,8 +19,24 @@ constexpr double kConsistentRows = 1e-8;
 /// Above this size the augmented system is solved with a sparse LU.
 constexpr int kDenseAugmentedLimit = 200;
 
-void throwIfRedundant(const System& sys, const MatX& G) {
-  const std::vector<int> rows = dependentRows(G);
+/// The rows of G not released (dependent on earlier ones) as rows of the full G, ascending.
+std::vector<int> dependentUnreleasedRows(const MatX& G, const std::vector<int>& released) {
+  if (released.empty()) return dependentRows(G);
+  std::vector<int> kept;
+  for (int i = 0, k = 0; i < G.rows(); ++i) {
+    if (k < static_cast<int>(released.size()) && released[k] == i) {
+      ++k;
+    } else {
+      kept.push_back(i);
+    }
+  }
+  std::vector<int> rows = dependentRows(withoutRows(G, released));
+  for (int& r : rows) r = kept[r];
+  return rows;
+}
+
+void throwIfRedundant(const System& sys, const MatX& G, const std::vector<int>& released) {
+  const std::vector<int> rows = dependentUnreleasedRows(G, released);
   if (rows.empty()) return;
   std::ostringstream os;
   os << "redundant or conflicting constraints: ";
@@ -114,25 +130,33 @@ std::string massDiagonalReport(const System& sys, const MatX& M) {
 }  // namespace
 
 void computeAccelerations(const System& sys, double t, const VecX& q, const VecX& v, VecX& a,
-                          VecX& lambda) {
-  const VecX Q = generalizedForces(sys, t, q, v), rhs = accelerationConstraintRhs(sys, q, v, t);
+                          VecX& lambda, const std::vector<int>& released) {
+  const VecX Q = generalizedForces(sys, t, q, v);
+  const VecX rhs = withoutRows(accelerationConstraintRhs(sys, q, v, t), released);
+  VecX kept;  // the multipliers of the rows not released
   try {
     // the same component loops into a dense array for small systems, sparse triplets above
     const int n = sys.numVelocities();
-    if (n + sys.numConstraintEquations() <= kDenseAugmentedLimit) {
-      solveAugmented(denseAugmentedMatrix(sys, q), n, Q, rhs, a, lambda);
+    if (!released.empty()) {
+      MatX G;
+      evaluateConstraints(sys, q, t, nullptr, &G);
+      solveAugmented(massMatrix(sys, q), withoutRows(G, released), Q, rhs, a, kept);
+    } else if (n + sys.numConstraintEquations() <= kDenseAugmentedLimit) {
+      solveAugmented(denseAugmentedMatrix(sys, q), n, Q, rhs, a, kept);
     } else {
-      solveAugmented(augmentedMatrix(sys, q), n, Q, rhs, a, lambda);
+      solveAugmented(augmentedMatrix(sys, q), n, Q, rhs, a, kept);
     }
   } catch (const ModelError& e) {
     // singular: the dense arrays for the diagnosis (rank of G) and the projection
-    MatX G;
-    evaluateConstraints(sys, q, t, nullptr, &G);
+    MatX Gfull;
+    evaluateConstraints(sys, q, t, nullptr, &Gfull);
+    const MatX G = withoutRows(Gfull, released);
     const MatX M = massMatrix(sys, q);
-    const std::vector<int> rows = dependentRows(G);
+    const std::vector<int> rows = dependentUnreleasedRows(Gfull, released);
     // At a singular position the accelerations are still unique (M is regular) when the
     // constraint rows agree: a = M^-1 (Q - G^T lambda) with the minimum-norm multipliers of
     // (G M^-1 G^T) lambda = G M^-1 Q - rhs (the mass-orthogonal projection of M^-1 Q).
+    bool solved = false;
     if (!rows.empty()) {
       const Eigen::LDLT<MatX> Mf(M);
       if (Mf.info() == Eigen::Success) {
@@ -144,28 +168,47 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
         const double scale = (G * MiQ).cwiseAbs().maxCoeff() + rhs.cwiseAbs().maxCoeff() + 1.0;
         if (acc.allFinite() && l.allFinite() && (G * acc - rhs).cwiseAbs().maxCoeff() <= kConsistentRows * scale) {
           a = acc;
-          lambda = l;
-          return;
+          kept = l;
+          solved = true;
         }
       }
     }
-    std::string rank;
-    for (size_t k = 0; k < rows.size(); ++k) rank += (k ? "; " : "") + sys.describeEquation(rows[k]);
-    throw ModelError(e.what() + massDiagonalReport(sys, M) +
-                     (rows.empty() ? std::string("; the constraint Jacobian has full rank")
-                                   : "; dependent constraint rows: " + rank));
+    if (!solved) {
+      std::string rank;
+      for (size_t k = 0; k < rows.size(); ++k) rank += (k ? "; " : "") + sys.describeEquation(rows[k]);
+      throw ModelError(e.what() + massDiagonalReport(sys, M) +
+                       (rows.empty() ? std::string("; the constraint Jacobian has full rank")
+                                     : "; dependent constraint rows: " + rank));
+    }
+  }
+  if (released.empty()) {
+    lambda = std::move(kept);
+    return;
+  }
+  lambda = VecX::Zero(sys.numConstraintEquations());
+  for (int i = 0, k = 0, r = 0; i < lambda.size(); ++i) {
+    if (k < static_cast<int>(released.size()) && released[k] == i) {
+      ++k;
+    } else {
+      lambda[i] = kept[r++];
+    }
   }
 }
 
-ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0, const VecX& v0) {
+ConsistentState computeConsistentState(const System& sys, double t0, const VecX& q0, const VecX& v0,
+                                       const ReleasedEquations& released) {
   const int nv = sys.numVelocities(), m = sys.numConstraintEquations();
   ConsistentState s;
   s.q = q0;
   VecX g;
   MatX G;
   evaluateConstraints(sys, s.q, t0, &g, &G);
-  // Redundancy is a property of the model: check it where the user put it.
-  throwIfRedundant(sys, G);
+  // Redundancy is a property of the model: check it where the user put it (released
+  // equations are detected where the mechanism is assembled, below).
+  if (!released.detect) {
+    s.released = released.rows;
+    throwIfRedundant(sys, G, s.released);
+  }
   // Elastic coordinates keep their given values when the frame coordinates alone can
   // satisfy the constraints (a body is not deformed, nor set vibrating, to assemble the
   // mechanism); otherwise every coordinate takes part.
@@ -175,7 +218,8 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     for (size_t k = 0; k < cols.size(); ++k) B.col(k) = A.col(cols[k]);
     return B;
   };
-  if (static_cast<int>(cols.size()) < nv && dependentRows(restrictCols(G)).size() > 0) {
+  // (the frame coordinates do not suffice when they lose rank the whole G does not lose)
+  if (static_cast<int>(cols.size()) < nv && dependentRows(restrictCols(G)).size() > dependentRows(G).size()) {
     cols.resize(nv);
     for (int k = 0; k < nv; ++k) cols[k] = k;
   }
@@ -213,11 +257,15 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     throw ModelError(os.str());
   }
   // The rank may drop on the way (a singular position): check again where we arrived.
-  throwIfRedundant(sys, G);
+  // Released equations: those dependent at the assembled position (a structural
+  // redundancy persists along the motion; docs/formulations.md).
+  if (released.detect) s.released = dependentRows(G);
+  throwIfRedundant(sys, G, s.released);
+  const MatX Gi = withoutRows(G, s.released);  // the independent rows
   // 2. Velocities: min (v - v0)^T M (v - v0) subject to G v = f'(t0), over the same
   //    coordinates as the positions (elastic velocities kept at their given values).
   const MatX M = massMatrix(sys, s.q);
-  const VecX df = -velocityConstraintResidual(sys, s.q, VecX::Zero(nv), t0);  // = f'(t0)
+  const VecX df = withoutRows(-velocityConstraintResidual(sys, s.q, VecX::Zero(nv), t0), s.released);  // = f'(t0)
   s.v = v0;
   {
     MatX Mr(cols.size(), cols.size());
@@ -229,11 +277,11 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     VecX vr, nu;
     VecX keptVelocities = v0;  // contribution of the coordinates that stay fixed
     for (int c : cols) keptVelocities[c] = 0.0;
-    solveAugmented(Mr, restrictCols(G), Mr * v0r, df - G * keptVelocities, vr, nu);
+    solveAugmented(Mr, restrictCols(Gi), Mr * v0r, df - Gi * keptVelocities, vr, nu);
     for (size_t k = 0; k < cols.size(); ++k) s.v[cols[k]] = vr[k];
   }
   // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v.
-  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
+  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda, s.released);
   return s;
 }
 

@@ -20,8 +20,9 @@ const char* firstNonFinite(const OutputSample& s) {
 
 }  // namespace
 
-OutputRecorder::OutputRecorder(const System& sys, double modelSize, const OutputCallback& onOutput)
-    : sys_(sys), modelSize_(modelSize), onOutput_(onOutput), conservative_(isConservative(sys)),
+OutputRecorder::OutputRecorder(const System& sys, double modelSize, const OutputCallback& onOutput,
+                               std::vector<int> released)
+    : sys_(sys), modelSize_(modelSize), released_(std::move(released)), onOutput_(onOutput), conservative_(isConservative(sys)),
       kinds_(sys.coordinateKinds()), velocityKinds_(sys.velocityKinds()) {}
 
 void OutputRecorder::record(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v) {
@@ -36,14 +37,17 @@ void OutputRecorder::record(double t, const Eigen::Ref<const VecX>& q, const Eig
   }
   // Accelerations and multipliers recomputed from the state (q, v): as accurate as the
   // state itself, unlike the interpolated y' (docs/formulations.md).
-  computeAccelerations(sys_, t, s.q, s.v, s.a, s.lambda);
+  computeAccelerations(sys_, t, s.q, s.v, s.a, s.lambda, released_);
   for (size_t k = 0; k < velocityKinds_.size(); ++k) {
     const double scale = velocityKinds_[k] == CoordinateKind::Angle ? modelSize_ : 1.0;
     r.maxSpeed = std::max(r.maxSpeed, std::fabs(s.v[k]) * scale);
   }
   if (sys_.numConstraintEquations() > 0) {
     VecX g;
-    evaluateConstraints(sys_, s.q, t, &g, nullptr);
+    MatX G;
+    evaluateConstraints(sys_, s.q, t, &g, released_.empty() ? nullptr : &G);
+    // a redundant set's reactions are not unique: the minimum-norm ones with the same resultant
+    if (!released_.empty()) s.lambda = minimumNormMultipliers(G, s.lambda);
     r.maxPositionViolation = std::max(r.maxPositionViolation, g.lpNorm<Eigen::Infinity>());
     r.maxVelocityViolation =
         std::max(r.maxVelocityViolation, velocityConstraintResidual(sys_, s.q, s.v, t).lpNorm<Eigen::Infinity>());

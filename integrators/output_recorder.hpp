@@ -40,7 +40,10 @@ class OutputRecorder {
  public:
   /// @pre sys is finalized; sys and onOutput outlive the recorder (onOutput may be empty).
   /// @pre `onOutput` outlives the recorder (it is held by reference).
-  OutputRecorder(const System& sys, double modelSize, const OutputCallback& onOutput);
+  /// `released`: the DAE's released constraint equations (ascending); the multipliers
+  /// recorded are then the minimum-norm ones of the full set (minimumNormMultipliers).
+  OutputRecorder(const System& sys, double modelSize, const OutputCallback& onOutput,
+                 std::vector<int> released = {});
   OutputRecorder(const OutputRecorder&) = delete;
   OutputRecorder& operator=(const OutputRecorder&) = delete;
 
@@ -58,6 +61,7 @@ class OutputRecorder {
  private:
   const System& sys_;
   const double modelSize_;
+  const std::vector<int> released_;
   const OutputCallback& onOutput_;
   const bool conservative_;
   const std::vector<CoordinateKind> kinds_, velocityKinds_;

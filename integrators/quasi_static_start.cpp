@@ -103,7 +103,7 @@ ConsistentState movedState(const System& sys, double t0, const ConsistentState& 
                            const std::vector<FastMode>& fast, const VecX& d) {
   VecX q = s.q;
   addModes(modes, fast, d, true, q);
-  return computeConsistentState(sys, t0, projectKeepingElastic(sys, t0, q, modes), s.v);
+  return computeConsistentState(sys, t0, projectKeepingElastic(sys, t0, q, modes), s.v, {false, s.released});
 }
 
 bool converged(double change, double size) {
@@ -149,13 +149,13 @@ QuasiStaticStart quasiStaticElasticStart(const System& sys, double t0, const Con
   const double dt = kJerkStepFraction / cutoff;
   for (int it = 0; it < kMaxIterations; ++it, ++out.iterations) {
     VecX ap, am, lp, lm;
-    computeAccelerations(sys, t0 + dt, sys.applyIncrement(s.q, dt * s.v), s.v + dt * s.a, ap, lp);
-    computeAccelerations(sys, t0 - dt, sys.applyIncrement(s.q, -dt * s.v), s.v - dt * s.a, am, lm);
+    computeAccelerations(sys, t0 + dt, sys.applyIncrement(s.q, dt * s.v), s.v + dt * s.a, ap, lp, s.released);
+    computeAccelerations(sys, t0 - dt, sys.applyIncrement(s.q, -dt * s.v), s.v - dt * s.a, am, lm, s.released);
     const VecX jerk = (ap - am) / (2.0 * dt);  // central difference, error O(dt^2)
     const VecX d = fastComponents(modes, fast, jerk).cwiseQuotient(omega2);
     VecX v = s.v;
     addModes(modes, fast, d, false, v);
-    s = computeConsistentState(sys, t0, s.q, v);
+    s = computeConsistentState(sys, t0, s.q, v, {false, s.released});
     if (converged(elasticChange(modes, fast, d, false, s.v), largestElastic(modes, s.v, false))) break;
   }
   out.residual = fastComponents(modes, fast, s.a).cwiseQuotient(omega2).lpNorm<Eigen::Infinity>();

@@ -52,7 +52,9 @@ std::string withDiagnosis(std::string message, const FailureContext& ctx, double
   try {
     message += divergenceReport(ctx.outputs.largestCoordinate, ctx.modelSize, ctx.outputs.tEvaluating);
     if (!ctx.outputs.diverged(ctx.modelSize)) {
-      message += singularityDiagnosis(ctx.sys, ctx.outputs.last, tDiagnosis, ctx.startRatio).text;
+      message += singularityDiagnosis(ctx.sys, ctx.outputs.last, tDiagnosis, ctx.startRatio,
+                                      ctx.released ? *ctx.released : std::vector<int>{})
+                     .text;
     }
   } catch (const std::exception&) {
     // the diagnosis is optional: the solver's reason stays the message
@@ -119,10 +121,21 @@ RunStart startRun(const DaeSystem& dae, const ConsistentState& init, double t0) 
       start.warnings.push_back(initialCorrectionWarning(c));
     }
   }
+  if (!dae.releasedEquations().empty()) {
+    // one line at the start naming what was released (the summary lists them too)
+    std::string names;
+    for (const int r : dae.releasedEquations()) names += (names.empty() ? "" : "; ") + sys.describeEquation(r);
+    start.warnings.push_back("redundant constraints resolved: " + names +
+                             (dae.releasedEquations().size() == 1 ? " depends" : " depend") +
+                             " on the joints and drivers defined before and "+
+                             (dae.releasedEquations().size() == 1 ? "is" : "are") + " released (integrated with the "
+                             "independent equations); the reactions of the redundant set are not unique, the "
+                             "minimum-norm ones are reported");
+  }
   if (dae.layout().m > 0) {
     MatX G0;
     evaluateConstraints(sys, init.q, t0, nullptr, &G0);
-    start.startRatio = constraintConditioning(G0);
+    start.startRatio = constraintConditioning(withoutRows(G0, dae.releasedEquations()));
   }
   return start;
 }
@@ -208,7 +221,8 @@ std::optional<std::string> shouldHandOver(IntegratorKind kind, const StepWindow&
 
 void handOverToRadau(const RunContext& ctx, RunState& state, const OutputSample& last, const std::string& reason) {
   state.integratorSwitch = reason;
-  const ConsistentState cs = computeConsistentState(ctx.sys, last.t, last.q, last.v);
+  const ConsistentState cs =
+      computeConsistentState(ctx.sys, last.t, last.q, last.v, {false, ctx.dae.releasedEquations()});
   VecX y, yp;
   packConsistentState(ctx.dae, cs, y, yp);
   addStats(state.finished, state.integrator->stats());
@@ -301,7 +315,8 @@ std::optional<RunFailure> integrateAndDiagnose(const RunContext& ctx, RunState& 
     const std::optional<double> integratorTime =
         state.integrator ? std::optional<double>(state.integrator->stats().currentTime) : std::nullopt;
     return diagnoseFailure(std::current_exception(),
-                           FailureContext{ctx.sys, recorder.recorded(), ctx.modelSize, ctx.startRatio, integratorTime});
+                           FailureContext{ctx.sys, recorder.recorded(), ctx.modelSize, ctx.startRatio, integratorTime,
+                                          &ctx.dae.releasedEquations()});
   }
 }
 

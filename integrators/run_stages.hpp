@@ -135,6 +135,7 @@ struct FailureContext {
   double startRatio;  ///< RunStart::startRatio
   /// The running integrator's current time; none during a crossing or after it.
   std::optional<double> integratorTime;
+  const std::vector<int>* released = nullptr;  ///< the DAE's released equations (none if null)
 };
 
 /// Stage "diagnose": the failure that ended a run early, with its message: the solver's

@@ -122,6 +122,14 @@ ElasticStart parseElasticStart(const std::string& name) {
   throw InputError("solver.elastic_start: unknown elastic start '" + name + "' (expected one of: given, quasi_static)");
 }
 
+RedundantConstraints parseRedundantConstraints(const std::string& name) {
+  if (name == "resolve") return RedundantConstraints::Resolve;
+  if (name == "refuse") return RedundantConstraints::Refuse;
+  throw InputError("solver.redundant_constraints: unknown choice '" + name + "' (expected one of: resolve, refuse)");
+}
+
+std::string toString(RedundantConstraints r) { return r == RedundantConstraints::Refuse ? "refuse" : "resolve"; }
+
 std::string toString(ElasticStart s) { return s == ElasticStart::QuasiStatic ? "quasi_static" : "given"; }
 
 VecX absoluteTolerances(const DaeSystem& dae, const SolverSettings& settings) {
@@ -141,17 +149,20 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   // start: the consistent state (the elastic one quasi-static if asked), what it
   // corrected, the first output; the modal content of the flexible bodies at every output
   std::string elasticStart;
+  // redundant constraints: refused, or released where they are found dependent
+  ReleasedEquations released;
+  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
   const ConsistentState init = elasticStartState(
-      sys, settings, computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities()),
+      sys, settings, computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released),
       elasticStart);
-  const DaeSystem dae(sys, settings.formulation);
+  const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
   const RunStart start = startRun(dae, init, t0);
   ModalParticipation participation(sys);
   const OutputCallback recordParticipation = [&](const OutputSample& s) {  // outlives the recorder
     participation.add(s.q, s.v);
     if (onOutput) onOutput(s);
   };
-  OutputRecorder recorder(sys, start.modelSize, recordParticipation);
+  OutputRecorder recorder(sys, start.modelSize, recordParticipation, dae.releasedEquations());
   if (const std::optional<RunFailure> stop = recordInitialOutput(recorder, dae.layout(), start, t0)) {
     return summaryAtStart(start, recorder.recorded(), *stop);
   }
@@ -177,6 +188,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   // finish
   SimulationSummary summary = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
   summary.elasticStart = elasticStart;
+  for (const int r : dae.releasedEquations()) summary.redundantConstraints.push_back(sys.describeEquation(r));
   summary.modalParticipation = participation.result();
   for (const std::string& w : participation.warnings()) summary.warnings.push_back(w);
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;

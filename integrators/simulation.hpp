@@ -23,6 +23,14 @@ enum class ElasticStart { Given, QuasiStatic };
 ElasticStart parseElasticStart(const std::string& name);
 std::string toString(ElasticStart s);
 
+/// What a run does with constraint equations that depend on the others (a redundant
+/// joint, docs/formulations.md): release them and integrate with the independent ones
+/// (default), or refuse the model as a ModelError naming them.
+enum class RedundantConstraints { Resolve, Refuse };
+/// "resolve", "refuse". @throws InputError otherwise.
+RedundantConstraints parseRedundantConstraints(const std::string& name);
+std::string toString(RedundantConstraints r);
+
 struct SolverSettings {
   Formulation formulation = Formulation::Ggl;
   /// Automatic: chosen from the model at the start (chooseIntegrator,
@@ -62,6 +70,7 @@ struct SolverSettings {
   /// Jacobian loses rank: change points, dead centres), cross it with the augmented
   /// Lagrangian integrator (ALI3-P) and restart after it. Off: such a run stops there.
   bool crossSingular = true;
+  RedundantConstraints redundantConstraints = RedundantConstraints::Resolve;
   /// @throws InputError naming the solver key that is out of range.
   void validate() const;
 };
@@ -135,6 +144,10 @@ struct SimulationSummary {
   /// Per flexible body (at most 400 elastic coordinates): the largest amplitude and energy
   /// of each mode over the outputs and the modes that carry the motion (issue 24, item 4).
   std::vector<BodyParticipation> modalParticipation;
+  /// The constraint equations released as dependent on the others (redundant constraints
+  /// resolved), each named as "joint 'F' (revolute, equation 4)"; their reactions, and
+  /// those of the equations they depend on, are the minimum-norm ones.
+  std::vector<std::string> redundantConstraints;
 };
 
 /// A value of the results (state, energy, reaction, output) that is inf or NaN: the run

@@ -91,8 +91,8 @@ double constraintConditioning(const MatX& G) {
 }
 
 SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample& last, double tFail,
-                                          double startRatio) {
-  const int m = sys.numConstraintEquations();
+                                          double startRatio, const std::vector<int>& released) {
+  const int m = sys.numConstraintEquations() - static_cast<int>(released.size());
   if (m == 0 || last.q.size() == 0 || m > sys.numVelocities()) return {};
   const double dt = tFail - last.t;
   VecX q = sys.applyIncrement(last.q, dt * last.v + 0.5 * dt * dt * last.a);
@@ -112,8 +112,18 @@ SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample&
     G = Gn;
   }
   if (!G.allFinite()) return {};
+  std::vector<int> kept;  // the equations not released, as rows of the full G
+  for (int i = 0, k = 0; i < G.rows(); ++i) {
+    if (k < static_cast<int>(released.size()) && released[k] == i) {
+      ++k;
+    } else {
+      kept.push_back(i);
+    }
+  }
+  G = withoutRows(G, released);
   const double ratio = constraintConditioning(G);
-  const std::vector<int> rows = dependentRows(G, kNearlyDependent);
+  std::vector<int> rows = dependentRows(G, kNearlyDependent);
+  for (int& r : rows) r = kept[r];
   bool driven = false;
   for (int c = 0; c < sys.numConstraints(); ++c) driven = driven || sys.constraint(ConstraintIndex(c)).isDriver();
   std::ostringstream os;
@@ -145,7 +155,7 @@ std::optional<CrossingPlan> planCrossing(const RunContext& ctx, const RunState& 
   if (!ctx.mayCross || outputs.diverged(ctx.modelSize)) return std::nullopt;
   SingularityDiagnosis d;
   try {
-    d = singularityDiagnosis(ctx.sys, outputs.last, failure.time(), ctx.startRatio);
+    d = singularityDiagnosis(ctx.sys, outputs.last, failure.time(), ctx.startRatio, ctx.dae.releasedEquations());
   } catch (const std::exception&) {
     // no diagnosis: only a failure just after a crossing is crossed
   }
@@ -225,7 +235,8 @@ void crossSingularPosition(const RunContext& ctx, RunState& state, OutputRecorde
   state.crossings.push_back(crossing);
   addStats(state.finished, ali.stats());
   if (ali.time() < tEnd) {
-    const ConsistentState cs = computeConsistentState(ctx.sys, ali.time(), ali.q(), ali.v());
+    const ConsistentState cs =
+        computeConsistentState(ctx.sys, ali.time(), ali.q(), ali.v(), {false, ctx.dae.releasedEquations()});
     VecX y, yp;
     packConsistentState(ctx.dae, cs, y, yp);
     state.restart(ctx.dae, ali.time(), y, yp, ctx.options);

@@ -33,9 +33,10 @@ double constraintConditioning(const MatX& G);
 /// which may stop short beyond a lock-up) and the constraint Jacobian G is examined there.
 /// startRatio: constraintConditioning at the start of the run. An empty diagnosis (text
 /// "", not singular) without constraints, or with more constraint equations than
-/// velocities. @throws what the constraint evaluation throws.
+/// velocities. `released`: equations released as redundant (ascending), left out of G.
+/// @throws what the constraint evaluation throws.
 SingularityDiagnosis singularityDiagnosis(const System& sys, const OutputSample& last, double tFail,
-                                          double startRatio);
+                                          double startRatio, const std::vector<int>& released = {});
 
 /// A crossing of a singular position that failed: the integrator's reason, the diagnosis
 /// and why the augmented-Lagrangian bridge could not cross either.

@@ -359,6 +359,7 @@ nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Sce
   }
   j["initial_corrections"] = corrections;
   j["warnings"] = summary.warnings;
+  j["redundant_constraints"] = summary.redundantConstraints;
   j["energy_start"] = summary.energyStart ? numberOrNull(*summary.energyStart) : nlohmann::ordered_json(nullptr);
   j["energy_end"] = summary.energyEnd ? numberOrNull(*summary.energyEnd) : nlohmann::ordered_json(nullptr);
   nlohmann::ordered_json crossings = nlohmann::ordered_json::array();

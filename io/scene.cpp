@@ -396,6 +396,14 @@ SolverSettings parseSolver(const json& j) {
       r.fail("unknown elastic start " + inQuotes(e) + " (expected one of: given, quasi_static)");
     }
   }
+  if (r.has("redundant_constraints")) {
+    const std::string e = r.string("redundant_constraints");
+    try {
+      s.redundantConstraints = parseRedundantConstraints(e);
+    } catch (const InputError&) {
+      r.fail("unknown choice " + inQuotes(e) + " (expected one of: resolve, refuse)");
+    }
+  }
   if (r.has("quasi_static_above")) s.quasiStaticAbove = r.number("quasi_static_above");
   if (r.has("linear_solver")) {
     const std::string ls = r.string("linear_solver");

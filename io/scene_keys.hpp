@@ -54,7 +54,7 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
                              "atol_elastic", "atol_velocity", "t_start",  "t_end",      "output_step",
                              "max_step",     "min_step",      "max_steps", "max_order", "initial_step",
                              "linear_solver", "fd_jacobian", "cross_singular", "elastic_start",
-                             "quasi_static_above"};
+                             "quasi_static_above", "redundant_constraints"};
 
 // spatial scenes ("dimension": 3)
 inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "position",

@@ -342,6 +342,9 @@ PYBIND11_MODULE(_flexmbd, m) {
           "formulation", [](const SolverSettings& s) { return toString(s.formulation); },
           [](SolverSettings& s, const std::string& f) { s.formulation = parseFormulation(f); })
       .def_property(
+          "redundant_constraints", [](const SolverSettings& s) { return toString(s.redundantConstraints); },
+          [](SolverSettings& s, const std::string& r) { s.redundantConstraints = parseRedundantConstraints(r); })
+      .def_property(
           "integrator", [](const SolverSettings& s) { return toString(s.integrator); },
           [](SolverSettings& s, const std::string& i) { s.integrator = parseIntegrator(i); })
       .def("validate", &SolverSettings::validate);

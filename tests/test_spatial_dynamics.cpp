@@ -350,7 +350,8 @@ TEST(SpatialSliderCrank, SliderPositionVelocityAndAccelerationMatchTheClosedForm
 TEST(SpatialRedundancy, FourBarWithParallelRevolutesIsReportedNamingTheDependentJoints) {
   // A planar four-bar built of spatial bodies and four revolute joints with parallel axes:
   // 18 velocities, 20 equations, 1 degree of freedom: 3 equations are redundant (the
-  // out-of-plane ones of the last joint). The model error names the dependent equations.
+  // out-of-plane ones of the last joint). With "redundant_constraints": "refuse" the model
+  // error names the dependent equations (resolved by default: test_redundant_constraints).
   System sys;
   const Vec3 A(0, 0, 0), B(0.5, std::sqrt(3.0) / 2, 0), C(3.016007650436934, 2.4999487505001956, 0), D(3, 0, 0);
   auto link = [&](const std::string& name, const Vec3& p, const Vec3& q) {
@@ -376,7 +377,9 @@ TEST(SpatialRedundancy, FourBarWithParallelRevolutesIsReportedNamingTheDependent
   sys.addConstraint(std::make_unique<SpatialJoint>("C", SpatialJointType::Revolute, coupler, end(1.5), rocker, end(1.25)));
   sys.finalize();
   try {
-    simulate(sys, settings(0.1, 1e-8, 0.01), nullptr);
+    SolverSettings refuse = settings(0.1, 1e-8, 0.01);
+    refuse.redundantConstraints = RedundantConstraints::Refuse;
+    simulate(sys, refuse, nullptr);
     ADD_FAILURE() << "expected a ModelError for the redundant joints";
   } catch (const ModelError& e) {
     const std::string what = e.what();

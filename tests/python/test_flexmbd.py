@@ -118,9 +118,18 @@ def test_input_errors_are_value_errors_with_the_engines_message(tmp_path):
 def test_a_model_error_names_the_redundant_joint():
     scene = rigid_crank_in_python()
     scene.system.add_revolute_joint("again", "crank", (1, 0), "rod", (0, 0))  # O2 twice
+    scene.solver.redundant_constraints = "refuse"
     with pytest.raises(flexmbd.ModelError, match="again") as e:
         scene.run()
     assert isinstance(e.value, flexmbd.InputError)
+
+
+def test_a_redundant_joint_is_released_by_default_and_named():
+    scene = rigid_crank_in_python()
+    scene.system.add_revolute_joint("again", "crank", (1, 0), "rod", (0, 0))  # O2 twice
+    assert scene.solver.redundant_constraints == "resolve"
+    results = scene.run()
+    assert any("joint 'again'" in r for r in results.summary["redundant_constraints"])
 
 
 def test_a_solver_failure_says_when_and_keeps_the_results():
