@@ -47,6 +47,43 @@ void throwIfRedundant(const System& sys, const MatX& G, const std::vector<int>& 
   throw ModelError(os.str());
 }
 
+/// True when global equation `row` belongs to a driver (System::describeEquation's walk).
+bool isDriverEquation(const System& sys, int row) {
+  for (int c = sys.numConstraints() - 1; c >= 0; --c) {
+    if (row >= sys.constraintOffset(ConstraintIndex(c))) return sys.constraintIsDriver(ConstraintIndex(c));
+  }
+  return false;
+}
+
+/// Released equations must be redundant, not conflicting. A driver's law can disagree with
+/// the equations it depends on at any later time, so a dependent driver equation is never
+/// released; a dependent joint equation must agree with the kept ones at velocity and
+/// acceleration level too (it holds at position level where the mechanism assembled),
+/// else it fights them (a "fixed" joint on a driven angle): both are refused, named.
+void throwIfReleasedConflict(const System& sys, double t0, const ConsistentState& s, const MatX& G) {
+  if (s.released.empty()) return;
+  const VecX rv = velocityConstraintResidual(sys, s.q, s.v, t0);                 // G v - f'
+  const VecX ra = G * s.a - accelerationConstraintRhs(sys, s.q, s.v, t0);          // G a - (f'' - v^T H v)
+  const double vScale = 1.0 + s.v.lpNorm<Eigen::Infinity>(), aScale = 1.0 + s.a.lpNorm<Eigen::Infinity>();
+  std::ostringstream os;
+  int conflicts = 0;
+  for (const int r : s.released) {
+    const double gScale = 1.0 + G.row(r).lpNorm<Eigen::Infinity>();
+    const bool driver = isDriverEquation(sys, r);
+    const bool disagrees = std::abs(rv[r]) > kConsistentRows * gScale * vScale ||
+                           std::abs(ra[r]) > kConsistentRows * gScale * aScale;
+    if (!driver && !disagrees) continue;
+    os << (conflicts++ ? "; " : "") << sys.describeEquation(r);
+    if (driver) os << " (a driver: its law may disagree with the others at later times)";
+    else os << " (velocity residual " << rv[r] << ", acceleration residual " << ra[r] << ")";
+  }
+  if (conflicts == 0) return;
+  throw ModelError("conflicting constraints: " + os.str() +
+                   (conflicts == 1 ? " depends" : " depend") +
+                   " on the joints and drivers defined before and cannot be released as redundant; remove it or "
+                   "free a coordinate");
+}
+
 }  // namespace
 
 namespace {
@@ -282,6 +319,7 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
   }
   // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v.
   computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda, s.released);
+  if (released.detect) throwIfReleasedConflict(sys, t0, s, G);
   return s;
 }
 

@@ -166,6 +166,39 @@ TEST(RedundantConstraints, RefuseStopsNamingTheEquation) {
   EXPECT_THROW(computeConsistentState(dup, 0.0, dup.initialCoordinates(), dup.initialVelocities()), ModelError);
 }
 
+TEST(RedundantConstraints, ConflictingEquationsAreNotReleased) {
+  // A crank turned by a driver at 1 rad/s and also welded to the ground by a fixed joint:
+  // the weld's position equations hold at t = 0 (the mechanism assembles) and its x, y
+  // rows repeat the pivot's, but its angle row contradicts the driver's speed: released,
+  // the run would report a motion that violates it. It is refused, named, with its
+  // velocity residual (1 rad/s). Two drivers on one angle at different speeds likewise:
+  // a driver is never released (its law may disagree later even where it agrees now).
+  const auto crankSystem = [](bool weld, bool secondDriver) {
+    System s;
+    const BodyIndex crank = addRigidBody(s, "crank", {1.0, 0.1, {0, 0}}, {Vec2(0.5, 0.0), 0.0});
+    addRevoluteJoint(s, "A", kGround, Vec2(0, 0), crank, {-0.5, 0});
+    addBodyCoordinateDriver(s, "spin", crank, "theta", makeConstantSpeedLaw(1.0));
+    if (weld) addFixedJoint(s, "weld", kGround, Vec2(0, 0), crank, {-0.5, 0});
+    if (secondDriver) addBodyCoordinateDriver(s, "spin2", crank, "theta", makeConstantSpeedLaw(2.0));
+    s.finalize();
+    return s;
+  };
+  const auto expectRefused = [](const System& sys, const std::string& named) {
+    try {
+      simulate(sys, settings(0.1), nullptr);
+      ADD_FAILURE() << "expected a ModelError naming " << named;
+    } catch (const ModelError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("conflicting constraints: "), std::string::npos) << what;
+      EXPECT_NE(what.find(named), std::string::npos) << what;
+    }
+  };
+  expectRefused(crankSystem(true, false), "joint 'weld' (fixed, equation 2) (velocity residual");
+  expectRefused(crankSystem(false, true), "driver 'spin2'");
+  // the driven crank alone runs
+  EXPECT_TRUE(simulate(crankSystem(false, false), settings(0.1), nullptr).ok);
+}
+
 TEST(RedundantConstraints, ParallelogramWithAThirdCrankMovesAsOneDegreeOfFreedom) {
   // Cranks of 1 m at x = 0, 1, 2 m hanging at -90 + 34 deg, a coupler of 2 m: 12
   // coordinates, 12 equations, one degree of freedom, one dependent equation (the last
