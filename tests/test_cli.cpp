@@ -134,6 +134,30 @@ TEST_F(Cli, ConflictingDriversExitWith2) {
   EXPECT_FALSE(fs::exists(out / "results.csv"));
 }
 
+TEST_F(Cli, RedundantJointRunsByDefaultAndRefuseExitsWith2) {
+  // A second revolute joint at the crank pivot repeats O1's two equations: by default the
+  // run releases them, exits 0 and names them in summary.json; with "refuse" it exits 2
+  // with one error line naming the joint, and writes no results.
+  nlohmann::json j = example();
+  j["joints"].push_back(nlohmann::json::parse(
+      R"({"name": "O1b", "type": "revolute", "bodies": ["ground", "crank"], "points": [[0.0, 0.0], [0.0, 0.0]]})"));
+  const fs::path out = dir_ / "out";
+  const CliResult ok = run("run " + shellQuote(writeScene("redundant.json", j).string()) + " --out " +
+                           shellQuote(out.string()) + " --quiet");
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  ASSERT_EQ(summary.at("redundant_constraints").size(), 2u) << summary.dump();
+  EXPECT_NE(summary.at("redundant_constraints")[0].get<std::string>().find("joint 'O1b'"), std::string::npos);
+  j["solver"]["redundant_constraints"] = "refuse";
+  const fs::path out2 = dir_ / "out2";
+  const CliResult refused = run("run " + shellQuote(writeScene("refuse.json", j).string()) + " --out " +
+                                shellQuote(out2.string()) + " --quiet");
+  EXPECT_EQ(refused.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(refused.err)) << refused.err;
+  EXPECT_NE(refused.err.find("O1b"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(out2 / "results.csv"));
+}
+
 }  // namespace
 
 TEST_F(Cli, LockUpMidRunExitsWith1AndKeepsResultsUpToTheFailure) {
