@@ -124,7 +124,6 @@ int main(int argc, char** argv) {
       {"hand_ida", false, Formulation::Ggl, IntegratorKind::Ida},
       {"hand_radau5", false, Formulation::Ggl, IntegratorKind::Radau5},
       {"engine_index1_radau9", true, Formulation::Index1, IntegratorKind::Radau5, {5, 5, 5}},
-      {"engine_index1_radau13", true, Formulation::Index1, IntegratorKind::Radau5, {7, 7, 7}},
       {"engine_index1_radau", true, Formulation::Index1, IntegratorKind::Radau, {3, 7, 3}},
       {"engine_ggl_radau", true, Formulation::Ggl, IntegratorKind::Radau, {3, 7, 3}},
       {"hand_radau9", false, Formulation::Ggl, IntegratorKind::Radau5, {5, 5, 5}},
