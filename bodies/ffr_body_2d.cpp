@@ -106,10 +106,6 @@ Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const Mat2& A, const Qf& q
 
 }  // namespace
 
-Eigen::Matrix3d FfrBody2d::frameMass(const ConstVecRef& q) const {
-  return frameMassAt(inv_, rotation(q[2]), q.tail(numElastic()));
-}
-
 Eigen::Vector3d FfrBody2d::frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const {
   // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~ (column k)
   Eigen::Vector3d c;

@@ -97,8 +97,8 @@ class FfrBody2d final : public Body {
   int findPoint(const Vec2& point) const;
   /// The node `pointId` (resolvePoint), or the node at `point` when pointId is kAnyPoint.
   const FfrPoint& node(const Vec2& point, int pointId) const;
-  /// Mass matrix blocks: frame-frame (3 x 3) and column k of frame-elastic (3 x nf).
-  Eigen::Matrix3d frameMass(const ConstVecRef& q) const;
+  /// Column k of the frame-elastic mass block (3 x nf); the frame-frame block is
+  /// frameMassAt in the .cpp, at the rotation the caller has computed.
   Eigen::Vector3d frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const;
   void kinematicsOn(const ConstVecRef& q, const FfrPoint& p, const std::vector<int>* cols, bool withHessians,
                     PointKinematics& out) const;

@@ -298,8 +298,8 @@ namespace flexmbd {
 namespace {
 
 TEST(Allocations, RadauStepsAtEveryOrderAllocateNothing) {
-  // Simeon's crank with the variable-order Radau IIA (its orders change every few dozen
-  // steps here): after a warm-up, steps allocate nothing with dense LU (measured 0 in 167
+  // Simeon's crank with the variable-order Radau IIA (its order changes along the run):
+  // after a warm-up, steps allocate nothing with dense LU (measured 0 in 167
   // steps); with KLU only a re-pivoting full factorisation may (measured 0 in 160 steps;
   // bounded by the factorisations).
   if (!FLEXMBD_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
