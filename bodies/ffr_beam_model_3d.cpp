@@ -92,6 +92,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
   for (int k = 0; k < 3; ++k) nodal.positionShape[k] = Mat3X::Zero(3, nd);
   using Triplets = std::vector<Eigen::Triplet<double>>;
   std::array<Triplets, 9> tS;  // S_kl at 3 k + l
+  std::array<Triplets, 9> tR;  // R_kl at 3 k + l
   Triplets tm, tk, td;
   for (size_t e = 0; e < elements_.size(); ++e) {
     const BeamElement3d& el = elements_[e];
@@ -129,6 +130,17 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
         skl[3 * k + l] = T.transpose() * acc * T;
       }
     }
+    // R_kl likewise (int rho u2 dV = 0 over each section: no terms from the start s)
+    std::array<BeamElement3d::Mat12, 9> rkl;
+    for (int k = 0; k < 3; ++k) {
+      for (int l = 0; l < 3; ++l) {
+        BeamElement3d::Mat12 acc = BeamElement3d::Mat12::Zero();
+        for (int a = 0; a < 3; ++a) {
+          for (int b = 0; b < 3; ++b) acc += (C(k, a) * C(l, b)) * el.sectionRotationMoment(a, b);
+        }
+        rkl[3 * k + l] = T.transpose() * acc * T;
+      }
+    }
     const BeamElement3d::Mat12 mm = T.transpose() * el.massMatrix() * T;
     const BeamElement3d::Mat12 kk = T.transpose() * el.stiffness() * T;
     const double beta = el.section().damping;
@@ -141,6 +153,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
         // walks the stored entries at every evaluation (issue 24)
         for (int kl = 0; kl < 9; ++kl) {
           if (skl[kl](a, b) != 0.0) tS[kl].emplace_back(idx[a], idx[b], skl[kl](a, b));
+          if (rkl[kl](a, b) != 0.0) tR[kl].emplace_back(idx[a], idx[b], rkl[kl](a, b));
         }
         tm.emplace_back(idx[a], idx[b], mm(a, b));
         tk.emplace_back(idx[a], idx[b], kk(a, b));
@@ -153,7 +166,10 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
     A.setFromTriplets(t.begin(), t.end());  // duplicates summed
   };
   for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) build(nodal.sKL[k][l], tS[3 * k + l]);
+    for (int l = 0; l < 3; ++l) {
+      build(nodal.sKL[k][l], tS[3 * k + l]);
+      build(nodal.rKL[k][l], tR[3 * k + l]);
+    }
   }
   build(nodal.mff, tm);
   build(nodal.kff, tk);

@@ -98,6 +98,13 @@ FfrBody3d::FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameSt
   w_[1] = S[2][0] - SpMat(S[2][0].transpose());
   w_[2] = S[0][1] - SpMat(S[0][1].transpose());
   for (auto& w : w_) w.makeCompressed();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      const SpMat& R = inv_.rKL[k][l];
+      if (R.size() != 0 && R.nonZeros() > 0) sectionRotation_.push_back({k, l, R});
+    }
+  }
+  for (auto& t : sectionRotation_) t.R.makeCompressed();
   for (const FfrPoint3d& p : inv_.points) nodeSupport_.push_back(FfrInvariants3d::support(p));
 }
 
@@ -219,7 +226,12 @@ Mat3 FfrBody3d::secondMomentAt(const ConstVecRef& qf) const {
   for (int k = 0; k < 3; ++k) {
     for (int l = k; l < 3; ++l) quadratic(k, l) = bilinear(inv_.sKL[k][l], qf, qf);
   }
+  addSectionRotationMoment(qf, quadratic);
   return secondMomentFrom(qf, quadratic);
+}
+
+void FfrBody3d::addSectionRotationMoment(const ConstVecRef& qf, Mat3& quadratic) const {
+  for (const SectionRotationTerm& t : sectionRotation_) quadratic(t.k, t.l) += bilinear(t.R, qf, qf);
 }
 
 Mat3 FfrBody3d::secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const {
@@ -242,6 +254,12 @@ Mat3 FfrBody3d::secondMomentDerivative(const ConstVecRef& qf, int c) const {
       D(k, l) = inv_.positionShape[k](l, c) + inv_.positionShape[l](k, c) + columnDot(inv_.sKL[k][l], c, qf) +
                 columnDot(inv_.sKL[l][k], c, qf);
     }
+  }
+  // d(qf^T R_kl qf)/dqf_c = 2 (R_kl qf)_c (R_kl symmetric), at (k, l) and (l, k)
+  for (const SectionRotationTerm& t : sectionRotation_) {
+    const double d = 2.0 * columnDot(t.R, c, qf);
+    D(t.k, t.l) += d;
+    if (t.k != t.l) D(t.l, t.k) += d;
   }
   return D;
 }
@@ -318,6 +336,7 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
       yaf[wp.index] += wp.sign * y;
     }
   }
+  addSectionRotationMoment(qf, quadratic);
   const Mat3 J = secondMomentFrom(qf, quadratic);
   // row R: m aR - A s~ aw + A S-bar af
   out.head<3>() += inv_.mass * aR + A * (aw.cross(s) + inv_.sBar * af);
@@ -419,6 +438,23 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
       if (k != l) Gq(l, k) = glk;
     }
   }
+  // The sections' second-order rotation: J_kl = J_lk gains qf^T R_kl qf, so G_kl = G_lk
+  // gains qf'^T R_kl qf, and Q_f -sum_kl Om_kl R_kl qf (the term dT/dqf of
+  // T = -(1/2) sum_kl Om_kl J_kl, as for S_kl)
+  for (const SectionRotationTerm& t : sectionRotation_) {
+    const double om = (t.k == t.l ? 1.0 : 2.0) * Om(t.k, t.l);
+    double jq = 0.0, g = 0.0;
+    for (int j = 0; j < t.R.outerSize(); ++j) {
+      double rq = 0.0;  // (R qf)_j
+      for (SpMat::InnerIterator it(t.R, j); it; ++it) rq += it.value() * qf[it.row()];
+      jq += qf[j] * rq;
+      g += pf[j] * rq;
+      Qf[j] -= om * rq;
+    }
+    quadratic(t.k, t.l) += jq;
+    Gq(t.k, t.l) += g;
+    if (t.k != t.l) Gq(t.l, t.k) += g;
+  }
   const Mat3 J = secondMomentFrom(qf, quadratic);
   Mat3 G;
   for (int k = 0; k < 3; ++k) {
@@ -452,6 +488,11 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + bilinear(inv_.sKL[k][l], pf, qf);
   }
+  for (const SectionRotationTerm& t : sectionRotation_) {
+    const double g = bilinear(t.R, pf, qf);
+    G(t.k, t.l) += g;
+    if (t.k != t.l) G(t.l, t.k) += g;
+  }
   // Q_R = -A c, c = w~ w~ s + 2 w~ S-bar qf'
   const Vec3 c = Om * s + 2.0 * ws * sp;
   dQdq.addBlock(0, 3, Mat34(A * skew(c) * Rinv));
@@ -470,6 +511,15 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
         Gp(a, b) = inv_.positionShape[b](a, k) + columnDot(inv_.sKL[b][a], k, qf);
       }
     }
+    for (const SectionRotationTerm& t : sectionRotation_) {
+      const double gq = columnDot(t.R, k, pf), gp = columnDot(t.R, k, qf);  // R symmetric
+      Gq(t.k, t.l) += gq;
+      Gp(t.k, t.l) += gp;
+      if (t.k != t.l) {
+        Gq(t.l, t.k) += gq;
+        Gp(t.l, t.k) += gp;
+      }
+    }
     Vec6 cq, cv;
     cq << -A * (Om * sk), -ws * (Dk.trace() * w - Dk * w) - 2.0 * (Gq.trace() * w - Gq * w);
     cv << -2.0 * A * (ws * sk), -2.0 * (Gp.trace() * w - Gp * w);
@@ -479,6 +529,9 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   // Q_f = -sum_kl Om_kl (positionShape[l].row(k)^T + S_kl qf) + 2 sum_i w_i W_i qf' - K qf - D qf'
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) dQdq.addSparse(6, 7, inv_.sKL[k][l], -Om(k, l));
+  }
+  for (const SectionRotationTerm& t : sectionRotation_) {
+    dQdq.addSparse(6, 7, t.R, -(t.k == t.l ? 1.0 : 2.0) * Om(t.k, t.l));
   }
   if (model_) {
     model_->addStrainEnergyHessian(qf, -1.0, dQdq, 6, 7);
@@ -497,6 +550,9 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
           // (S_kl qf)_m = (S_lk^T qf)_m
           sum -= dOm(k, l) * (inv_.positionShape[l](k, m) + columnDot(inv_.sKL[l][k], m, qf));
         }
+      }
+      for (const SectionRotationTerm& t : sectionRotation_) {
+        sum -= (t.k == t.l ? 1.0 : 2.0) * dOm(t.k, t.l) * columnDot(t.R, m, qf);
       }
       return sum - 2.0 * columnDot(w_[j], m, pf);  // (W_j qf')_m = -(W_j^T qf')_m
     });

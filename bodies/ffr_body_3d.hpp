@@ -134,7 +134,9 @@ class FfrBody3d final : public Body {
   NodeMotion nodeMotion(const Vec3& point, int pointId, const ConstVecRef& qf) const;
   /// J(q_f) = int rho u u^T dV.
   Mat3 secondMomentAt(const ConstVecRef& qf) const;
-  /// J(q_f) from its quadratic part, (qf^T S_kl qf) in the upper triangle (k <= l).
+  /// quadratic(k, l) += qf^T R_kl qf for k <= l (sectionRotation_).
+  void addSectionRotationMoment(const ConstVecRef& qf, Mat3& quadratic) const;
+  /// J(q_f) from its quadratic part, (qf^T (S_kl + R_kl) qf) in the upper triangle (k <= l).
   Mat3 secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const;
   /// dJ/dq_f,k.
   Mat3 secondMomentDerivative(const ConstVecRef& qf, int k) const;
@@ -150,6 +152,13 @@ class FfrBody3d final : public Body {
   std::vector<std::vector<int>> nodeSupport_;  // per node: the elastic coordinates its shapes use
   std::array<SpMat, 3> w_;   // W_x = S_yz - S_zy, W_y = S_zx - S_xz, W_z = S_xy - S_yx (skew):
                              // int rho (N a) x (N b) dV = (a^T W_i b)_i
+  /// R_kl (k <= l) of the invariants that are present and not zero: J gains qf^T R_kl qf
+  /// at (k, l) and (l, k) (FfrInvariants3d::rKL, the cross-sections' second-order rotation).
+  struct SectionRotationTerm {
+    int k, l;
+    SpMat R;
+  };
+  std::vector<SectionRotationTerm> sectionRotation_;
 };
 
 }  // namespace flexmbd

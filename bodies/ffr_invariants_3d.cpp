@@ -16,6 +16,7 @@ namespace {
 const char* kAxis[3] = {"x", "y", "z"};
 
 std::string sklName(int k, int l) { return std::string("s_") + kAxis[k] + kAxis[l]; }
+std::string rklName(int k, int l) { return std::string("r_") + kAxis[k] + kAxis[l]; }
 
 }  // namespace
 
@@ -43,6 +44,7 @@ void FfrInvariants3d::validate(const std::string& owner) const {
     requireFiniteAll(positionShape[k], owner, std::string("position_shape_") + kAxis[k]);
     for (int l = 0; l < 3; ++l) requireFiniteAll(sKL[k][l], owner, sklName(k, l));
   }
+  validateSectionRotation(owner);
   requireSymmetric(mff, owner, "m_ff");
   requireSymmetric(kff, owner, "k_ff");
   requireSymmetric(dff, owner, "d_ff");
@@ -101,6 +103,24 @@ void FfrInvariants3d::validate(const std::string& owner) const {
   }
 }
 
+void FfrInvariants3d::validateSectionRotation(const std::string& owner) const {
+  const int n = numElastic();
+  const std::string sz = std::to_string(n);
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      const SpMat& R = rKL[k][l];
+      if (R.size() == 0) continue;  // none
+      requireSize(R.rows() == n && R.cols() == n, owner, rklName(k, l), sz + " x " + sz + " (or absent)");
+      requireFiniteAll(R, owner, rklName(k, l));
+      requireSymmetric(R, owner, rklName(k, l));
+      if (l != k && (rKL[l][k].size() == 0 || maxAbs(SpMat(rKL[l][k] - R)) > 0.0)) {
+        throw InputError(owner + ": invariant " + rklName(l, k) + " differs from " + rklName(k, l) +
+                         "; expected R_lk = R_kl");
+      }
+    }
+  }
+}
+
 std::vector<int> FfrInvariants3d::support(const FfrPoint3d& p) {
   std::vector<int> s;
   for (int k = 0; k < p.shape.cols(); ++k) {
@@ -120,7 +140,10 @@ FfrInvariants3d FfrInvariants3d::transformed(const SpMat& P) const {
   const SpMat Pt = P.transpose();
   for (int k = 0; k < 3; ++k) {
     r.positionShape[k] = positionShape[k] * P;
-    for (int l = 0; l < 3; ++l) r.sKL[k][l] = Pt * sKL[k][l] * P;
+    for (int l = 0; l < 3; ++l) {
+      r.sKL[k][l] = Pt * sKL[k][l] * P;
+      if (rKL[k][l].size() != 0) r.rKL[k][l] = Pt * rKL[k][l] * P;
+    }
   }
   r.mff = Pt * mff * P;
   r.kff = Pt * kff * P;

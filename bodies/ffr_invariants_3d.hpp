@@ -37,6 +37,11 @@ struct FfrInvariants3d {
   /// nine inertia shape integrals, six independent). Sparse: banded for nodal meshes,
   /// full for modal models.
   std::array<std::array<SpMat, 3>, 3> sKL;
+  /// rKL[k][l] = R_kl (nf x nf, symmetric, R_lk = R_kl): the second-order part of the
+  /// cross-sections' rotation in int rho u u^T dV, which gains qf^T R_kl qf (a section
+  /// point moves on a circle, not along the tangent N q_f: BeamElement3d::
+  /// sectionRotationMoment). Empty (0 x 0): none (invariants from other FE tools).
+  std::array<std::array<SpMat, 3>, 3> rKL;
   SpMat mff;                                ///< m_ff = S_xx + S_yy + S_zz
   SpMat kff;                                ///< stiffness under the reference conditions
   SpMat dff;                                ///< damping
@@ -48,6 +53,8 @@ struct FfrInvariants3d {
   /// semi-definite with |first moment|^2 <= m tr(second moment); finite entries.
   /// @throws InputError naming `owner` and the offending invariant.
   void validate(const std::string& owner) const;
+  /// rKL: each absent or nf x nf, finite, symmetric, R_lk = R_kl.
+  void validateSectionRotation(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
   FfrInvariants3d transformed(const SpMat& P) const;
   /// The elastic coordinates the point's shape and rotation shape depend on (ascending).

@@ -65,6 +65,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   secondMoment_.setZero();
   sBar_.setZero();
   for (Mat12& s : sKL_) s.setZero();
+  for (Mat12& r : rKL_) r.setZero();
   for (Mat3x12& s : xS_) s.setZero();
   G_.setZero();
   for (size_t g = 0; g < kGaussXi.size(); ++g) {
@@ -83,6 +84,8 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     }
     sKL_[4] += (w * rIy) * phi.transpose() * phi;  // S_yy += int rho z^2 tx^T tx dV
     sKL_[8] += (w * rIz) * phi.transpose() * phi;  // S_zz += int rho y^2 tx^T tx dV
+    rKL_[4] -= (w * rIz) * phi.transpose() * phi;  // R_yy = 2 int rho y u2_y dV = -rho Iz int tx^2 dx
+    rKL_[8] -= (w * rIy) * phi.transpose() * phi;  // R_zz = 2 int rho z u2_z dV = -rho Iy int tx^2 dx
     xS_[0] += (w * rhoA * x) * Sc;                 // int rho x S dV
     xS_[1].row(2) += (w * rIz) * phi;              // int rho y S_z dV = int rho y^2 tx dV
     xS_[2].row(1) -= (w * rIy) * phi;              // int rho z S_y dV = -int rho z^2 tx dV
@@ -94,6 +97,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     sKL_[4 * k] = (0.5 * (sKL_[4 * k] + sKL_[4 * k].transpose())).eval();
     for (int m = k + 1; m < 3; ++m) sKL_[3 * m + k] = sKL_[3 * k + m].transpose();
   }
+  for (Mat12& r : rKL_) r = (0.5 * (r + r.transpose())).eval();  // symmetric exactly
   massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz
   // x0 cross u = (y u_z - z u_y, z u_x - x u_z, x u_y - y u_x)
   skewXS_.row(0) = xS_[1].row(2) - xS_[2].row(1);
@@ -132,6 +136,13 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
 const BeamElement3d::Mat12& BeamElement3d::sKL(int k, int l) const {
   if (k < 0 || k > 2 || l < 0 || l > 2) throw std::out_of_range("BeamElement3d::sKL: k, l must be 0, 1 or 2");
   return sKL_[3 * k + l];
+}
+
+const BeamElement3d::Mat12& BeamElement3d::sectionRotationMoment(int k, int l) const {
+  if (k < 0 || k > 2 || l < 0 || l > 2) {
+    throw std::out_of_range("BeamElement3d::sectionRotationMoment: k, l must be 0, 1 or 2");
+  }
+  return rKL_[3 * k + l];
 }
 
 const BeamElement3d::Mat3x12& BeamElement3d::positionShapeIntegral(int k) const {

@@ -121,6 +121,18 @@ class BeamElement3d {
   const Mat3x12& skewPositionShapeIntegral() const { return skewXS_; }
   /// int rho x0^T S dV (1 x 12), kg m: int rho x0 . (S e) dV = this * e.
   const Row12& positionDotShapeIntegral() const { return dotXS_; }
+  /// R_kl (12 x 12, symmetric; R_lk = R_kl), kg: the second-order change of
+  /// int rho x x^T dV by the rotation of the cross-sections, e^T R_kl e. A section
+  /// turned by the twist tx moves its points on circles, u = (R(tx) - 1) r: to second
+  /// order u2 = (1/2) tx~ tx~ r = -(tx^2 / 2) (0, y, z) beside the first-order
+  /// tx e_x cross r of pointShape(). Over the section int rho (x0 u2^T + u2 x0^T) dA gives
+  ///   R_yy = -rho Iz int tx^T tx dx,   R_zz = -rho Iy int tx^T tx dx,   others zero,
+  /// so the polar moment (J_yy + J_zz of a shaft along x) does not change by the twist
+  /// and a section's second moments turn with it (Iz cos^2 + Iy sin^2). Without it a
+  /// spinning shaft loses torsional stiffness Omega^2 rho Ip per length (issue 25).
+  /// The body adds it to int rho u u^T dV only (its rotational inertia); the first-order
+  /// field S is unchanged. @throws std::out_of_range unless 0 <= k, l <= 2.
+  const Mat12& sectionRotationMoment(int k, int l) const;
 
   // ----- stiffness and strain energy (element frame) -----------------------------
   /// Linear stiffness K (12 x 12), the classic Przemieniecki matrix: axial EA/l, torsion
@@ -159,6 +171,7 @@ class BeamElement3d {
   Mat3 secondMoment_;
   Mat3x12 sBar_;
   std::array<Mat12, 9> sKL_;  // S_kl at index 3 k + l
+  std::array<Mat12, 9> rKL_;  // R_kl at index 3 k + l (sectionRotationMoment)
   Mat12 massMatrix_;
   std::array<Mat3x12, 3> xS_;  // int rho x0_k S dV
   Mat3x12 skewXS_;

@@ -54,10 +54,10 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
   FfrInvariants3d& inv = c.inv;
   inv.sBar = Mat3X::Zero(3, nf);
   MatX mff = MatX::Zero(nf, nf), kff = MatX::Zero(nf, nf);
-  std::array<std::array<MatX, 3>, 3> skl;
+  std::array<std::array<MatX, 3>, 3> skl, rkl;
   for (int k = 0; k < 3; ++k) {
     inv.positionShape[k] = Mat3X::Zero(3, nf);
-    for (int l = 0; l < 3; ++l) skl[k][l] = MatX::Zero(nf, nf);
+    for (int l = 0; l < 3; ++l) skl[k][l] = rkl[k][l] = MatX::Zero(nf, nf);
   }
   for (int e = 0; e < ne; ++e) {
     const BeamElement3d& el = c.elements[e];
@@ -83,6 +83,10 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
         for (int a = 0; a < 3; ++a)
           for (int b = 0; b < 3; ++b) s += C(k, a) * C(l, b) * el.sKL(a, b);
         skl[k][l] += TL.transpose() * s * TL;
+        BeamElement3d::Mat12 r = BeamElement3d::Mat12::Zero();  // R_kl likewise
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) r += C(k, a) * C(l, b) * el.sectionRotationMoment(a, b);
+        rkl[k][l] += TL.transpose() * r * TL;
       }
     }
     mff += TL.transpose() * el.massMatrix() * TL;
@@ -93,6 +97,9 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
     for (int l = 0; l < 3; ++l) {
       const MatX s = (k == l) ? MatX(0.5 * (skl[k][k] + skl[k][k].transpose())) : MatX(skl[k][l]);
       inv.sKL[k][l] = s.sparseView(0.0, 0.0);
+      // R_kl: symmetric, R_lk = R_kl (round-off of the sums)
+      const MatX r = 0.25 * (rkl[k][l] + rkl[k][l].transpose() + rkl[l][k] + rkl[l][k].transpose());
+      inv.rKL[k][l] = r.sparseView(0.0, 0.0);
     }
   }
   for (int k = 0; k < 3; ++k)
@@ -105,6 +112,8 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
   for (auto* S : {&inv.mff, &inv.kff, &inv.dff}) S->makeCompressed();
   for (auto& row : inv.sKL)
     for (auto& S : row) S.makeCompressed();
+  for (auto& row : inv.rKL)
+    for (auto& R : row) R.makeCompressed();
   for (int n = 0; n < ne + 1; ++n) {
     FfrPoint3d p;
     p.position = nodes[n];
