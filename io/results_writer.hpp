@@ -49,7 +49,8 @@ std::string summaryJson(const SimulationSummary& summary, const Scene& scene);
 /// coordinate "<body>.<coord>" (System::coordinateNames()); every velocity
 /// "<body>.<coord>_dot"; every acceleration "<body>.<coord>_ddot" (OutputSample::a, from
 /// the state at the output time); the reaction outputs (reactionOutputNames: "<joint>.fx",
-/// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs.
+/// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs; the
+/// spatial joints' outputs (SpatialJointOutputs, angles unwrapped over the rows written).
 /// Numbers are written with 17 significant digits (they read back exactly).
 /// The file is created at the first sample, so a run that fails before its first
 /// output leaves no results file behind. In HDF5 the numbers are the doubles themselves.
