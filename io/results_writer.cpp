@@ -118,6 +118,7 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
   reserveSummary(dir);
 
   columns_ = resultColumns(scene);
+  joints_ = std::make_unique<SpatialJointOutputs>(scene.system);
 }
 
 std::vector<std::string> resultColumns(const Scene& scene) {
@@ -133,11 +134,19 @@ std::vector<std::string> resultColumns(const Scene& scene) {
     const auto names = o.columnNames();
     columns.insert(columns.end(), names.begin(), names.end());
   }
+  const auto joints = SpatialJointOutputs(sys).columnNames();
+  columns.insert(columns.end(), joints.begin(), joints.end());
   return columns;
 }
 
 void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& s,
                std::vector<double>& values) {
+  SpatialJointOutputs joints(scene.system);
+  resultRow(scene, columns, s, values, joints);
+}
+
+void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& s,
+               std::vector<double>& values, SpatialJointOutputs& joints) {
   const System& sys = scene.system;
   const long nq = sys.numCoordinates(), nv = sys.numVelocities();
   const long m = sys.numConstraintEquations();
@@ -156,6 +165,7 @@ void resultRow(const Scene& scene, const std::vector<std::string>& columns, cons
   for (const auto& o : scene.outputs) {
     for (double x : o.evaluate(sys, s.q, s.v)) values.push_back(x);
   }
+  joints.append(s.q, s.v, values);
   if (values.size() != columns.size()) {
     throw std::runtime_error(sizeMismatch("a row", static_cast<long>(values.size()),
                                           static_cast<long>(columns.size()), s.t));
@@ -216,7 +226,7 @@ void ResultsWriter::open() {
 void ResultsWriter::write(const OutputSample& s) {
   // The whole row first: a row with a non-finite value is not written (the run stops).
   std::vector<double> values;
-  resultRow(scene_, columns_, s, values);
+  resultRow(scene_, columns_, s, values, *joints_);
   if (format_ == ResultsFormat::Hdf5) {
     if (!h5_) {
       auto file = std::make_unique<Hdf5RowFile>();

@@ -11,6 +11,7 @@
 
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
+#include "joints/joint_outputs.hpp"
 
 namespace flexmbd {
 
@@ -28,11 +29,15 @@ const char* resultsFileName(ResultsFormat format);
 /// The columns of a scene's results table, in order: t; every coordinate
 /// "<body>.<coord>"; every velocity "<body>.<coord>_dot"; every acceleration
 /// "<body>.<coord>_ddot"; the reaction outputs (reactionOutputNames); the scene's
-/// requested outputs.
+/// requested outputs; the spatial joints' outputs (SpatialJointOutputs: "<joint>.angle", ...).
 std::vector<std::string> resultColumns(const Scene& scene);
-/// The values of one row (resultColumns' order) for a sample, into `values` (cleared).
+/// The values of one row (resultColumns' order) for a sample, into `values` (cleared);
+/// `joints` (made for scene.system) unwraps the joint angles over the rows of a run.
 /// @throws NonFiniteResult for a value that is inf or NaN (naming the column and the
 ///         time), std::runtime_error if the sample has the wrong sizes.
+void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& sample,
+               std::vector<double>& values, SpatialJointOutputs& joints);
+/// The same for a single row: joint angles in (-pi, pi], not unwrapped.
 void resultRow(const Scene& scene, const std::vector<std::string>& columns, const OutputSample& sample,
                std::vector<double>& values);
 /// The run summary as JSON (the keys of writeSummary, in the same order).
@@ -44,7 +49,8 @@ std::string summaryJson(const SimulationSummary& summary, const Scene& scene);
 /// coordinate "<body>.<coord>" (System::coordinateNames()); every velocity
 /// "<body>.<coord>_dot"; every acceleration "<body>.<coord>_ddot" (OutputSample::a, from
 /// the state at the output time); the reaction outputs (reactionOutputNames: "<joint>.fx",
-/// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs.
+/// ".fy", ".m" in world axes, "<driver>.effort"); the scene's requested outputs; the
+/// spatial joints' outputs (SpatialJointOutputs, angles unwrapped over the rows written).
 /// Numbers are written with 17 significant digits (they read back exactly).
 /// The file is created at the first sample, so a run that fails before its first
 /// output leaves no results file behind. In HDF5 the numbers are the doubles themselves.
@@ -78,6 +84,7 @@ class ResultsWriter {
   std::filesystem::path path_;
   std::unique_ptr<Hdf5RowFile> h5_;  ///< results.h5, opened at the first row
   std::vector<std::string> columns_;
+  std::unique_ptr<SpatialJointOutputs> joints_;  ///< unwraps the joint angles over the rows
   int fd_ = -1;                ///< results.csv, opened at the first row
   long long bytes_ = 0;        ///< size of results.csv up to its last complete row
   long rows_ = 0;

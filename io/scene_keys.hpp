@@ -57,8 +57,12 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
                              "quasi_static_above", "redundant_constraints"};
 
 // spatial scenes ("dimension": 3)
-inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "position",
+inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "shape", "position",
                                   "orientation", "velocity", "angular_velocity"};
+inline const Keys kShapeBox = {"type", "size", "mass", "density"};
+inline const Keys kShapeSphere = {"type", "radius", "mass", "density"};
+inline const Keys kShapeCylinder = {"type", "radius", "length", "axis", "mass", "density"};
+inline const Keys kShapeTube = {"type", "inner_radius", "outer_radius", "length", "axis", "mass", "density"};
 inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "orientation", "velocity",
                                      "angular_velocity",     "section",     "beam",        "nodes",
                                      "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",
@@ -76,7 +80,8 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
                                    "d_ff",  "points"};
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
-inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames"};
+inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames", "world"};
+inline const Keys kJointWorld = {"point", "axis", "x_axis", "orientation"};
 inline const Keys kJointFrame = {"point", "axis", "orientation"};
 inline const Keys kBushing = {"name", "type", "bodies", "frames", "stiffness", "damping"};
 inline const Keys kSpatialAppliedLoad = {"name",    "type",     "body",     "point",    "force_x",
@@ -144,6 +149,10 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"output.deflection", &kPointOutput},
       {"solver", &kSolver},
       {"body.rigid.3d", &kRigidBody3d},
+      {"shape.box", &kShapeBox},
+      {"shape.sphere", &kShapeSphere},
+      {"shape.cylinder", &kShapeCylinder},
+      {"shape.tube", &kShapeTube},
       {"orientation", &kOrientation},
       {"body.flexible.3d", &kFlexibleBody3d},
       {"body.flexible_invariants.3d", &kInvariantsBody3d},
@@ -159,6 +168,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"joint.3d.fixed", &kSpatialJoint},
       {"joint.3d.planar", &kSpatialJoint},
       {"joint.frame", &kJointFrame},
+      {"joint.world", &kJointWorld},
       {"driver.body_z", &kBodyDriver},
       {"force.applied_load.3d", &kSpatialAppliedLoad},
       {"force.bushing", &kBushing},

@@ -8,6 +8,7 @@
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
+#include "bodies/shape_inertia.hpp"
 #include "io/beam_model_reader.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
@@ -16,6 +17,7 @@
 #include "io/scene_keys.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
+#include "joints/world_frames.hpp"
 
 namespace flexmbd::scenereaders {
 namespace {
@@ -38,13 +40,7 @@ JointFrame parseJointFrame(const json& j, const std::string& where) {
   if (r.has("axis")) {
     const Vec3 a = r.vector("axis", 3);
     if (!(a.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
-    const Vec3 z = a.normalized();
-    Eigen::Index k = 0;
-    z.cwiseAbs().minCoeff(&k);
-    const Vec3 x = (Vec3::Unit(k) - z[k] * z).normalized();
-    f.axes.col(0) = x;
-    f.axes.col(1) = z.cross(x);
-    f.axes.col(2) = z;
+    f.axes = located(r.where(), [&] { return frameAxesFromZ(a, nullptr, "key \"axis\""); });
   } else if (r.has("orientation")) {
     f.axes = parseOrientation(r.object("orientation"), r.where() + ".orientation");
   }
@@ -56,6 +52,59 @@ std::array<JointFrame, 2> parseFramePair(const ObjectReader& r) {
   const json& frames = r.requiredArray("frames");
   if (frames.size() != 2) r.fail("key \"frames\" must list two frames [{...}, {...}], one on each body");
   return {parseJointFrame(frames[0], r.where() + ".frames[0]"), parseJointFrame(frames[1], r.where() + ".frames[1]")};
+}
+
+/// Joint types whose frame axes matter: the joint axis z must be given ("axis").
+bool needsAxis(SpatialJointType t) { return t != SpatialJointType::Spherical && t != SpatialJointType::Fixed; }
+
+/// Key "world": {"point", "axis", "x_axis"} or {"point", "orientation"}: one frame in world
+/// axes, in the initial configuration, that both bodies' frames are made from. A universal
+/// joint needs its x axis (the cross's pin on body I): "x_axis" or "orientation".
+JointFrame parseWorldFrame(const json& j, const std::string& where, SpatialJointType t) {
+  ObjectReader r(j, where);
+  r.allowOnly(scenekeys::kJointWorld, " for a joint placed in the world");
+  const Vec3 point = r.vector("point", 3);
+  if (r.has("orientation")) {
+    if (r.has("axis") || r.has("x_axis")) r.fail("give either \"axis\" (with \"x_axis\") or \"orientation\", not both");
+    JointFrame f;
+    f.point = point;
+    f.axes = parseOrientation(r.object("orientation"), r.where() + ".orientation");
+    return f;
+  }
+  if (!r.has("axis")) {
+    if (needsAxis(t)) {
+      r.fail(std::string("a ") + toString(t) + " joint needs key \"axis\" (its joint axis, world axes) or \"orientation\"");
+    }
+    if (r.has("x_axis")) r.fail("key \"x_axis\" needs key \"axis\"");
+    JointFrame f;  // spherical, fixed: the world axes
+    f.point = point;
+    return f;
+  }
+  if (t == SpatialJointType::Universal && !r.has("x_axis")) {
+    r.fail("a universal joint needs key \"x_axis\" (the cross's pin on the first body, world axes) with \"axis\"");
+  }
+  const Vec3 axis = r.vector("axis", 3);
+  if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
+  Vec3 xHint = Vec3::Zero();
+  if (r.has("x_axis")) {
+    xHint = r.vector("x_axis", 3);
+    if (!(xHint.norm() > 0.0)) r.fail("key \"x_axis\" must be a non-zero vector, got [0, 0, 0]");
+  }
+  return located(r.where(), [&] {
+    return worldJointFrame(point, axis, r.has("x_axis") ? &xHint : nullptr, "key \"x_axis\"");
+  });
+}
+
+/// The frames of a joint: key "frames" (body axes) or key "world" (exactly one).
+std::array<JointFrame, 2> parseJointFrames(const ObjectReader& r, const System& sys, BodyIndex bi, BodyIndex bj,
+                                           SpatialJointType t) {
+  if (r.has("frames") == r.has("world")) {
+    r.fail("give exactly one of \"frames\" (one frame on each body, body axes) or \"world\" (a point and axes in "
+           "world axes, initial configuration)");
+  }
+  if (r.has("frames")) return parseFramePair(r);
+  const JointFrame world = parseWorldFrame(r.object("world"), r.where() + ".world", t);
+  return located(r.where() + ".world", [&] { return jointFramesFromWorld(sys, bi, bj, world, "key \"point\""); });
 }
 
 /// The frames of a spatial joint (for its drivers).
@@ -218,6 +267,45 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody3d>(name, std::move(inv), init, qf0, qf0dot)); });
 }
 
+/// Key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" | "sphere",
+/// its dimensions, exactly one of "mass" or "density"}, centred on the body frame.
+RigidBody3dProperties parseShape(const json& j, const std::string& where) {
+  const ObjectReader r(j, where);
+  const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
+  SolidShape s;
+  if (type == "box") {
+    r.allowOnly(scenekeys::kShapeBox, " for a box shape");
+    s.type = SolidShape::Type::Box;
+    s.size = r.vector("size", 3);
+    for (int k = 0; k < 3; ++k) r.checkPositive(s.size[k], "size[" + std::to_string(k) + "]");
+  } else if (type == "sphere") {
+    r.allowOnly(scenekeys::kShapeSphere, " for a sphere shape");
+    s.type = SolidShape::Type::Sphere;
+    s.radius = r.positive("radius");
+  } else {
+    const bool tube = type == "tube";
+    r.allowOnly(tube ? scenekeys::kShapeTube : scenekeys::kShapeCylinder, " for a " + type + " shape");
+    s.type = tube ? SolidShape::Type::Tube : SolidShape::Type::Cylinder;
+    s.radius = r.positive(tube ? "outer_radius" : "radius");
+    if (tube) {
+      s.innerRadius = r.nonNegative("inner_radius");
+      if (!(s.innerRadius < s.radius)) {
+        r.fail("key \"inner_radius\" must be < outer_radius (" + fmt(s.radius) + "), got " + fmt(s.innerRadius));
+      }
+    }
+    s.length = r.positive("length");
+    const std::string axis = r.string("axis", "z");
+    if (axis != "x" && axis != "y" && axis != "z") {
+      r.fail("key \"axis\" must be \"x\", \"y\" or \"z\" (the body axis along the shape's axis), got " + inQuotes(axis));
+    }
+    s.axis = axis[0] - 'x';
+  }
+  if (r.has("mass") == r.has("density")) r.fail("give exactly one of \"mass\" or \"density\"");
+  const double mass = r.has("mass") ? r.positive("mass") : 0.0;
+  const double density = r.has("density") ? r.positive("density") : 0.0;
+  return located(r.where(), [&] { return shapeProperties(s, mass, density); });
+}
+
 }  // namespace
 
 Mat3 parseOrientation(const json& j, const std::string& where) {
@@ -259,6 +347,16 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys) {
   if (type == "flexible") return parseSpatialFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseSpatialInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");
+  const FrameState3d init = parseFrameState3d(r);
+  if (r.has("shape") == r.has("inertia")) {
+    r.fail("give exactly one of \"inertia\" (with \"mass\") or \"shape\" (mass and inertia of a solid shape)");
+  }
+  if (r.has("shape")) {
+    if (r.has("mass")) r.fail("key \"mass\" does not go with \"shape\": give the shape's \"mass\" or \"density\"");
+    const RigidBody3dProperties props = parseShape(r.object("shape"), r.where() + ".shape");
+    located(r.where(), [&] { return sys.addBody(std::make_unique<RigidBody3d>(name, props, init)); });
+    return;
+  }
   RigidBody3dProperties props;
   props.mass = r.positive("mass");
   const json& inertia = r.required("inertia");
@@ -273,7 +371,6 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys) {
     }
     props.inertia = m;
   }
-  const FrameState3d init = parseFrameState3d(r);
   located(r.where(), [&] { return sys.addBody(std::make_unique<RigidBody3d>(name, props, init)); });
 }
 
@@ -285,7 +382,6 @@ void parseSpatialJoint(const json& j, const std::string& where, System& sys) {
   r.allowOnly(scenekeys::kSpatialJoint, " for a joint in a spatial scene");
   const std::string name = r.name("name");
   const auto [bi, bj] = lookupBodyPair(sys, r, "a joint");
-  const auto [fi, fj] = parseFramePair(r);
   static const std::array<std::pair<const char*, SpatialJointType>, 7> types = {{
       {"spherical", SpatialJointType::Spherical}, {"revolute", SpatialJointType::Revolute},
       {"prismatic", SpatialJointType::Prismatic}, {"cylindrical", SpatialJointType::Cylindrical},
@@ -295,6 +391,7 @@ void parseSpatialJoint(const json& j, const std::string& where, System& sys) {
   for (const auto& [n, v] : types) {
     if (type == n) t = v;
   }
+  const auto [fi, fj] = parseJointFrames(r, sys, bi, bj, t);
   located(r.where(), [&] { return sys.addConstraint(std::make_unique<SpatialJoint>(name, t, bi, fi, bj, fj)); });
 }
 

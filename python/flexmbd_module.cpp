@@ -56,8 +56,9 @@ RunOutput runScene(Scene& scene, bool progress) {
   settings.progress = progress;
   checkSolverSettings(settings);
   std::vector<double> row;
+  SpatialJointOutputs joints(scene.system);  // unwraps joint angles over the rows
   const SimulationSummary summary = simulateKeepingFailures(scene.system, settings, [&](const OutputSample& s) {
-    resultRow(scene, out.columns, s, row);
+    resultRow(scene, out.columns, s, row, joints);
     out.data.insert(out.data.end(), row.begin(), row.end());
     ++out.rows;
   });

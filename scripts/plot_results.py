@@ -96,12 +96,16 @@ def values(header, rows, name):
 COORD_UNITS = {"x": "m", "y": "m", "z": "m", "theta": "rad", "vx": "m/s", "vy": "m/s", "vz": "m/s",
                "ux": "m", "uy": "m", "N": "N", "M": "N m", "fx": "N", "fy": "N", "m": "N m",
                "effort": "N or N m", "force": "N", "tension": "N", "length": "m", "impulse": "N s",
-               "slack": "-"}
+               "slack": "-",
+               # spatial joint outputs (docs/scene-format.md, "Results files", item 7)
+               "angle": "rad", "angle1": "rad", "angle2": "rad", "displacement": "m", "dx": "m", "dy": "m",
+               "rx": "rad", "ry": "rad", "rz": "rad", "omega_x": "rad/s", "omega_y": "rad/s", "omega_z": "rad/s"}
 DESCRIPTIONS = {"ux": "elastic displacement x", "uy": "elastic displacement y", "N": "axial force",
                 "M": "bending moment", "fx": "reaction x", "fy": "reaction y", "m": "reaction moment",
                 "effort": "driver effort", "theta": "angle", "theta_dot": "angular velocity",
                 "theta_ddot": "angular acceleration", "kinetic": "kinetic energy",
-                "potential": "potential energy", "total": "total energy"}
+                "potential": "potential energy", "total": "total energy",
+                "angle": "joint angle", "displacement": "joint displacement"}
 
 
 def unit_of(name, kinematics):
