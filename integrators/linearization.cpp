@@ -360,7 +360,9 @@ ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, co
   // at rest but accelerating: not an equilibrium yet, solve for it (a free body at rest
   // without load is one already, and its static tangent would be singular)
   if (c.v.lpNorm<Eigen::Infinity>() == 0.0 && s.a.lpNorm<Eigen::Infinity>() > kEquilibriumAcceleration) {
-    const StaticEquilibrium eq = solveStaticEquilibrium(sys, t0, c.q);
+    StaticEquilibriumOptions options;
+    options.released = c.released;
+    const StaticEquilibrium eq = solveStaticEquilibrium(sys, t0, c.q, options);
     s.q = eq.q;
     s.lambda = eq.lambda;
     s.a = VecX::Zero(sys.numVelocities());
