@@ -165,20 +165,12 @@ ReferenceState initialReference(const Scene& scene, bool steady) {
 /// The state to linearise about: initialReference, or the state reached by simulating to `at`.
 /// @throws SolverError if that simulation fails.
 ReferenceState findReference(const Scene& scene, std::optional<double> at, bool steady, bool quiet) {
-  const System& sys = scene.system;
   if (!at) return initialReference(scene, steady);
   if (!(*at > scene.solver.tStart)) {
     throw InputError("option --at must be > t_start (" + fmt(scene.solver.tStart, 6) + ") of the scene, got " +
                      fmt(*at, 6));
   }
-  SolverSettings s = scene.solver;
-  s.tEnd = *at;
-  s.progress = !quiet;
-  OutputSample last;
-  const SimulationSummary summary = simulate(sys, s, [&](const OutputSample& sample) { last = sample; });
-  if (!summary.ok) throw SolverError("the simulation to --at " + fmt(*at, 6) + " failed: " + summary.message,
-                                     summary.tReached, 0.0);
-  return ReferenceState{last.t, last.q, last.v, last.a, last.lambda};
+  return referenceStateByRun(scene.system, scene.solver, *at, !quiet);
 }
 
 void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {

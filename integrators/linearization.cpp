@@ -16,7 +16,9 @@
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
+#include "core/number_text.hpp"
 #include "integrators/initial_conditions.hpp"
+#include "integrators/simulation.hpp"
 #include "integrators/static_equilibrium.hpp"
 
 namespace flexmbd {
@@ -368,6 +370,22 @@ ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, co
     s.a = VecX::Zero(sys.numVelocities());
   }
   return s;
+}
+
+ReferenceState referenceStateByRun(const System& sys, const SolverSettings& settings, double at, bool progress) {
+  if (!(at > settings.tStart)) {
+    throw InputError("modes: the time to linearise at must be after t_start (" + fmt(settings.tStart, 6) +
+                     ") of the scene, got " + fmt(at, 6));
+  }
+  SolverSettings s = settings;
+  s.tEnd = at;
+  s.progress = progress;
+  OutputSample last;
+  const SimulationSummary summary = simulate(sys, s, [&](const OutputSample& sample) { last = sample; });
+  if (!summary.ok) {
+    throw SolverError("the simulation to t = " + fmt(at, 6) + " failed: " + summary.message, summary.tReached, 0.0);
+  }
+  return ReferenceState{last.t, last.q, last.v, last.a, last.lambda};
 }
 
 ReferenceState solveSteadyMotion(const System& sys, double t0, const VecX& q0, const VecX& v0) {

@@ -22,10 +22,20 @@ struct ReferenceState {
 
 /// The consistent state at t0 from the system's initial values: positions projected on
 /// the constraints, velocities on the velocity constraints; if the velocities are then
-/// all zero, the static equilibrium is solved from there (a = 0, its multipliers);
+/// all zero, the static equilibrium is solved from there (a = 0, its multipliers; planar
+/// and spatial models, solveStaticEquilibrium);
 /// otherwise accelerations and multipliers come from the augmented system.
 /// @throws ModelError if the model cannot be assembled or has no equilibrium.
 ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0);
+
+struct SolverSettings;  // integrators/simulation.hpp
+
+/// The state a run of the model with `settings` (its tStart, tolerances and integrator)
+/// reaches at time `at`: positions, velocities, accelerations and multipliers of the last
+/// output sample (`flexmbd modes --at`, Python's Scene.modes(at=...)).
+/// @throws InputError if `at` is not after settings.tStart; SolverError if the run fails.
+ReferenceState referenceStateByRun(const System& sys, const SolverSettings& settings, double at,
+                                   bool progress = false);
 
 /// A steady motion with constant velocities and zero accelerations (a rotor at constant
 /// speed with its frame origin on the axis, stretched by the centrifugal load): from the

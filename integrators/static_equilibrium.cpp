@@ -104,12 +104,35 @@ class StaticProblem {
   MatX J_, T_;
 };
 
+/// Starting multipliers. From lambda = 0 the tangent has no geometric stiffness
+/// sum lambda_a H_a: a mechanism held only by its joints under a constant load (a rigid
+/// pendulum under gravity: dQ/dq T = 0) has a singular tangent there. Then lambda starts
+/// from the least-squares balance of the starting load, G^T lambda ~ Q (minimum norm;
+/// the reactions that hold what the joints can hold), which gives the joints their
+/// stiffness. Models whose tangent is regular at lambda = 0 (those solved before spatial
+/// models were: stressed structures) keep lambda = 0, and their iterations.
+void chooseStartingMultipliers(StaticProblem& P, const std::vector<int>& released) {
+  if (P.m() == 0) return;
+  MatX A;
+  P.tangent(A);
+  if (Eigen::FullPivLU<MatX>(A).isInvertible()) return;
+  VecX r;
+  P.residual(r);  // F_v = -Q at lambda = 0
+  const MatX Gt = A.topRightCorner(P.nv(), P.m());
+  VecX lambda = Gt.completeOrthogonalDecomposition().solve(-r.head(P.nv()));
+  for (const int k : released) lambda[k] = 0.0;  // their rows are lambda_k = 0
+  VecX x = P.state();
+  x.tail(P.m()) = lambda;
+  P.setState(x);
+}
+
 }  // namespace
 
 StaticEquilibrium solveStaticEquilibrium(const System& sys, double t, const VecX& q0,
                                          const StaticEquilibriumOptions& options) {
   StaticProblem P(sys, t, q0, options.released);
   const int nv = P.nv(), m = P.m();
+  chooseStartingMultipliers(P, options.released);
   VecX r0;
   P.residual(r0);  // the unbalanced load at the start
   double s = 0.0;  // load fraction of the last converged state

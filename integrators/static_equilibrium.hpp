@@ -29,7 +29,9 @@ struct StaticEquilibrium {
 };
 
 /// Newton iterations on r = [ -Q(t, q, 0) + G^T lambda ; g(q, t) ] = 0 (nv + m equations,
-/// Q and G in velocity space) from q0, lambda = 0. The unknowns are velocity-space
+/// Q and G in velocity space) from q0 and lambda = 0 (or, where the tangent is singular at
+/// lambda = 0, as for a pendulum held only by its joint, the least-squares multipliers
+/// G^T lambda ~ Q of the starting load). The unknowns are velocity-space
 /// increments: q <- q (+) dx (Body::applyIncrement: Euler parameters rotated in body axes
 /// and re-normalised; q + dx for planar bodies) and lambda <- lambda + dlambda, with the
 /// tangent [ (-dQ/dq + sum lambda_a H_a) T(q) , G^T ; (dg/dq) T(q) , 0 ] (q' = T(q) v;
