@@ -154,12 +154,19 @@ BasisKind basisFor(const System& sys, EigenSolverKind solver) {
   return sparse ? BasisKind::CoordinatePartitioning : BasisKind::Svd;
 }
 
+/// Redundant constraints handled as a run of the scene would ("redundant_constraints":
+/// "resolve" releases the dependent equations, "refuse" names them in a ModelError).
+ReleasedEquations releasedFor(const SolverSettings& s) {
+  return ReleasedEquations{s.redundantConstraints == RedundantConstraints::Resolve, {}};
+}
+
 /// The state at t_start: the consistent state (an equilibrium if at rest), or with
 /// `steady` the steady motion at the initial velocities.
 ReferenceState initialReference(const Scene& scene, bool steady) {
   const System& sys = scene.system;
   return steady ? solveSteadyMotion(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities())
-                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
+                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities(),
+                                   releasedFor(scene.solver));
 }
 
 /// The state to linearise about: initialReference, or the state reached by simulating to `at`.

@@ -352,13 +352,14 @@ constexpr double kEquilibriumAcceleration = 1e-8;
 
 }  // namespace
 
-ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0) {
-  const ConsistentState c = computeConsistentState(sys, t0, q0, v0);
+ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0,
+                                const ReleasedEquations& released) {
+  const ConsistentState c = computeConsistentState(sys, t0, q0, v0, released);
   ReferenceState s;
   s.t = t0;
   s.q = c.q;
   s.v = c.v;
-  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
+  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda, c.released);
   // at rest but accelerating: not an equilibrium yet, solve for it (a free body at rest
   // without load is one already, and its static tangent would be singular)
   if (c.v.lpNorm<Eigen::Infinity>() == 0.0 && s.a.lpNorm<Eigen::Infinity>() > kEquilibriumAcceleration) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/system.hpp"
+#include "integrators/initial_conditions.hpp"
 
 namespace flexmbd {
 
@@ -25,8 +26,13 @@ struct ReferenceState {
 /// all zero, the static equilibrium is solved from there (a = 0, its multipliers; planar
 /// and spatial models, solveStaticEquilibrium);
 /// otherwise accelerations and multipliers come from the augmented system.
+/// `released`: redundant constraints (as a run's "redundant_constraints"; default: refused,
+/// a ModelError naming them): the equations released at the consistent state are released
+/// in the static solve too (their multipliers 0; the linearisation's null-space basis
+/// handles the rank of G by itself).
 /// @throws ModelError if the model cannot be assembled or has no equilibrium.
-ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0);
+ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0,
+                                const ReleasedEquations& released = {});
 
 struct SolverSettings;  // integrators/simulation.hpp
 

@@ -118,9 +118,12 @@ void chooseStartingMultipliers(StaticProblem& P, const std::vector<int>& release
   if (Eigen::FullPivLU<MatX>(A).isInvertible()) return;
   VecX r;
   P.residual(r);  // F_v = -Q at lambda = 0
-  const MatX Gt = A.topRightCorner(P.nv(), P.m());
-  VecX lambda = Gt.completeOrthogonalDecomposition().solve(-r.head(P.nv()));
-  for (const int k : released) lambda[k] = 0.0;  // their rows are lambda_k = 0
+  // the kept equations' reactions only: a released one's row is lambda_k = 0, and sharing
+  // the load with it would leave the kept joints half their stiffness (a first Newton step
+  // twice too long, past the bottom of a pendulum to its top)
+  MatX Gt = A.topRightCorner(P.nv(), P.m());
+  for (const int k : released) Gt.col(k).setZero();
+  const VecX lambda = Gt.completeOrthogonalDecomposition().solve(-r.head(P.nv()));  // minimum norm: 0 at released
   VecX x = P.state();
   x.tail(P.m()) = lambda;
   P.setState(x);

@@ -393,10 +393,12 @@ PYBIND11_MODULE(_flexmbd, m) {
               const double t0 = s.solver.tStart;
               // at: the state a run reaches at that time (flexmbd modes --at); otherwise the
               // consistent state at t_start, the static equilibrium if it is at rest
+              const ReleasedEquations released{s.solver.redundantConstraints == RedundantConstraints::Resolve, {}};
               const ReferenceState state =
                   at ? referenceStateByRun(sys, s.solver, *at)
                   : steady ? solveSteadyMotion(sys, t0, sys.initialCoordinates(), sys.initialVelocities())
-                           : referenceStateAt(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
+                           : referenceStateAt(sys, t0, sys.initialCoordinates(), sys.initialVelocities(),
+                                              released);
               ModesOptions o;
               o.count = count;
               modes = modesAbout(sys, state, o);

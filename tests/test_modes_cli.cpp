@@ -128,6 +128,25 @@ TEST_F(Cli, ModesOfSpatialScenesWithoutAtAreTakenAboutTheStaticEquilibrium) {
   EXPECT_NEAR(w[0] / std::sqrt(m * g * d / (iyy + m * d * d)), 1.0, 1e-10);
   EXPECT_NE(r.out.find("at rest"), std::string::npos) << r.out;
 
+  // the same arm on its revolute joint twice: by default ("redundant_constraints":
+  // "resolve", as a run) the repeated equations are released and the modes are the same;
+  // with "refuse" exit status 2 naming the repeated joint
+  nlohmann::json doubled = pendulum;
+  doubled["joints"].push_back(doubled["joints"][0]);
+  doubled["joints"][1]["name"] = "again";
+  const fs::path doubledScene = writeScene("doubled.json", doubled);
+  r = run("modes " + shellQuote(doubledScene.string()) + " --out " + shellQuote((dir_ / "doubled").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  w = omegas(dir_ / "doubled" / "modes.csv");
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NEAR(w[0] / std::sqrt(m * g * d / (iyy + m * d * d)), 1.0, 1e-10);
+  doubled["solver"]["redundant_constraints"] = "refuse";
+  const fs::path refused = writeScene("refused.json", doubled);
+  r = run("modes " + shellQuote(refused.string()) + " --out " + shellQuote((dir_ / "refused").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err)) << r.err;
+  EXPECT_NE(r.err.find("joint 'again'"), std::string::npos) << r.err;
+
   // 2. A spatial steel cantilever (8 elements, square 20 mm section, L = 1.2 m) sagging
   // under its weight: its two lowest modes are the Euler-Bernoulli clamped-free
   // (beta_1 L)^2 sqrt(EI / (rho A L^4)), beta_1 L = 1.87510407, in both bending planes

@@ -249,6 +249,17 @@ TEST(SpatialStatics, RedundantConstraintsAreSolvedWhenReleased) {
   const StaticEquilibrium eq = solveStaticEquilibrium(sys, 0.0, sys.initialCoordinates(), o);
   EXPECT_NEAR(eq.q[2], -0.3, 1e-9);
   for (int k = 5; k < 10; ++k) EXPECT_EQ(eq.lambda[k], 0.0);
+  // modes at rest release what the consistent initialisation releases (detect, as a run's
+  // "resolve"): the equilibrium and the frequency are the single joint's (1e-8, as above)
+  ReleasedEquations detect;
+  detect.detect = true;
+  const ReferenceState ref = referenceStateAt(sys, 0.0, sys.initialCoordinates(), sys.initialVelocities(), detect);
+  EXPECT_NEAR(ref.q[2], -0.3, 1e-9);
+  const std::vector<Mode> modes = modesAbout(sys, ref);
+  ASSERT_EQ(modes.size(), 1u);
+  const double exact = std::sqrt(2.0 * g * 0.3 / (0.02 + 2.0 * 0.3 * 0.3));
+  EXPECT_NEAR(modes[0].omega / exact, 1.0, 1e-8);
+  EXPECT_NEAR(modes[0].dampingRatio, 0.0, 1e-8);  // an oscillation: the stable (bottom) equilibrium
 }
 
 TEST(SpatialStatics, StiffenedCantileverTurnedInSpaceNeedsLoadSteppingAndKeepsTheLinearTipDeflection) {
