@@ -154,31 +154,30 @@ BasisKind basisFor(const System& sys, EigenSolverKind solver) {
   return sparse ? BasisKind::CoordinatePartitioning : BasisKind::Svd;
 }
 
+/// Redundant constraints handled as a run of the scene would ("redundant_constraints":
+/// "resolve" releases the dependent equations, "refuse" names them in a ModelError).
+ReleasedEquations releasedFor(const SolverSettings& s) {
+  return ReleasedEquations{s.redundantConstraints == RedundantConstraints::Resolve, {}};
+}
+
 /// The state at t_start: the consistent state (an equilibrium if at rest), or with
 /// `steady` the steady motion at the initial velocities.
 ReferenceState initialReference(const Scene& scene, bool steady) {
   const System& sys = scene.system;
   return steady ? solveSteadyMotion(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities())
-                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities());
+                : referenceStateAt(sys, scene.solver.tStart, sys.initialCoordinates(), sys.initialVelocities(),
+                                   releasedFor(scene.solver));
 }
 
 /// The state to linearise about: initialReference, or the state reached by simulating to `at`.
 /// @throws SolverError if that simulation fails.
 ReferenceState findReference(const Scene& scene, std::optional<double> at, bool steady, bool quiet) {
-  const System& sys = scene.system;
   if (!at) return initialReference(scene, steady);
   if (!(*at > scene.solver.tStart)) {
     throw InputError("option --at must be > t_start (" + fmt(scene.solver.tStart, 6) + ") of the scene, got " +
                      fmt(*at, 6));
   }
-  SolverSettings s = scene.solver;
-  s.tEnd = *at;
-  s.progress = !quiet;
-  OutputSample last;
-  const SimulationSummary summary = simulate(sys, s, [&](const OutputSample& sample) { last = sample; });
-  if (!summary.ok) throw SolverError("the simulation to --at " + fmt(*at, 6) + " failed: " + summary.message,
-                                     summary.tReached, 0.0);
-  return ReferenceState{last.t, last.q, last.v, last.a, last.lambda};
+  return referenceStateByRun(scene.system, scene.solver, *at, !quiet);
 }
 
 void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {

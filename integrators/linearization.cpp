@@ -16,7 +16,9 @@
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
+#include "core/number_text.hpp"
 #include "integrators/initial_conditions.hpp"
+#include "integrators/simulation.hpp"
 #include "integrators/static_equilibrium.hpp"
 
 namespace flexmbd {
@@ -350,22 +352,41 @@ constexpr double kEquilibriumAcceleration = 1e-8;
 
 }  // namespace
 
-ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0) {
-  const ConsistentState c = computeConsistentState(sys, t0, q0, v0);
+ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0,
+                                const ReleasedEquations& released) {
+  const ConsistentState c = computeConsistentState(sys, t0, q0, v0, released);
   ReferenceState s;
   s.t = t0;
   s.q = c.q;
   s.v = c.v;
-  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda);
+  computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda, c.released);
   // at rest but accelerating: not an equilibrium yet, solve for it (a free body at rest
   // without load is one already, and its static tangent would be singular)
   if (c.v.lpNorm<Eigen::Infinity>() == 0.0 && s.a.lpNorm<Eigen::Infinity>() > kEquilibriumAcceleration) {
-    const StaticEquilibrium eq = solveStaticEquilibrium(sys, t0, c.q);
+    StaticEquilibriumOptions options;
+    options.released = c.released;
+    const StaticEquilibrium eq = solveStaticEquilibrium(sys, t0, c.q, options);
     s.q = eq.q;
     s.lambda = eq.lambda;
     s.a = VecX::Zero(sys.numVelocities());
   }
   return s;
+}
+
+ReferenceState referenceStateByRun(const System& sys, const SolverSettings& settings, double at, bool progress) {
+  if (!(at > settings.tStart)) {
+    throw InputError("modes: the time to linearise at must be after t_start (" + fmt(settings.tStart, 6) +
+                     ") of the scene, got " + fmt(at, 6));
+  }
+  SolverSettings s = settings;
+  s.tEnd = at;
+  s.progress = progress;
+  OutputSample last;
+  const SimulationSummary summary = simulate(sys, s, [&](const OutputSample& sample) { last = sample; });
+  if (!summary.ok) {
+    throw SolverError("the simulation to t = " + fmt(at, 6) + " failed: " + summary.message, summary.tReached, 0.0);
+  }
+  return ReferenceState{last.t, last.q, last.v, last.a, last.lambda};
 }
 
 ReferenceState solveSteadyMotion(const System& sys, double t0, const VecX& q0, const VecX& v0) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/system.hpp"
+#include "integrators/initial_conditions.hpp"
 
 namespace flexmbd {
 
@@ -22,10 +23,25 @@ struct ReferenceState {
 
 /// The consistent state at t0 from the system's initial values: positions projected on
 /// the constraints, velocities on the velocity constraints; if the velocities are then
-/// all zero, the static equilibrium is solved from there (a = 0, its multipliers);
+/// all zero, the static equilibrium is solved from there (a = 0, its multipliers; planar
+/// and spatial models, solveStaticEquilibrium);
 /// otherwise accelerations and multipliers come from the augmented system.
+/// `released`: redundant constraints (as a run's "redundant_constraints"; default: refused,
+/// a ModelError naming them): the equations released at the consistent state are released
+/// in the static solve too (their multipliers 0; the linearisation's null-space basis
+/// handles the rank of G by itself).
 /// @throws ModelError if the model cannot be assembled or has no equilibrium.
-ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0);
+ReferenceState referenceStateAt(const System& sys, double t0, const VecX& q0, const VecX& v0,
+                                const ReleasedEquations& released = {});
+
+struct SolverSettings;  // integrators/simulation.hpp
+
+/// The state a run of the model with `settings` (its tStart, tolerances and integrator)
+/// reaches at time `at`: positions, velocities, accelerations and multipliers of the last
+/// output sample (`flexmbd modes --at`, Python's Scene.modes(at=...)).
+/// @throws InputError if `at` is not after settings.tStart; SolverError if the run fails.
+ReferenceState referenceStateByRun(const System& sys, const SolverSettings& settings, double at,
+                                   bool progress = false);
 
 /// A steady motion with constant velocities and zero accelerations (a rotor at constant
 /// speed with its frame origin on the axis, stretched by the centrifugal load): from the

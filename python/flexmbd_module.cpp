@@ -12,6 +12,7 @@
 
 #include <cstring>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -381,16 +382,24 @@ PYBIND11_MODULE(_flexmbd, m) {
       })
       .def(
           "modes",
-          [](Scene& s, int count, bool steady) {
+          [](Scene& s, int count, bool steady, std::optional<double> at) {
+            if (at && steady) {
+              throw InputError("modes: at and steady cannot be combined (steady solves for the state at t_start)");
+            }
             std::vector<Mode> modes;
             {
               py::gil_scoped_release release;
               if (!s.system.isFinalized()) s.system.finalize();
               const System& sys = s.system;
               const double t0 = s.solver.tStart;
+              // at: the state a run reaches at that time (flexmbd modes --at); otherwise the
+              // consistent state at t_start, the static equilibrium if it is at rest
+              const ReleasedEquations released{s.solver.redundantConstraints == RedundantConstraints::Resolve, {}};
               const ReferenceState state =
-                  steady ? solveSteadyMotion(sys, t0, sys.initialCoordinates(), sys.initialVelocities())
-                         : referenceStateAt(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
+                  at ? referenceStateByRun(sys, s.solver, *at)
+                  : steady ? solveSteadyMotion(sys, t0, sys.initialCoordinates(), sys.initialVelocities())
+                           : referenceStateAt(sys, t0, sys.initialCoordinates(), sys.initialVelocities(),
+                                              released);
               ModesOptions o;
               o.count = count;
               modes = modesAbout(sys, state, o);
@@ -407,9 +416,10 @@ PYBIND11_MODULE(_flexmbd, m) {
             }
             return out;
           },
-          py::arg("count") = 10, py::arg("steady") = false,
-          "Modes of the model linearised about its consistent initial state (static equilibrium if at rest) "
-          "or, steady=True, about the steady motion at its initial velocities (integrators/linearization.hpp): "
+          py::arg("count") = 10, py::arg("steady") = false, py::arg("at") = py::none(),
+          "Modes of the model linearised about its consistent initial state (static equilibrium if at rest, "
+          "planar or spatial), steady=True about the steady motion at its initial velocities, or at=T about "
+          "the state a run reaches at time T (integrators/linearization.hpp): "
           "dicts of eigenvalue, omega (rad/s), frequency_hz, damping_ratio, shape (velocity space)")
       .def_property_readonly("velocity_names", [](Scene& s) {
         if (!s.system.isFinalized()) s.system.finalize();

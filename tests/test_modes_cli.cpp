@@ -90,3 +90,85 @@ TEST_F(Cli, ModesBadInputExitsWith2NamingTheKey) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("--out"), std::string::npos) << r.err;
 }
+
+namespace {
+
+/// omega_rad_s of each row of modes.csv.
+std::vector<double> omegas(const fs::path& csv) {
+  std::vector<double> out;
+  const std::vector<std::string> rows = lines(readFile(csv));
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const size_t c1 = rows[k].find(','), c2 = rows[k].find(',', c1 + 1);
+    out.push_back(std::stod(rows[k].substr(c2 + 1)));
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_F(Cli, ModesOfSpatialScenesWithoutAtAreTakenAboutTheStaticEquilibrium) {
+  // 1. A rigid arm on a revolute joint about world y, started at rest 1.2 rad off the
+  // bottom: the modes are those of the hanging equilibrium, omega = sqrt(m g d / I_pivot)
+  // with I_pivot = Iyy + m d^2 (compound pendulum); exact to round-off, the CSV's 12 digits.
+  const double m = 3.0, d = 0.35, iyy = 0.08, angle = 1.2, g = 9.81;
+  const nlohmann::json pendulum = {
+      {"name", "spatial pendulum"}, {"dimension", 3}, {"gravity", {0, 0, -g}},
+      {"bodies", {{{"name", "arm"}, {"type", "rigid"}, {"mass", m}, {"inertia", {0.05, iyy, 0.04}},
+                   {"position", {-d * std::sin(angle), 0, -d * std::cos(angle)}},
+                   {"orientation", {{"axis", {0, 1, 0}}, {"angle", angle}}}}}},
+      {"joints", {{{"name", "pivot"}, {"type", "revolute"}, {"bodies", {"ground", "arm"}},
+                   {"frames", {{{"point", {0, 0, 0}}, {"axis", {0, 1, 0}}}, {{"point", {0, 0, d}}, {"axis", {0, 1, 0}}}}}}}},
+      {"solver", {{"t_end", 1}}}};
+  const fs::path scene = writeScene("spatial_pendulum.json", pendulum);
+  const fs::path out = dir_ / "pendulum";
+  CliResult r = run("modes " + shellQuote(scene.string()) + " --out " + shellQuote(out.string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<double> w = omegas(out / "modes.csv");
+  ASSERT_EQ(w.size(), 1u);  // one degree of freedom
+  EXPECT_NEAR(w[0] / std::sqrt(m * g * d / (iyy + m * d * d)), 1.0, 1e-10);
+  EXPECT_NE(r.out.find("at rest"), std::string::npos) << r.out;
+
+  // the same arm on its revolute joint twice: by default ("redundant_constraints":
+  // "resolve", as a run) the repeated equations are released and the modes are the same;
+  // with "refuse" exit status 2 naming the repeated joint
+  nlohmann::json doubled = pendulum;
+  doubled["joints"].push_back(doubled["joints"][0]);
+  doubled["joints"][1]["name"] = "again";
+  const fs::path doubledScene = writeScene("doubled.json", doubled);
+  r = run("modes " + shellQuote(doubledScene.string()) + " --out " + shellQuote((dir_ / "doubled").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  w = omegas(dir_ / "doubled" / "modes.csv");
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NEAR(w[0] / std::sqrt(m * g * d / (iyy + m * d * d)), 1.0, 1e-10);
+  doubled["solver"]["redundant_constraints"] = "refuse";
+  const fs::path refused = writeScene("refused.json", doubled);
+  r = run("modes " + shellQuote(refused.string()) + " --out " + shellQuote((dir_ / "refused").string()));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_TRUE(IsOneErrorLine(r.err)) << r.err;
+  EXPECT_NE(r.err.find("joint 'again'"), std::string::npos) << r.err;
+
+  // 2. A spatial steel cantilever (8 elements, square 20 mm section, L = 1.2 m) sagging
+  // under its weight: its two lowest modes are the Euler-Bernoulli clamped-free
+  // (beta_1 L)^2 sqrt(EI / (rho A L^4)), beta_1 L = 1.87510407, in both bending planes
+  // (cubic elements, h^4: 2.1e-6 with 8 elements; 1e-5 bounds it).
+  const double L = 1.2, side = 0.02, E = 2.1e11, rho = 7850.0;
+  const nlohmann::json beam = {
+      {"name", "cantilever"}, {"dimension", 3}, {"gravity", {0, 0, -g}},
+      {"bodies", {{{"name", "beam"}, {"type", "flexible"},
+                   {"section", {{"width", side}, {"height", side}, {"youngs_modulus", E}, {"poisson_ratio", 0.3}, {"density", rho}}},
+                   {"beam", {{"length", L}, {"elements", 8}}}, {"reference", {{"type", "clamped"}}}}}},
+      {"joints", {{{"name", "root"}, {"type", "fixed"}, {"bodies", {"ground", "beam"}},
+                   {"frames", {{{"point", {0, 0, 0}}}, {{"point", {0, 0, 0}}}}}}}},
+      {"solver", {{"t_end", 1}}}};
+  const fs::path beamScene = writeScene("spatial_cantilever.json", beam);
+  const fs::path beamOut = dir_ / "cantilever";
+  r = run("modes " + shellQuote(beamScene.string()) + " --out " + shellQuote(beamOut.string()) + " --count 3");
+  ASSERT_EQ(r.status, 0) << r.err;
+  w = omegas(beamOut / "modes.csv");
+  ASSERT_EQ(w.size(), 3u);
+  const double I = std::pow(side, 4) / 12, A = side * side, beta1L = 1.87510407;
+  const double exact = beta1L * beta1L * std::sqrt(E * I / (rho * A * std::pow(L, 4)));
+  EXPECT_NEAR(w[0] / exact, 1.0, 1e-5);
+  EXPECT_NEAR(w[1] / exact, 1.0, 1e-5);
+  EXPECT_TRUE(fs::exists(beamOut / "vtk" / "mode_01.pvd"));
+}

@@ -139,13 +139,18 @@ class Scene:
         "deflection" or "energy"): extra result columns."""
         self._native.add_output_json(json.dumps(output), spatial)
 
-    def modes(self, count=10, steady=False):
-        """The model's lowest modes, linearised about its consistent initial state (the static
-        equilibrium if it starts at rest) or, ``steady=True``, about the steady motion at its
-        initial velocities (docs/modes.md): a list of dicts with ``eigenvalue``, ``omega``
-        (rad/s), ``frequency_hz``, ``damping_ratio`` and ``shape`` (complex, one entry per
-        ``velocity_names``)."""
-        return self._native.modes(count, steady)
+    def modes(self, count=10, steady=False, at=None):
+        """The model's lowest modes (docs/modes.md), linearised about
+
+        - ``at=None`` (the default): its consistent initial state, the static equilibrium
+          if it starts at rest (planar and spatial models);
+        - ``at=T`` (a number > ``solver.t_start``): the state a run of the scene reaches at
+          time T, as ``flexmbd modes --at T`` (a failed run raises RuntimeError);
+        - ``steady=True`` (not with ``at``): the steady motion at its initial velocities.
+
+        Returns a list of dicts with ``eigenvalue``, ``omega`` (rad/s), ``frequency_hz``,
+        ``damping_ratio`` and ``shape`` (complex, one entry per ``velocity_names``)."""
+        return self._native.modes(count, steady, None if at is None else float(at))
 
     @property
     def velocity_names(self):

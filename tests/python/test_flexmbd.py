@@ -204,6 +204,42 @@ def test_modes_of_a_pendulum_built_in_python():
     assert len(modes[0]["shape"]) == len(scene.velocity_names) == 3
 
 
+def spatial_pendulum(angle):
+    """A rigid arm (m = 3 kg, Iyy = 0.08 kg m^2 about its centre of mass, which is d = 0.35 m
+    below the pivot) on a revolute joint about the world y axis, at rest, turned by `angle`
+    about y from the bottom."""
+    d = 0.35
+    return {"name": "spatial pendulum", "dimension": 3, "gravity": [0, 0, -9.81],
+            "bodies": [{"name": "arm", "type": "rigid", "mass": 3.0, "inertia": [0.05, 0.08, 0.04],
+                        "position": [-d * math.sin(angle), 0, -d * math.cos(angle)],
+                        "orientation": {"axis": [0, 1, 0], "angle": angle}}],
+            "joints": [{"name": "pivot", "type": "revolute", "bodies": ["ground", "arm"],
+                        "frames": [{"point": [0, 0, 0], "axis": [0, 1, 0]}, {"point": [0, 0, d], "axis": [0, 1, 0]}]}],
+            "solver": {"t_end": 1, "rtol": 1e-10, "atol": 1e-12}}
+
+
+def test_spatial_modes_at_rest_and_at_a_time_of_a_run():
+    # at=None: about the static equilibrium (the arm started 1.2 rad off the bottom hangs
+    # straight down), omega = sqrt(m g d / (Iyy + m d^2)); the linearisation of an
+    # equilibrium is exact to round-off (1e-10). at=0.5: about the state a run reaches then;
+    # started at the bottom the arm stays there (to the run's tolerances, 1e-10 relative),
+    # so the same frequency.
+    m, d, iyy, g = 3.0, 0.35, 0.08, 9.81
+    exact = math.sqrt(m * g * d / (iyy + m * d * d))
+    modes = flexmbd.scene_from_dict(spatial_pendulum(1.2)).modes(count=3)
+    assert len(modes) == 1
+    assert abs(modes[0]["omega"] / exact - 1) < 1e-10
+    assert len(modes[0]["shape"]) == 6  # velocity space: 3 translations, 3 body-axes rotations
+    at_rest = flexmbd.scene_from_dict(spatial_pendulum(0.0))
+    later = at_rest.modes(count=3, at=0.5)
+    assert len(later) == 1
+    assert abs(later[0]["omega"] / exact - 1) < 1e-8
+    with pytest.raises(flexmbd.InputError, match="after t_start"):
+        at_rest.modes(at=0.0)
+    with pytest.raises(flexmbd.InputError, match="at and steady"):
+        at_rest.modes(at=0.5, steady=True)
+
+
 def test_kinematics_from_python_equals_the_command_line(tmp_path):
     # The four-bar's kinematics table: the same columns and numbers as kinematics.csv
     # (17 significant digits read back exactly).
