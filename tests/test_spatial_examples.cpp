@@ -300,3 +300,163 @@ TEST(SpatialExample, FlexibleRobotArmTorquesWorkIsTheChangeOfEnergy) {
   constexpr double kBalance = 1e-5;
   EXPECT_LE(e.worst, kBalance);
 }
+
+// ----- flyball governor (IFToMM A05 parameters) -----------------------------------------
+
+namespace {
+
+/// The governor of examples/flyball_governor.json as the scene gives it: arms (rod + ball)
+/// of mass ma, centre of mass dc from the hinge, principal moments Ixx (along the arm) and
+/// Ip (across), hinges e off the axis at height h, springs k, free length L0 from the arm
+/// point `a` (from the hinge) to the sleeve's side e off the axis, sleeve mass ms.
+struct Governor {
+  double ma, dc, Ixx, Ip, e, h, k, L0, a, ms, g;
+  /// The amended potential of a steady rotation at the spindle speed Om (arms alpha below
+  /// the horizontal, sleeve at height s): gravity + springs - Om^2 I_axis / 2 (the
+  /// relative equilibria of the driven governor are its stationary points; the spindle
+  /// and sleeve add constants).
+  double potential(double alpha, double s, double Om) const {
+    const double ca = std::cos(alpha), sa = std::sin(alpha);
+    const double xc = e + dc * ca, zc = h - dc * sa;
+    const double Iaxis = Ixx * sa * sa + Ip * ca * ca + ma * xc * xc;
+    const double l = std::hypot(a * ca, h - a * sa - s);
+    return 2 * (ma * g * zc + 0.5 * k * (l - L0) * (l - L0) - 0.5 * Om * Om * Iaxis) + ms * g * s;
+  }
+  /// Its gradient (d/dalpha, d/ds), analytic: with dz = h - a sin(alpha) - s and
+  /// l = sqrt((a cos alpha)^2 + dz^2),
+  ///   dV/dalpha = 2 (-ma g dc cos + k (l - L0) dl/dalpha - Om^2 ((Ixx - Ip) sin cos - ma xc dc sin)),
+  ///   dV/ds = -2 k (l - L0) dz / l + ms g.
+  Eigen::Vector2d gradient(const Eigen::Vector2d& x, double Om) const {
+    const double ca = std::cos(x[0]), sa = std::sin(x[0]);
+    const double dz = h - a * sa - x[1], l = std::hypot(a * ca, dz), xc = e + dc * ca;
+    const double dlda = (-a * a * ca * sa - dz * a * ca) / l;
+    return {2 * (-ma * g * dc * ca + k * (l - L0) * dlda - Om * Om * ((Ixx - Ip) * sa * ca - ma * xc * dc * sa)),
+            -2 * k * (l - L0) * dz / l + ms * g};
+  }
+  /// Newton on the gradient (Hessian by differences of it) from x.
+  Eigen::Vector2d equilibrium(Eigen::Vector2d x, double Om) const {
+    for (int it = 0; it < 30; ++it) {
+      Eigen::Matrix2d H;
+      const double d = 1e-7;
+      for (int c = 0; c < 2; ++c) {
+        Eigen::Vector2d xp = x, xm = x;
+        xp[c] += d, xm[c] -= d;
+        H.col(c) = (gradient(xp, Om) - gradient(xm, Om)) / (2 * d);
+      }
+      const Eigen::Vector2d dx = H.lu().solve(-gradient(x, Om));
+      x += dx;
+      if (dx.norm() < 1e-13) break;
+    }
+    return x;
+  }
+};
+
+Governor governorOf(const json& j) {
+  Governor gv;
+  const json& arm = j["bodies"][2];
+  EXPECT_EQ(arm["name"], "arm_right");
+  gv.ma = arm["mass"], gv.Ixx = arm["inertia"][0], gv.Ip = arm["inertia"][1];
+  const json& hinge = j["joints"][2]["world"]["point"];
+  gv.e = hinge[0], gv.h = hinge[2];
+  const Vec3 r(arm["position"][0], arm["position"][1], arm["position"][2]);
+  gv.dc = (r - Vec3(gv.e, 0, gv.h)).norm();
+  const json& spring = j["forces"][0];
+  gv.k = spring["stiffness"], gv.L0 = spring["free_length"];
+  gv.a = gv.dc + spring["points"][1][0].get<double>();  // the arm point, from the hinge
+  EXPECT_NEAR(spring["points"][0][0].get<double>(), gv.e, 1e-15);  // the sleeve's side, e off the axis
+  const json& sleeve = j["bodies"][1]["shape"];
+  gv.ms = sleeve["density"].get<double>() * std::pow(sleeve["size"][0].get<double>(), 3);
+  gv.g = -j["gravity"][2].get<double>();
+  return gv;
+}
+
+/// Arm angle below the horizontal and sleeve height along a run.
+void governorState(const System& sys, const VecX& q, double& alpha, double& s) {
+  const BodyIndex arm = sys.findBody("arm_right"), sleeve = sys.findBody("sleeve");
+  const Mat3 A = quaternionRotation(Vec4(q.segment<4>(sys.coordinateOffset(arm) + 3)));
+  const Vec3 d = A.col(0);  // along the arm, from the hinge out
+  alpha = std::atan2(-d.z(), std::hypot(d.x(), d.y()));
+  s = q[sys.coordinateOffset(sleeve) + 2];
+}
+
+}  // namespace
+
+TEST(SpatialExample, FlyballGovernorTurnsSteadilyAtTheClosedFormArmAngle) {
+  const json j = exampleJson("flyball_governor.json");
+  const Governor gv = governorOf(j);
+  const double Om = j["drivers"][0]["law"]["speed"];
+  const Eigen::Vector2d eq = gv.equilibrium(Eigen::Vector2d(0.5, 0.5), Om);
+  // the potential's gradient checked against differences of it (the code of the two)
+  {
+    const Eigen::Vector2d x(0.4, 0.45);
+    const double d = 1e-6;
+    const Eigen::Vector2d fd((gv.potential(x[0] + d, x[1], Om) - gv.potential(x[0] - d, x[1], Om)) / (2 * d),
+                             (gv.potential(x[0], x[1] + d, Om) - gv.potential(x[0], x[1] - d, Om)) / (2 * d));
+    EXPECT_LE((fd - gv.gradient(x, Om)).norm(), 1e-5 * gv.gradient(x, Om).norm());
+  }
+  // how much the equilibrium moves with the speed: the test's resolution
+  const Eigen::Vector2d eqFaster = gv.equilibrium(eq, 1.01 * Om);
+  Scene scene = parseScene(j);
+  const RunData run = runScene(scene);
+  double dAlpha = 0, dS = 0;
+  for (const VecX& q : run.q) {
+    double alpha, s;
+    governorState(scene.system, q, alpha, s);
+    dAlpha = std::max(dAlpha, std::abs(alpha - eq[0]));
+    dS = std::max(dS, std::abs(s - eq[1]));
+  }
+  std::printf("[ figures ] flyball governor at %.6f rad/s: closed-form equilibrium arm %.9f deg below the "
+              "horizontal, sleeve %.9f m (1%% faster: %.6f deg); over %.1f s the arm stays within %.3e rad and the "
+              "sleeve within %.3e m of it\n",
+              Om, eq[0] * 180 / M_PI, eq[1], eqFaster[0] * 180 / M_PI, run.t.back(), dAlpha, dS);
+  // Tolerances: the run starts on the configuration the file gives (30 deg, sleeve at
+  // the springs' static stretch, 12 digits), the equilibrium to round-off; the BDF at
+  // rtol 1e-8 then keeps the arm within 1e-6 rad and the sleeve within 7e-7 m (the slow
+  // governor mode stirred by the integration error). kAngle 1e-5 rad and kSleeve 5e-6 m:
+  // 10x above that, 3 orders below what 1% of speed moves the equilibrium (1.1e-2 rad,
+  // ~1e-2 m of sleeve) and below the springs' static stretch (7e-5 m).
+  constexpr double kAngle = 1e-5, kSleeve = 5e-6;
+  EXPECT_NEAR(eq[0], M_PI / 6, kAngle);  // the published 30 deg is the steady rotation at this speed
+  EXPECT_LE(dAlpha, kAngle);
+  EXPECT_LE(dS, kSleeve);
+  EXPECT_GT(std::abs(eqFaster[0] - eq[0]), 100 * kAngle);
+}
+
+TEST(SpatialExample, FlyballGovernorDriverWorkIsTheChangeOfEnergy) {
+  // The governor spun up to 1.2 times its steady speed from the steady state (the
+  // consistent start projects the bodies' velocities onto the new driver speed), without
+  // the springs' dampers (their dissipation is not an output): the arms swing out and
+  // back, and the motor's work, -lambda Om (M v' = Q - G^T lambda, so the driver's force
+  // -G^T lambda delivers -lambda G v = -lambda Om), is the change of the total energy.
+  json j = exampleJson("flyball_governor.json");
+  const double Om = 1.2 * j["drivers"][0]["law"]["speed"].get<double>();
+  j["drivers"][0]["law"]["speed"] = Om;
+  for (auto& f : j["forces"]) f["damping"] = 0.0;
+  j["solver"]["output_step"] = 1e-3;
+  Scene scene = parseScene(j);
+  const int motor = scene.system.constraintOffset(scene.system.findConstraint("motor"));
+  const RunData run = runScene(scene);
+  std::vector<double> tt, pp;
+  double worst = 0, W = 0, dE = 0, alphaMin = 10, alphaMax = -10;
+  for (std::size_t k = 0; k < run.t.size(); ++k) {
+    tt.push_back(run.t[k]);
+    pp.push_back(-run.lambda[k][motor] * Om);
+    double alpha, s;
+    governorState(scene.system, run.q[k], alpha, s);
+    alphaMin = std::min(alphaMin, alpha), alphaMax = std::max(alphaMax, alpha);
+    if (k % 2 == 0) {
+      W = integrate(tt, pp), dE = run.outputs[k][2] - run.outputs[0][2];
+      worst = std::max(worst, std::abs(W - dE));
+    }
+  }
+  std::printf("[ figures ] flyball governor spun at 1.2 x: arm between %.4f and %.4f deg, motor work %.9f J, change "
+              "of energy %.9f J, largest |W - dE| %.3e J (%ld steps)\n",
+              alphaMin * 180 / M_PI, alphaMax * 180 / M_PI, W, dE, worst, run.steps);
+  EXPECT_GT(alphaMax - alphaMin, 0.1);  // the arms swing
+  EXPECT_GT(std::abs(W), 1.0);
+  // kBalance 1e-4 J of ~200 J: Simpson at 1 ms on a power that carries the sleeve's
+  // bounce on the undamped springs (~700 rad/s, (omega h)^4 / 180 ~ 1e-3 of its small
+  // part), and rtol 1e-8 of 200 J, 2e-6 J.
+  constexpr double kBalance = 1e-4;
+  EXPECT_LE(worst, kBalance);
+}
