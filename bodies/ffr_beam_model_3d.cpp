@@ -81,7 +81,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
   for (size_t e = 0; e < mesh_.elements.size(); ++e) {
     const auto& el = mesh_.elements[e];
     const std::string who = owner + ": element " + std::to_string(e);
-    elements_.emplace_back(mesh_.nodes[el.node1], mesh_.nodes[el.node2], el.yHint, el.section, who);
+    elements_.emplace_back(mesh_.nodes[el.node1], mesh_.nodes[el.node2], el.yHint, el.section, who, options_.theory);
   }
 
   // ----- nodal invariants (6 coordinates per node, body frame) ---------------------
@@ -93,6 +93,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
   using Triplets = std::vector<Eigen::Triplet<double>>;
   std::array<Triplets, 9> tS;  // S_kl at 3 k + l
   std::array<Triplets, 9> tR;  // R_kl at 3 k + l
+  std::array<Triplets, 3> tH;  // H_i
   Triplets tm, tk, td;
   for (size_t e = 0; e < elements_.size(); ++e) {
     const BeamElement3d& el = elements_[e];
@@ -141,6 +142,13 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
         rkl[3 * k + l] = T.transpose() * acc * T;
       }
     }
+    // H_i: int rho u0 x u2 dV = C int rho x0 x u2 dV (+ s x int rho u2 dV = 0): a vector
+    std::array<BeamElement3d::Mat12, 3> hi;
+    for (int i = 0; i < 3; ++i) {
+      BeamElement3d::Mat12 acc = BeamElement3d::Mat12::Zero();
+      for (int a = 0; a < 3; ++a) acc += C(i, a) * el.sectionRotationCoupling(a);
+      hi[i] = T.transpose() * acc * T;
+    }
     const BeamElement3d::Mat12 mm = T.transpose() * el.massMatrix() * T;
     const BeamElement3d::Mat12 kk = T.transpose() * el.stiffness() * T;
     const double beta = el.section().damping;
@@ -154,6 +162,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
         for (int kl = 0; kl < 9; ++kl) {
           if (skl[kl](a, b) != 0.0) tS[kl].emplace_back(idx[a], idx[b], skl[kl](a, b));
           if (rkl[kl](a, b) != 0.0) tR[kl].emplace_back(idx[a], idx[b], rkl[kl](a, b));
+          if (kl < 3 && hi[kl](a, b) != 0.0) tH[kl].emplace_back(idx[a], idx[b], hi[kl](a, b));
         }
         tm.emplace_back(idx[a], idx[b], mm(a, b));
         tk.emplace_back(idx[a], idx[b], kk(a, b));
@@ -170,6 +179,7 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
       build(nodal.sKL[k][l], tS[3 * k + l]);
       build(nodal.rKL[k][l], tR[3 * k + l]);
     }
+    build(nodal.hI[k], tH[k]);
   }
   build(nodal.mff, tm);
   build(nodal.kff, tk);

@@ -74,6 +74,9 @@ struct FfrBeamOptions3d {
   /// Element-averaged second-order membrane strain in the strain energy (BeamElement3d,
   /// locking-free); off: the linear FFR model.
   bool geometricStiffening = false;
+  /// The elements' beam theory (BeamTheory): Rayleigh adds the sections' rotary inertia
+  /// of bending (and its second-order rotation, R_kl and H_i).
+  BeamTheory theory = BeamTheory::EulerBernoulli;
 };
 
 class FfrBeamModel3d {

@@ -105,6 +105,15 @@ FfrBody3d::FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameSt
     }
   }
   for (auto& t : sectionRotation_) t.R.makeCompressed();
+  for (int i = 0; i < 3; ++i) {
+    if (inv_.hI[i].size() != 0 && inv_.hI[i].nonZeros() > 0) {
+      h_[i] = inv_.hI[i];
+      hasCoupling_ = true;
+    } else {
+      h_[i].resize(nf_, nf_);
+    }
+    h_[i].makeCompressed();
+  }
   for (const FfrPoint3d& p : inv_.points) nodeSupport_.push_back(FfrInvariants3d::support(p));
 }
 
@@ -271,7 +280,10 @@ Mat3 FfrBody3d::inertiaAt(const ConstVecRef& q) const {
 
 Vec3 FfrBody3d::skewShapeColumn(const ConstVecRef& qf, int k) const {
   // Y = int rho u~ N dV = X0 + int rho (N qf)~ N dV; column k: X0_k + (qf^T W_i e_k)_i
-  return x0_.col(k) + Vec3(columnDot(w_[0], k, qf), columnDot(w_[1], k, qf), columnDot(w_[2], k, qf));
+  // + (qf^T H_i e_k)_i = (H_i qf)_k, the sections' second-order rotation (H symmetric)
+  return x0_.col(k) + Vec3(columnDot(w_[0], k, qf) + columnDot(h_[0], k, qf),
+                           columnDot(w_[1], k, qf) + columnDot(h_[1], k, qf),
+                           columnDot(w_[2], k, qf) + columnDot(h_[2], k, qf));
 }
 
 void FfrBody3d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
@@ -292,7 +304,7 @@ void FfrBody3d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
     M.addColumn(6, j, nf_, [&](int k) { return A.row(j).dot(inv_.sBar.col(k)); });
   }
   for (int j = 0; j < 3; ++j) {
-    M.addColumn(6, 3 + j, nf_, [&](int k) { return x0_(j, k) + columnDot(w_[j], k, qf); });
+    M.addColumn(6, 3 + j, nf_, [&](int k) { return x0_(j, k) + columnDot(w_[j], k, qf) + columnDot(h_[j], k, qf); });
   }
   M.addSparse(6, 6, inv_.mff);
 }
@@ -337,6 +349,13 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
     }
   }
   addSectionRotationMoment(qf, quadratic);
+  if (hasCoupling_) {
+    // Y af gains (qf^T H_i af)_i, rows f Y^T aw gains sum_i aw_i H_i qf
+    for (int i = 0; i < 3; ++i) {
+      yaf[i] += bilinear(h_[i], qf, af);
+      addProduct(h_[i], qf, aw[i], of);
+    }
+  }
   const Mat3 J = secondMomentFrom(qf, quadratic);
   // row R: m aR - A s~ aw + A S-bar af
   out.head<3>() += inv_.mass * aR + A * (aw.cross(s) + inv_.sBar * af);
@@ -366,7 +385,9 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
     const Vec3 sk = inv_.sBar.col(k);
     const Mat3 Dk = secondMomentDerivative(qf, k);
     // d(Y af)/dqf_k = (W_i af)_k = -(W_i^T af)_k (W_i skew)
-    const Vec3 dY(-columnDot(w_[0], k, af), -columnDot(w_[1], k, af), -columnDot(w_[2], k, af));
+    // and (H_i af)_k (H_i symmetric)
+    const Vec3 dY(-columnDot(w_[0], k, af) + columnDot(h_[0], k, af), -columnDot(w_[1], k, af) + columnDot(h_[1], k, af),
+                  -columnDot(w_[2], k, af) + columnDot(h_[2], k, af));
     Vec6 col;
     col << A * (awS * sk), -bRs * sk + Dk.trace() * aw - Dk * aw + dY;
     K.addBlock(0, 7 + k, col);
@@ -378,6 +399,10 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   }
   // d(Y^T aw)/dqf = sum_i aw_i W_i^T = -sum_i aw_i W_i
   for (int i = 0; i < 3; ++i) K.addSparse(6, 7, w_[i], -aw[i]);
+  // + sum_i aw_i H_i
+  if (hasCoupling_) {
+    for (int i = 0; i < 3; ++i) K.addSparse(6, 7, h_[i], aw[i]);
+  }
 }
 
 // ----- forces ------------------------------------------------------------------------
@@ -461,6 +486,15 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
     for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + Gq(k, l);
   }
   Q.segment<3>(3) -= w.cross(J.trace() * w - J * w) + 2.0 * (G.trace() * w - G * w);
+  if (hasCoupling_) {
+    // T gains w . b, b_i = qf^T H_i qf': d/dt b + w x b, the qf'' part in the mass matrix
+    Vec3 b, c;
+    for (int i = 0; i < 3; ++i) {
+      b[i] = bilinear(h_[i], qf, pf);
+      c[i] = bilinear(h_[i], pf, pf);
+    }
+    Q.segment<3>(3) -= c + w.cross(b);
+  }
   // int rho N_k^T u_l dV = positionShape[l].row(k)^T + S_kl qf: the constant part
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) Qf.noalias() -= Om(k, l) * inv_.positionShape[l].row(k).transpose();
@@ -500,7 +534,13 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   dQdv.addBlock(0, 3,
                 Mat3(-A * (w * s.transpose() + w.dot(s) * Mat3::Identity() - 2.0 * s * w.transpose() - 2.0 * skew(sp))));
   // Q_theta = -w~ I w - 2 (tr(G) w - G w)
-  dQdv.addBlock(3, 3, Mat3(-(ws * I - skew(I * w)) - 2.0 * (G.trace() * Mat3::Identity() - G)));
+  Mat3 dQwdw = -(ws * I - skew(I * w)) - 2.0 * (G.trace() * Mat3::Identity() - G);
+  if (hasCoupling_) {
+    Vec3 b;  // b_i = qf^T H_i qf': d(-w x b)/dw = b~
+    for (int i = 0; i < 3; ++i) b[i] = bilinear(h_[i], qf, pf);
+    dQwdw += skew(b);
+  }
+  dQdv.addBlock(3, 3, dQwdw);
   for (int k = 0; k < nf_; ++k) {
     const Vec3 sk = inv_.sBar.col(k);
     const Mat3 Dk = secondMomentDerivative(qf, k);
@@ -523,6 +563,13 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
     Vec6 cq, cv;
     cq << -A * (Om * sk), -ws * (Dk.trace() * w - Dk * w) - 2.0 * (Gq.trace() * w - Gq * w);
     cv << -2.0 * A * (ws * sk), -2.0 * (Gp.trace() * w - Gp * w);
+    if (hasCoupling_) {
+      // -(qf'^T H_i qf')_i - w x (qf^T H_i qf')_i by qf_k and qf'_k (H_i symmetric)
+      const Vec3 hp(columnDot(h_[0], k, pf), columnDot(h_[1], k, pf), columnDot(h_[2], k, pf));
+      const Vec3 hq(columnDot(h_[0], k, qf), columnDot(h_[1], k, qf), columnDot(h_[2], k, qf));
+      cq.tail<3>() -= w.cross(hp);
+      cv.tail<3>() -= 2.0 * hp + w.cross(hq);
+    }
     dQdq.addBlock(0, 7 + k, cq);
     dQdv.addBlock(0, 6 + k, cv);
   }

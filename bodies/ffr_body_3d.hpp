@@ -159,6 +159,11 @@ class FfrBody3d final : public Body {
     SpMat R;
   };
   std::vector<SectionRotationTerm> sectionRotation_;
+  /// H_i of the invariants (FfrInvariants3d::hI), or empty matrices (nf x nf, no entries)
+  /// when absent: Y = int rho u~ N dV gains (qf^T H_i)_i, Q_theta -(qf'^T H_i qf')_i -
+  /// w x (qf^T H_i qf')_i.
+  std::array<SpMat, 3> h_;
+  bool hasCoupling_ = false;
 };
 
 }  // namespace flexmbd

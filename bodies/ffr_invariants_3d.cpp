@@ -17,6 +17,16 @@ const char* kAxis[3] = {"x", "y", "z"};
 
 std::string sklName(int k, int l) { return std::string("s_") + kAxis[k] + kAxis[l]; }
 std::string rklName(int k, int l) { return std::string("r_") + kAxis[k] + kAxis[l]; }
+std::string hName(int i) { return std::string("h_") + kAxis[i]; }
+
+/// An optional invariant: absent (0 x 0) or n x n, finite and symmetric.
+void requireOptionalSymmetric(const SpMat& A, int n, const std::string& owner, const std::string& name) {
+  if (A.size() == 0) return;
+  const std::string sz = std::to_string(n);
+  requireSize(A.rows() == n && A.cols() == n, owner, name, sz + " x " + sz + " (or absent)");
+  requireFiniteAll(A, owner, name);
+  requireSymmetric(A, owner, name);
+}
 
 }  // namespace
 
@@ -105,14 +115,12 @@ void FfrInvariants3d::validate(const std::string& owner) const {
 
 void FfrInvariants3d::validateSectionRotation(const std::string& owner) const {
   const int n = numElastic();
-  const std::string sz = std::to_string(n);
+  for (int i = 0; i < 3; ++i) requireOptionalSymmetric(hI[i], n, owner, hName(i));
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) {
       const SpMat& R = rKL[k][l];
       if (R.size() == 0) continue;  // none
-      requireSize(R.rows() == n && R.cols() == n, owner, rklName(k, l), sz + " x " + sz + " (or absent)");
-      requireFiniteAll(R, owner, rklName(k, l));
-      requireSymmetric(R, owner, rklName(k, l));
+      requireOptionalSymmetric(R, n, owner, rklName(k, l));
       if (l != k && (rKL[l][k].size() == 0 || maxAbs(SpMat(rKL[l][k] - R)) > 0.0)) {
         throw InputError(owner + ": invariant " + rklName(l, k) + " differs from " + rklName(k, l) +
                          "; expected R_lk = R_kl");
@@ -144,6 +152,7 @@ FfrInvariants3d FfrInvariants3d::transformed(const SpMat& P) const {
       r.sKL[k][l] = Pt * sKL[k][l] * P;
       if (rKL[k][l].size() != 0) r.rKL[k][l] = Pt * rKL[k][l] * P;
     }
+    if (hI[k].size() != 0) r.hI[k] = Pt * hI[k] * P;
   }
   r.mff = Pt * mff * P;
   r.kff = Pt * kff * P;

@@ -42,6 +42,10 @@ struct FfrInvariants3d {
   /// point moves on a circle, not along the tangent N q_f: BeamElement3d::
   /// sectionRotationMoment). Empty (0 x 0): none (invariants from other FE tools).
   std::array<std::array<SpMat, 3>, 3> rKL;
+  /// hI[i] = H_i (nf x nf, symmetric): int rho u0 x u2 dV = (qf^T H_i qf / 2)_i, u2 the
+  /// sections' second-order displacement (BeamElement3d::sectionRotationCoupling): the
+  /// kinetic energy gains w . (qf^T H_i qf')_i. Empty: none (zero under Euler-Bernoulli).
+  std::array<SpMat, 3> hI;
   SpMat mff;                                ///< m_ff = S_xx + S_yy + S_zz
   SpMat kff;                                ///< stiffness under the reference conditions
   SpMat dff;                                ///< damping
@@ -53,7 +57,7 @@ struct FfrInvariants3d {
   /// semi-definite with |first moment|^2 <= m tr(second moment); finite entries.
   /// @throws InputError naming `owner` and the offending invariant.
   void validate(const std::string& owner) const;
-  /// rKL: each absent or nf x nf, finite, symmetric, R_lk = R_kl.
+  /// rKL, hI: each absent or nf x nf, finite, symmetric; R_lk = R_kl.
   void validateSectionRotation(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
   FfrInvariants3d transformed(const SpMat& P) const;

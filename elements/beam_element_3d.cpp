@@ -28,8 +28,8 @@ constexpr int kU = 0, kV = 1, kW = 2, kTx = 3, kTy = 4, kTz = 5, kNode2 = 6;
 }  // namespace
 
 BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHint,
-                             const BeamSection3d& section, const std::string& owner)
-    : start_(start), end_(end), section_(section) {
+                             const BeamSection3d& section, const std::string& owner, BeamTheory theory)
+    : start_(start), end_(end), section_(section), theory_(theory) {
   section.validate(owner);
   for (int k = 0; k < 3; ++k) {
     requireFinite(start[k], owner + ": node coordinate");
@@ -66,12 +66,14 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   sBar_.setZero();
   for (Mat12& s : sKL_) s.setZero();
   for (Mat12& r : rKL_) r.setZero();
+  for (Mat12& h : hI_) h.setZero();
   for (Mat3x12& s : xS_) s.setZero();
   G_.setZero();
   for (size_t g = 0; g < kGaussXi.size(); ++g) {
     const double xi = kGaussXi[g], w = kGaussW[g] * l, x = xi * l;  // dx = l dxi
     const Mat3x12 Sc = shape(xi, l);
-    const Row12 phi = twistShape(xi);
+    const Mat3x12 Phi = sectionRotationShape(xi, l, theory);
+    const Row12 px = Phi.row(0), py = Phi.row(1), pz = Phi.row(2);  // tx, ty, tz
     firstMoment_.x() += w * rhoA * x;                     // int rho x dV
     secondMoment_(0, 0) += w * rhoA * x * x;              // int rho x^2 dV
     secondMoment_(1, 1) += w * rIz;                       // int rho y^2 dV = rho Iz l
@@ -82,13 +84,31 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
         sKL_[3 * k + m] += (w * rhoA) * Sc.row(k).transpose() * Sc.row(m);  // rho A int Sc_k^T Sc_l dx
       }
     }
-    sKL_[4] += (w * rIy) * phi.transpose() * phi;  // S_yy += int rho z^2 tx^T tx dV
-    sKL_[8] += (w * rIz) * phi.transpose() * phi;  // S_zz += int rho y^2 tx^T tx dV
-    rKL_[4] -= (w * rIz) * phi.transpose() * phi;  // R_yy = 2 int rho y u2_y dV = -rho Iz int tx^2 dx
-    rKL_[8] -= (w * rIy) * phi.transpose() * phi;  // R_zz = 2 int rho z u2_z dV = -rho Iy int tx^2 dx
-    xS_[0] += (w * rhoA * x) * Sc;                 // int rho x S dV
-    xS_[1].row(2) += (w * rIz) * phi;              // int rho y S_z dV = int rho y^2 tx dV
-    xS_[2].row(1) -= (w * rIy) * phi;              // int rho z S_y dV = -int rho z^2 tx dV
+    // the section's rotation phi x (0, y, z): S_x += z ty - y tz, S_y -= z tx, S_z += y tx,
+    // over the section int y^2 dA = Iz, int z^2 dA = Iy, int y dA = int z dA = int yz dA = 0
+    sKL_[0] += w * (rIy * py.transpose() * py + rIz * pz.transpose() * pz);  // S_xx
+    sKL_[1] -= (w * rIy) * py.transpose() * px;                               // S_xy
+    sKL_[2] -= (w * rIz) * pz.transpose() * px;                               // S_xz
+    sKL_[4] += (w * rIy) * px.transpose() * px;                               // S_yy
+    sKL_[8] += (w * rIz) * px.transpose() * px;                               // S_zz
+    xS_[0] += (w * rhoA * x) * Sc;   // int rho x S dV
+    xS_[1].row(0) -= (w * rIz) * pz;  // int rho y S_x dV = -rho Iz tz
+    xS_[1].row(2) += (w * rIz) * px;  // int rho y S_z dV = rho Iz tx
+    xS_[2].row(0) += (w * rIy) * py;  // int rho z S_x dV = rho Iy ty
+    xS_[2].row(1) -= (w * rIy) * px;  // int rho z S_y dV = -rho Iy tx
+    // second order, u2 = (1/2) phi~ phi~ r = (1/2) (phi (phi . r) - |phi|^2 r), r = (0, y, z):
+    // J_kl += int rho (x0_k u2_l + u2_k x0_l) dV (R_kl) and int rho x0 x u2 dV (H_i)
+    const auto sym = [](const Row12& a, const Row12& b) -> Mat12 {
+      return 0.5 * (a.transpose() * b + b.transpose() * a);
+    };
+    rKL_[1] += (0.5 * w * rIz) * sym(px, py);  // R_xy: rho Iz tx ty / 2
+    rKL_[2] += (0.5 * w * rIy) * sym(px, pz);  // R_xz: rho Iy tx tz / 2
+    rKL_[4] -= (w * rIz) * (px.transpose() * px + pz.transpose() * pz);  // R_yy: -rho Iz (tx^2 + tz^2)
+    rKL_[8] -= (w * rIy) * (px.transpose() * px + py.transpose() * py);  // R_zz: -rho Iy (tx^2 + ty^2)
+    rKL_[5] += (0.5 * w * (rIy + rIz)) * sym(py, pz);                   // R_yz: rho Ip ty tz / 2
+    hI_[0] += (w * (rIz - rIy)) * sym(py, pz);  // H_x: rho (Iz - Iy) ty tz
+    hI_[1] += (w * rIy) * sym(px, pz);          // H_y: rho Iy tx tz
+    hI_[2] -= (w * rIz) * sym(px, py);          // H_z: -rho Iz tx ty
     const Row12 by = slopeShapeY(xi, l), bz = slopeShapeZ(xi, l);
     G_ += w * (by.transpose() * by + bz.transpose() * bz);  // int (by^T by + bz^T bz) dx
   }
@@ -98,6 +118,10 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     for (int m = k + 1; m < 3; ++m) sKL_[3 * m + k] = sKL_[3 * k + m].transpose();
   }
   for (Mat12& r : rKL_) r = (0.5 * (r + r.transpose())).eval();  // symmetric exactly
+  rKL_[3] = rKL_[1];  // R_lk = R_kl
+  rKL_[6] = rKL_[2];
+  rKL_[7] = rKL_[5];
+  for (Mat12& h : hI_) h = (0.5 * (h + h.transpose())).eval();
   massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz
   // x0 cross u = (y u_z - z u_y, z u_x - x u_z, x u_y - y u_x)
   skewXS_.row(0) = xS_[1].row(2) - xS_[2].row(1);
@@ -145,6 +169,11 @@ const BeamElement3d::Mat12& BeamElement3d::sectionRotationMoment(int k, int l) c
   return rKL_[3 * k + l];
 }
 
+const BeamElement3d::Mat12& BeamElement3d::sectionRotationCoupling(int i) const {
+  if (i < 0 || i > 2) throw std::out_of_range("BeamElement3d::sectionRotationCoupling: i must be 0, 1 or 2");
+  return hI_[i];
+}
+
 const BeamElement3d::Mat3x12& BeamElement3d::positionShapeIntegral(int k) const {
   if (k < 0 || k > 2) throw std::out_of_range("BeamElement3d::positionShapeIntegral: k must be 0, 1 or 2");
   return xS_[k];
@@ -174,11 +203,22 @@ BeamElement3d::Row12 BeamElement3d::twistShape(double xi) {
   return r;
 }
 
-BeamElement3d::Mat3x12 BeamElement3d::pointShape(double xi, double y, double z, double l) {
+BeamElement3d::Mat3x12 BeamElement3d::sectionRotationShape(double xi, double l, BeamTheory theory) {
+  Mat3x12 Phi = Mat3x12::Zero();
+  Phi.row(0) = twistShape(xi);
+  if (theory == BeamTheory::Rayleigh) {
+    Phi.row(1) = -slopeShapeZ(xi, l);  // ty = -w'
+    Phi.row(2) = slopeShapeY(xi, l);   // tz = v'
+  }
+  return Phi;
+}
+
+BeamElement3d::Mat3x12 BeamElement3d::pointShape(double xi, double y, double z, double l, BeamTheory theory) {
   Mat3x12 S = shape(xi, l);
-  const Row12 phi = twistShape(xi);
-  S.row(1) -= z * phi;  // tx e_x cross (0, y, z) = (0, -z tx, y tx)
-  S.row(2) += y * phi;
+  const Mat3x12 Phi = sectionRotationShape(xi, l, theory);
+  S.row(0) += z * Phi.row(1) - y * Phi.row(2);  // phi x (0, y, z) = (z ty - y tz, -z tx, y tx)
+  S.row(1) -= z * Phi.row(0);
+  S.row(2) += y * Phi.row(0);
   return S;
 }
 

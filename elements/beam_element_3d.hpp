@@ -44,10 +44,11 @@ struct BeamSectionForces3d {
 /// element (y, z in the section) moves by
 ///   u = S(x, y, z) e = S_c e + tx e_x cross (0, y, z) = S_c e + (0, -z tx, y tx)  (`pointShape()`).
 /// The rotation of the section by the twist is kept (it gives the torsional inertia
-/// rho Ip int tx^2 dx, without which the torsional mass would vanish); the axial
+/// rho Ip int tx^2 dx, without which the torsional mass would vanish). The axial
 /// displacement -y v' - z w' of the section's points by the bending slopes (the rotary
-/// inertia of bending) is neglected, as in the Euler-Bernoulli planar BeamElement2d
-/// (centre-line field only), so a spatial element in a plane has exactly the planar
+/// inertia of bending) is kept under BeamTheory::Rayleigh and neglected under
+/// Euler-Bernoulli (the default), as in the planar BeamElement2d (centre-line field
+/// only), so a spatial Euler-Bernoulli element in a plane has exactly the planar
 /// element's inertia. Shear deformation and warping are neglected.
 ///
 /// Everything constant is computed once, at construction: along x by 5-point
@@ -68,12 +69,13 @@ class BeamElement3d {
   /// length, `yHint` is zero, not finite, or within 1e-6 rad of the element axis, or the
   /// section is invalid.
   BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHint, const BeamSection3d& section,
-                const std::string& owner);
+                const std::string& owner, BeamTheory theory = BeamTheory::EulerBernoulli);
 
   double length() const { return l_; }                     ///< l, m
   const Vec3& start() const { return start_; }              ///< start node, body frame (element origin)
   const Vec3& end() const { return end_; }                  ///< end node, body frame
   const BeamSection3d& section() const { return section_; }
+  BeamTheory theory() const { return theory_; }
   /// C (3 x 3): columns = element x, y, z axes in the body frame; x_body = start + C x_el.
   const Mat3& rotation() const { return C_; }
   /// T (12 x 12, constant) = blockdiag(C^T, C^T, C^T, C^T): body-frame nodal coordinates
@@ -85,8 +87,14 @@ class BeamElement3d {
   static Mat3x12 shape(double xi, double l);
   /// Twist tx(xi) = twistShape(xi) e (1 x 12): (1-xi) at tx1, xi at tx2.
   static Row12 twistShape(double xi);
-  /// Point shape S(xi, y, z) (3 x 12): S_c(xi) + rows (0, -z tx, y tx), y, z in the section.
-  static Mat3x12 pointShape(double xi, double y, double z, double l);
+  /// The section's small rotation phi(xi) = Phi e (3 x 12, element axes): row x the
+  /// twist tx; rows y, z the bending rotations ty = -w', tz = v' under Rayleigh, zero
+  /// under Euler-Bernoulli (whose field does not turn the sections by the slopes).
+  static Mat3x12 sectionRotationShape(double xi, double l, BeamTheory theory);
+  /// Point shape S(xi, y, z) (3 x 12): S_c(xi) e + phi(xi) x (0, y, z), y, z in the
+  /// section: S_c + rows (z ty - y tz, -z tx, y tx) (ty = tz = 0 under Euler-Bernoulli).
+  static Mat3x12 pointShape(double xi, double y, double z, double l,
+                            BeamTheory theory = BeamTheory::EulerBernoulli);
   /// d w_x / dx (1 x 12, constant): the axial strain row a.
   static Row12 axialStrainShape(double l);
   /// d tx / dx (1 x 12, constant): the twist rate row.
@@ -123,16 +131,26 @@ class BeamElement3d {
   const Row12& positionDotShapeIntegral() const { return dotXS_; }
   /// R_kl (12 x 12, symmetric; R_lk = R_kl), kg: the second-order change of
   /// int rho x x^T dV by the rotation of the cross-sections, e^T R_kl e. A section
-  /// turned by the twist tx moves its points on circles, u = (R(tx) - 1) r: to second
-  /// order u2 = (1/2) tx~ tx~ r = -(tx^2 / 2) (0, y, z) beside the first-order
-  /// tx e_x cross r of pointShape(). Over the section int rho (x0 u2^T + u2 x0^T) dA gives
-  ///   R_yy = -rho Iz int tx^T tx dx,   R_zz = -rho Iy int tx^T tx dx,   others zero,
+  /// turned by phi (sectionRotationShape) moves its points on circles, u = (R(phi) - 1) r:
+  /// to second order u2 = (1/2) phi~ phi~ r beside the first-order phi x r of
+  /// pointShape(). Over the section int rho (x0 u2^T + u2 x0^T) dA gives (sym as below)
+  ///   R_yy = -rho Iz int (tx^2 + tz^2), R_zz = -rho Iy int (tx^2 + ty^2), R_xx = 0,
+  ///   R_xy = rho Iz int tx ty / 2, R_xz = rho Iy int tx tz / 2, R_yz = rho Ip int ty tz / 2;
+  /// under Euler-Bernoulli (ty = tz = 0) R_yy = -rho Iz int tx^T tx dx,
+  /// R_zz = -rho Iy int tx^T tx dx, others zero,
   /// so the polar moment (J_yy + J_zz of a shaft along x) does not change by the twist
   /// and a section's second moments turn with it (Iz cos^2 + Iy sin^2). Without it a
   /// spinning shaft loses torsional stiffness Omega^2 rho Ip per length (issue 25).
   /// The body adds it to int rho u u^T dV only (its rotational inertia); the first-order
   /// field S is unchanged. @throws std::out_of_range unless 0 <= k, l <= 2.
   const Mat12& sectionRotationMoment(int k, int l) const;
+  /// H_i (12 x 12, symmetric), kg m^2: int rho (x0 x u2)_i dV = e^T H_i e / 2, the
+  /// angular momentum coupling of the second-order rotation (the body's kinetic energy
+  /// gains w . (e^T H_i e')_i). Zero under Euler-Bernoulli (twist alone moves a section's
+  /// points radially: x0 x u2 integrates to zero); under Rayleigh
+  ///   H_x = rho (Iz - Iy) sym(ty, tz), H_y = rho Iy sym(tx, tz), H_z = -rho Iz sym(tx, ty),
+  /// sym(a, b) = int (a^T b + b^T a) / 2 dx. @throws std::out_of_range unless 0 <= i <= 2.
+  const Mat12& sectionRotationCoupling(int i) const;
 
   // ----- stiffness and strain energy (element frame) -----------------------------
   /// Linear stiffness K (12 x 12), the classic Przemieniecki matrix: axial EA/l, torsion
@@ -172,6 +190,8 @@ class BeamElement3d {
   Mat3x12 sBar_;
   std::array<Mat12, 9> sKL_;  // S_kl at index 3 k + l
   std::array<Mat12, 9> rKL_;  // R_kl at index 3 k + l (sectionRotationMoment)
+  std::array<Mat12, 3> hI_;   // H_i (sectionRotationCoupling)
+  BeamTheory theory_ = BeamTheory::EulerBernoulli;
   Mat12 massMatrix_;
   std::array<Mat3x12, 3> xS_;  // int rho x0_k S dV
   Mat3x12 skewXS_;

@@ -6,6 +6,13 @@
 
 namespace flexmbd {
 
+/// The beam theory of an element's inertia (issue 25; docs/spatial-flexible.md):
+/// Euler-Bernoulli keeps the centre line's inertia and the sections' rotation by the
+/// twist; Rayleigh adds the rotary inertia of the sections turned by the bending slopes
+/// (rho I int v'^2 dx: the gyroscopic moments of a spinning shaft). Both keep the
+/// Euler-Bernoulli kinematics (sections normal to the centre line, no shear strain).
+enum class BeamTheory { EulerBernoulli, Rayleigh };
+
 struct BeamSection {
   double area = 0.0;           ///< A, m^2
   double inertia = 0.0;        ///< second moment of area I, m^4

@@ -1,6 +1,8 @@
 #include "io/beam_model_reader.hpp"
 
 #include <algorithm>
+#include <string>
+#include <type_traits>
 
 #include <nlohmann/json.hpp>
 
@@ -83,6 +85,15 @@ void readBeamModelOptions(const ObjectReader& r, int numNodes, Options& o) {
     }
   }
   o.geometricStiffening = r.boolean("geometric_stiffening", false);
+  if constexpr (std::is_same_v<Options, FfrBeamOptions3d>) {
+    // the spatial element's beam theory (BeamTheory; the key list admits it for spatial bodies only)
+    const std::string theory = r.string("beam_theory", "euler_bernoulli");
+    if (theory == "rayleigh") {
+      o.theory = BeamTheory::Rayleigh;
+    } else if (theory != "euler_bernoulli") {
+      r.fail("key \"beam_theory\" must be \"euler_bernoulli\" or \"rayleigh\", got " + inQuotes(theory));
+    }
+  }
   o.inertiaModes = r.boolean("inertia_modes", false);
   if (o.inertiaModes && !craigBampton && o.modes == 0 && o.modeSet.empty()) {
     r.fail("key \"inertia_modes\" needs a modal reduction (\"modes\", or \"reduction\": \"craig_bampton\")");

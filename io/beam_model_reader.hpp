@@ -1,7 +1,7 @@
 // Reader of the beam-model keys that planar and spatial flexible bodies share
 // (docs/scene-format.md): "reference" (conditions B2), "modes" (modal reduction),
-// "reduction" with "interface_nodes" (Craig-Bampton), "inertia_modes" and
-// "geometric_stiffening". Called by io/scene.cpp and io/spatial_scene.cpp (whose key
+// "reduction" with "interface_nodes" (Craig-Bampton), "inertia_modes",
+// "geometric_stiffening" and, for spatial bodies, "beam_theory". Called by io/scene.cpp and io/spatial_scene.cpp (whose key
 // lists say which of these a body accepts).
 #pragma once
 
@@ -10,7 +10,7 @@
 namespace flexmbd::scenereaders {
 
 /// Fills options.reference, .modes / .modeSet, .reduction / .interfaceNodes,
-/// .inertiaModes and .geometricStiffening from the body
+/// .inertiaModes, .geometricStiffening (and, spatial, .theory) from the body
 /// object `r` (a mesh of `numNodes` nodes); FfrBeamOptions or FfrBeamOptions3d.
 /// @throws InputError naming the key.
 template <class Options>

@@ -67,7 +67,7 @@ inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "or
                                      "angular_velocity",     "section",     "beam",        "nodes",
                                      "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",
                                      "elastic_coordinates",  "elastic_velocities", "reduction", "interface_nodes",
-                                     "inertia_modes"};
+                                     "inertia_modes", "beam_theory"};
 inline const Keys kSection3d = {"area",          "inertia_y",     "inertia_z", "torsion_constant", "width",  "height",
                                 "youngs_modulus", "shear_modulus", "poisson_ratio", "density",     "damping"};
 inline const Keys kBeam3d = {"length", "elements", "origin"};

@@ -33,7 +33,13 @@ struct BeamChain3d {
   /// N (3 x nf) of the material point (xi, y, z) of element e (element frame).
   Mat3X pointShape(int e, double xi, double y, double z) const {
     const BeamElement3d& el = elements[e];
-    return el.rotation() * BeamElement3d::pointShape(xi, y, z, el.length()) * el.transformation() * selection(e);
+    return el.rotation() * BeamElement3d::pointShape(xi, y, z, el.length(), el.theory()) * el.transformation() *
+           selection(e);
+  }
+  /// The section rotation phi = Phi q_f (3 x nf, element axes) at xi of element e.
+  Mat3X sectionRotation(int e, double xi) const {
+    const BeamElement3d& el = elements[e];
+    return BeamElement3d::sectionRotationShape(xi, el.length(), el.theory()) * el.transformation() * selection(e);
   }
   /// u0 (body frame) of that point.
   Vec3 pointPosition(int e, double xi, double y, double z) const {
@@ -44,17 +50,18 @@ struct BeamChain3d {
 
 /// Elements between consecutive nodes (>= 2 nodes), all with the same section and y hint.
 inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSection3d& section, const Vec3& yHint,
-                                 double stiffnessScale = 1.0) {
+                                 double stiffnessScale = 1.0, BeamTheory theory = BeamTheory::EulerBernoulli) {
   BeamChain3d c;
   c.nodes = nodes;
   const int ne = static_cast<int>(nodes.size()) - 1;
   c.nf = 6 * ne;
   const int nf = c.nf;
-  for (int e = 0; e < ne; ++e) c.elements.emplace_back(nodes[e], nodes[e + 1], yHint, section, "test chain");
+  for (int e = 0; e < ne; ++e) c.elements.emplace_back(nodes[e], nodes[e + 1], yHint, section, "test chain", theory);
   FfrInvariants3d& inv = c.inv;
   inv.sBar = Mat3X::Zero(3, nf);
   MatX mff = MatX::Zero(nf, nf), kff = MatX::Zero(nf, nf);
   std::array<std::array<MatX, 3>, 3> skl, rkl;
+  std::array<MatX, 3> hi = {MatX::Zero(nf, nf), MatX::Zero(nf, nf), MatX::Zero(nf, nf)};
   for (int k = 0; k < 3; ++k) {
     inv.positionShape[k] = Mat3X::Zero(3, nf);
     for (int l = 0; l < 3; ++l) skl[k][l] = rkl[k][l] = MatX::Zero(nf, nf);
@@ -77,6 +84,9 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
       Mat3X pk = s0[k] * sb;
       for (int a = 0; a < 3; ++a) pk += C(k, a) * C * el.positionShapeIntegral(a) * TL;
       inv.positionShape[k] += pk;
+      BeamElement3d::Mat12 h = BeamElement3d::Mat12::Zero();  // H_k = sum_a C_ka H_a^e
+      for (int a = 0; a < 3; ++a) h += C(k, a) * el.sectionRotationCoupling(a);
+      hi[k] += TL.transpose() * h * TL;
       for (int l = 0; l < 3; ++l) {
         // N_k = sum_a C_ka S_a T L:  S_kl = (T L)^T (sum_ab C_ka C_lb S_ab) T L
         BeamElement3d::Mat12 s = BeamElement3d::Mat12::Zero();
@@ -114,6 +124,10 @@ inline BeamChain3d makeBeamChain(const std::vector<Vec3>& nodes, const BeamSecti
     for (auto& S : row) S.makeCompressed();
   for (auto& row : inv.rKL)
     for (auto& R : row) R.makeCompressed();
+  for (int k = 0; k < 3; ++k) {
+    inv.hI[k] = MatX(0.5 * (hi[k] + hi[k].transpose())).sparseView(0.0, 0.0);
+    inv.hI[k].makeCompressed();
+  }
   for (int n = 0; n < ne + 1; ++n) {
     FfrPoint3d p;
     p.position = nodes[n];

@@ -69,7 +69,7 @@ struct MassPoint {
   double w;
   Mat3 C;        ///< the element's axes (body frame)
   Vec3 section;  ///< (0, y, z): the point's offset in its section, element axes
-  Eigen::Matrix<double, 1, Eigen::Dynamic> twist;  ///< tx = twist q_f at the point
+  Mat3X rotation;  ///< the section's rotation phi = rotation q_f (element axes)
 };
 
 /// 6 (along) x 4 x 4 (section) Gauss points per element: exact for the degree-6
@@ -88,7 +88,7 @@ std::vector<MassPoint> massPoints(const BeamChain3d& c) {
           const BeamElement3d& el = c.elements[e];
           pts.push_back({c.pointPosition(e, gx[i], y, z), c.pointShape(e, gx[i], y, z),
                          rho * wx[i] * ws[j] * ws[k] * l * kWidthY * kHeightZ, el.rotation(), Vec3(0, y, z),
-                         BeamElement3d::twistShape(gx[i]) * el.transformation() * c.selection(e)});
+                         c.sectionRotation(e, gx[i])});
         }
   }
   return pts;
@@ -113,10 +113,15 @@ FrameState3d someFrame() {
 }
 
 struct Fixture {
-  BeamChain3d chain = makeBeamChain(bentNodes(), kSteel, kHint);
-  FfrBody3d body{"flex", chain.inv, someFrame()};
-  int nf = chain.nf;
+  explicit Fixture(BeamTheory theory = BeamTheory::EulerBernoulli)
+      : chain(makeBeamChain(bentNodes(), kSteel, kHint, 1.0, theory)), body("flex", chain.inv, someFrame()), nf(chain.nf) {}
+  BeamChain3d chain;
+  FfrBody3d body;
+  int nf;
 };
+
+constexpr BeamTheory kTheories[] = {BeamTheory::EulerBernoulli, BeamTheory::Rayleigh};
+const char* theoryName(BeamTheory t) { return t == BeamTheory::Rayleigh ? "Rayleigh" : "Euler-Bernoulli"; }
 
 /// A generic state: p of length 1.3 (the gauge is free), elastic coordinates of scale
 /// `elastic` (displacements, m) and 10 x that for rotations.
@@ -148,8 +153,11 @@ std::string sci(double x) {
 TEST(FfrBody3d, MassMatrixIsTheVolumeQuadratureOfTheKineticEnergy) {
   // T = 1/2 int rho |r'|^2 dV of the first-order field u0 + N q_f, plus the rotational
   // inertia of the sections' second-order rotation (int rho (w x u0).(w x u2) dV,
-  // BeamElement3d::sectionRotationMoment), both by volume quadrature.
-  Fixture f;
+  // BeamElement3d::sectionRotationMoment) and its coupling w . int rho u0 x u2' dV
+  // (sectionRotationCoupling), all by volume quadrature; Euler-Bernoulli and Rayleigh.
+  for (BeamTheory theory : kTheories) {
+  SCOPED_TRACE(theoryName(theory));
+  Fixture f(theory);
   const auto pts = massPoints(f.chain);
   Random rnd(11);
   double worst = 0.0;
@@ -158,20 +166,26 @@ TEST(FfrBody3d, MassMatrixIsTheVolumeQuadratureOfTheKineticEnergy) {
     genericState(rnd, f.nf, 2e-2, q, v, 1.0);  // large deformations: the q_f-quadratic terms show
     MatX Mq = MatX::Zero(6 + f.nf, 6 + f.nf);
     double T = 0.0;
-    Mat3 dJ = Mat3::Zero();  // int rho (u0 u2^T + u2 u0^T) dV
+    Mat3 dJ = Mat3::Zero();               // int rho (u0 u2^T + u2 u0^T) dV
+    MatX Yh = MatX::Zero(3, f.nf);         // int rho u0~ du2/dq_f dV
     for (const auto& p : pts) {
       const MatX J = pointJacobian(q, p, f.nf);
       Mq += p.w * J.transpose() * J;
       T += 0.5 * p.w * (J * v).squaredNorm();
-      // the section's second-order rotation u2 = (1/2) tx~ tx~ r = -(tx^2 / 2) r
-      const double tx = p.twist.dot(q.tail(f.nf));
-      const Vec3 u2 = p.C * (-0.5 * tx * tx * p.section);
+      // the section's second-order rotation u2 = (1/2) phi~ phi~ r = (phi (phi.r) - |phi|^2 r) / 2
+      const Vec3 phi = p.rotation * q.tail(f.nf), r = p.section;
+      const Vec3 u2 = p.C * (0.5 * (phi * phi.dot(r) - phi.squaredNorm() * r));
+      const Mat3 du2 = p.C * (0.5 * (phi * r.transpose() + phi.dot(r) * Mat3::Identity() - 2.0 * r * phi.transpose()));
       dJ += p.w * (p.u0 * u2.transpose() + u2 * p.u0.transpose());
+      Yh += p.w * skew(p.u0) * du2 * p.rotation;
     }
-    // it adds (tr dJ) 1 - dJ to the rotational inertia: 1/2 w^T (.) w to T
+    // it adds (tr dJ) 1 - dJ to the rotational inertia (1/2 w^T (.) w to T) and
+    // w . Yh qf' to T (the theta-f coupling)
     const Mat3 dI = dJ.trace() * Mat3::Identity() - dJ;
     Mq.block<3, 3>(3, 3) += dI;
-    T += 0.5 * v.segment<3>(3).dot(dI * v.segment<3>(3));
+    Mq.block(3, 6, 3, f.nf) += Yh;
+    Mq.block(6, 3, f.nf, 3) += Yh.transpose();
+    T += 0.5 * v.segment<3>(3).dot(dI * v.segment<3>(3)) + v.segment<3>(3).dot(Yh * v.tail(f.nf));
     const MatX M = f.body.massMatrix(q);
     worst = std::max(worst, expectMatrixNear(M, Mq, kQuadTol, "mass matrix vs quadrature"));
     EXPECT_NEAR(0.5 * v.dot(M * v), T, kQuadTol * T);
@@ -181,7 +195,9 @@ TEST(FfrBody3d, MassMatrixIsTheVolumeQuadratureOfTheKineticEnergy) {
     expectMatrixNear(Ma, M * v, 1e-13, "addMassTimes");
     EXPECT_NEAR(f.body.mass(), [&] { double m = 0; for (const auto& p : pts) m += p.w; return m; }(), 1e-12);
   }
-  std::printf("[ figures ] mass matrix vs volume quadrature: max relative error %s\n", sci(worst).c_str());
+  std::printf("[ figures ] %s: mass matrix vs volume quadrature: max relative error %s\n", theoryName(theory),
+              sci(worst).c_str());
+  }
 }
 
 TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
@@ -190,12 +206,14 @@ TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
   // applyIncrement(q, h v) is exactly the motion at constant v over h (R + h R',
   // p (x) exp(h w / 2), q_f + h q_f'), so J' v = (J(q (+) h v) - J(q (+) -h v)) v / 2h.
   // These are the forces of the first-order field u0 + N q_f: the body `first` without
-  // the sections' second-order rotation (R_kl); the power identity holds for both.
+  // the sections' second-order rotation (R_kl); the power identity holds for all, the
+  // Rayleigh body's too (rotary inertia, R_kl and H_i).
   Fixture f;
   FfrInvariants3d firstOrder = f.chain.inv;
   for (auto& row : firstOrder.rKL)
     for (SpMat& R : row) R = SpMat();
   const FfrBody3d first("first order", firstOrder, someFrame());
+  const Fixture rayleigh(BeamTheory::Rayleigh);  // same nodes: the same coordinates
   const auto pts = massPoints(f.chain);
   Random rnd(12);
   double worst = 0.0, worstPower = 0.0;
@@ -216,7 +234,7 @@ TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
     worst = std::max(worst, expectMatrixNear(Q1, Qref, kKaneTol, "quadratic velocity forces vs d'Alembert"));
     // power: v.Q_v = -1/2 v^T (dM/dt) v (the quadratic velocity forces do no work on the
     // kinetic energy other than through dM/dt)
-    for (const FfrBody3d* b : std::initializer_list<const FfrBody3d*>{&first, &f.body}) {
+    for (const FfrBody3d* b : std::initializer_list<const FfrBody3d*>{&first, &f.body, &rayleigh.body}) {
       const VecX Q = internalForces(*b, q, v) - internalForces(*b, q, VecX::Zero(v.size()));
       const double dMdt = (v.dot(b->massMatrix(qp) * v) - v.dot(b->massMatrix(qm) * v)) / (2.0 * h);
       const double power = v.dot(Q), scale = std::abs(dMdt) + Q.cwiseAbs().maxCoeff() * v.norm();
@@ -229,7 +247,9 @@ TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
 }
 
 TEST(FfrBody3d, AnalyticDerivativesMatchCentralDifferences) {
-  Fixture f;
+  for (BeamTheory theory : kTheories) {
+  SCOPED_TRACE(theoryName(theory));
+  Fixture f(theory);
   // with damping, so that D_ff enters the velocity Jacobian
   FfrInvariants3d inv = f.chain.inv;
   inv.dff = 1e-4 * inv.kff;
@@ -283,7 +303,10 @@ TEST(FfrBody3d, AnalyticDerivativesMatchCentralDifferences) {
     check(Ti * T, MatX::Identity(nv, nv), "T+ T = I");
     check(rate(q), T * v, "addCoordinateRate = T v");
   }
-  for (const auto& [what, err] : figures) std::printf("[ figures ] %-40s FD relative error %s\n", what.c_str(), sci(err).c_str());
+  for (const auto& [what, err] : figures) {
+    std::printf("[ figures ] %s: %-40s FD relative error %s\n", theoryName(theory), what.c_str(), sci(err).c_str());
+  }
+  }
 }
 
 /// The fixture's chain as a beam mesh model (clamped at node 0, nodal coordinates).

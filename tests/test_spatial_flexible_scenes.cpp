@@ -326,3 +326,29 @@ TEST(SpatialFlexibleScene, CraigBamptonKeysGiveTheStaticTipResponseExactly) {
   for (size_t k = 3; k < 9; ++k) EXPECT_NEAR(cb[k], nodal[k], 1e-9 * forceScale) << "section force " << k;
   EXPECT_NEAR(cb[3], F.x(), 1e-9 * forceScale) << "N";
 }
+
+TEST(SpatialFlexibleScene, BeamTheoryKeyGivesTheRayleighModelOfTheApi) {
+  // "beam_theory": "rayleigh" builds FfrBeamOptions3d::theory = Rayleigh: the mass matrix
+  // and the sections' second-order invariants of the API model (1e-14, as above), and a
+  // mass matrix that differs from the Euler-Bernoulli one by the rotary inertia.
+  json j = pendulumScene();
+  j["bodies"][0]["beam_theory"] = "rayleigh";
+  const Scene scene = parseScene(j);
+  const BeamSection3d s = rectangularSection3d(kWidth, kHeight, kE, kE / (2.0 * (1.0 + kNu)), kRho, 1e-4);
+  FfrBeamOptions3d o;
+  o.reference.type = ReferenceConditions3d::Type::Clamped;
+  o.theory = BeamTheory::Rayleigh;
+  const FfrBeamModel3d api(BeamMesh3d::straight(kLength, 4, s, Vec3::Zero(), Vec3(0, 1, 0.2)), o, "api");
+  const FfrInvariants3d &a = flexBody(scene).invariants(), &b = api.invariants();
+  const double mscale = MatX(b.mff).cwiseAbs().maxCoeff();
+  expectMatrixNear(MatX(a.mff), MatX(b.mff), 1e-14, "m_ff", mscale);
+  for (int i = 0; i < 3; ++i) {
+    expectMatrixNear(MatX(a.hI[i]), MatX(b.hI[i]), 1e-14, "H_i", mscale);
+    for (int l = 0; l < 3; ++l) expectMatrixNear(MatX(a.rKL[i][l]), MatX(b.rKL[i][l]), 1e-14, "R_kl", mscale);
+  }
+  const FfrInvariants3d& eb = flexBody(parseScene(pendulumScene())).invariants();
+  EXPECT_GT(MatX(a.mff - eb.mff).cwiseAbs().maxCoeff(), 1e-6 * mscale);  // the rotary inertia
+  j["bodies"][0]["beam_theory"] = "timoshenko";
+  expectInputError([&] { parseScene(j); }, {"bodies[0] (\"beam\")", "beam_theory", "\"euler_bernoulli\" or \"rayleigh\"",
+                                            "timoshenko"});
+}
