@@ -12,6 +12,8 @@
 #include "joints/fixed_joint.hpp"
 #include "joints/prismatic_joint.hpp"
 #include "joints/revolute_joint.hpp"
+#include "joints/spatial_joint.hpp"
+#include "builders/spatial_builders.hpp"
 
 namespace flexmbd {
 
@@ -88,6 +90,13 @@ ConstraintIndex addJointDriver(System& sys, const std::string& name, ConstraintI
     throw InputError("driver '" + name + "': joint index does not exist");
   }
   const Constraint& c = sys.constraint(joint);
+  if (const auto* s = dynamic_cast<const SpatialJoint*>(&c)) {  // spatial: builders/spatial_builders.hpp
+    if (s->type() == SpatialJointType::Revolute) return addJointAngleDriver(sys, name, joint, std::move(law));
+    if (s->type() == SpatialJointType::Prismatic) return addJointDisplacementDriver(sys, name, joint, std::move(law));
+    throw InputError("driver '" + name + "': joint '" + c.name() + "' is a spatial " + c.typeName() +
+                     " joint; addJointDriver drives revolute (angle) and prismatic (displacement) joints, "
+                     "addJointAngleDriver / addJointDisplacementDriver choose for a cylindrical one");
+  }
   if (const auto* r = dynamic_cast<const RevoluteJoint*>(&c)) {
     return sys.addConstraint(std::make_unique<JointAngleDriver>(name, r->bodies()[0], r->pointI(), r->bodies()[1],
                                                                 r->pointJ(), std::move(law)));
@@ -113,6 +122,9 @@ ForceIndex addRotationalSpringDamper(System& sys, const std::string& name, Const
                                      double stiffness, double damping, double freeAngle) {
   if (joint.value < 0 || joint.value >= sys.numConstraints()) {
     throw InputError("force '" + name + "': joint index does not exist");
+  }
+  if (dynamic_cast<const SpatialJoint*>(&sys.constraint(joint))) {  // spatial revolute or cylindrical
+    return addSpatialRotationalSpringDamper(sys, name, joint, stiffness, damping, freeAngle);
   }
   const auto* r = dynamic_cast<const RevoluteJoint*>(&sys.constraint(joint));
   if (!r) {

@@ -26,12 +26,15 @@ ConstraintIndex addFixedJoint(System& sys, const std::string& name, BodyIndex bo
 /// Prescribes coordinate `coordinate` ("x", "y", "theta", ...) of a body.
 ConstraintIndex addBodyCoordinateDriver(System& sys, const std::string& name, BodyIndex body,
                                         const std::string& coordinate, TimeLawPtr law);
-/// Prescribes a revolute joint's relative angle or a prismatic joint's displacement.
+/// Prescribes a revolute joint's relative angle or a prismatic joint's displacement
+/// (planar, or spatial: addJointAngleDriver / addJointDisplacementDriver of
+/// builders/spatial_builders.hpp).
 ConstraintIndex addJointDriver(System& sys, const std::string& name, ConstraintIndex joint, TimeLawPtr law);
 ForceIndex addSpringDamper(System& sys, const std::string& name, BodyIndex bodyI, const Vec2& pointI,
                            BodyIndex bodyJ, const Vec2& pointJ, double stiffness, double damping,
                            double freeLength);
-/// Acts on a revolute joint's relative angle; freeAngle: angle of zero torque.
+/// Acts on a revolute joint's relative angle; freeAngle: angle of zero torque (a spatial
+/// revolute or cylindrical joint: addSpatialRotationalSpringDamper).
 ForceIndex addRotationalSpringDamper(System& sys, const std::string& name, ConstraintIndex revoluteJoint,
                                      double stiffness, double damping, double freeAngle);
 ForceIndex addAppliedLoad(System& sys, const std::string& name, BodyIndex body, const Vec2& point,

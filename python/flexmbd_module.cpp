@@ -19,6 +19,7 @@
 #include "bodies/ffr_beam_model.hpp"
 #include "bodies/ffr_body_2d.hpp"
 #include "builders/planar_builders.hpp"
+#include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
 #include "integrators/linearization.hpp"
 #include "integrators/simulation.hpp"
@@ -27,9 +28,11 @@
 #include "io/scene.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
+#include "bindings_support.hpp"
 
 namespace py = pybind11;
 using namespace flexmbd;
+using namespace flexmbd::pybind;
 
 namespace {
 
@@ -73,26 +76,6 @@ py::array_t<double> table(const RunOutput& r) {
   py::array_t<double> a({static_cast<py::ssize_t>(r.rows), cols});
   if (!r.data.empty()) std::memcpy(a.mutable_data(), r.data.data(), r.data.size() * sizeof(double));
   return a;
-}
-
-/// A body given as a BodyIndex or by name ("ground" included).
-BodyIndex body(const System& sys, const py::object& b) {
-  if (py::isinstance<py::str>(b)) {
-    const std::string name = b.cast<std::string>();
-    return name == "ground" ? kGround : sys.findBody(name);  // InputError listing the known bodies
-  }
-  return b.cast<BodyIndex>();
-}
-
-ConstraintIndex joint(const System& sys, const py::object& j) {
-  if (py::isinstance<py::str>(j)) {
-    const std::string name = j.cast<std::string>();
-    for (int c = 0; c < sys.numConstraints(); ++c) {
-      if (sys.constraint(ConstraintIndex(c)).name() == name) return ConstraintIndex(c);
-    }
-    throw InputError("no joint named '" + name + "'");
-  }
-  return j.cast<ConstraintIndex>();
 }
 
 }  // namespace
@@ -233,7 +216,8 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def_property_readonly("num_elastic", &FfrBeamModel::numElastic);
 
   // ----- the system and the builders (builders/planar_builders.hpp) --------------------
-  py::class_<System>(m, "System")
+  py::class_<System> systemClass(m, "System");
+  systemClass
       .def(
           "add_rigid_body",
           [](System& s, const std::string& name, const RigidBodyProperties& p, const FrameState2d& init) {
@@ -303,7 +287,18 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("name"), py::arg("body"), py::arg("point"), py::arg("force_x") = nullptr,
           py::arg("force_y") = nullptr, py::arg("torque") = nullptr)
       .def(
-          "set_gravity", [](System& s, const Vec2& g) { s.setGravity(g); }, py::arg("gravity"))
+          "set_gravity",
+          [](System& s, const py::object& g) {
+            if (!py::isinstance<py::str>(g) && !g.is_none()) {
+              try {
+                s.setGravity(g.cast<Vec2>());  // planar
+                return;
+              } catch (const py::cast_error&) {
+              }
+            }
+            s.setGravity(argumentAs<Vec3>(g, "set_gravity", "gravity", "2 numbers (planar) or 3 numbers (spatial)"));
+          },
+          py::arg("gravity"), "(gx, gy) for a planar model, (gx, gy, gz) for a spatial one (world axes)")
       .def("find_body", &System::findBody, py::arg("name"))
       .def("finalize", &System::finalize)
       .def_property_readonly("is_finalized", &System::isFinalized)
@@ -313,6 +308,7 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def("coordinate_names", &System::coordinateNames)
       .def("initial_coordinates", &System::initialCoordinates)
       .def("coordinate_offset", &System::coordinateOffset, py::arg("body"));
+  bindSpatial(m, systemClass);
 
   // ----- solver settings (integrators/simulation.hpp) ------------------------------------
   py::class_<SolverSettings>(m, "SolverSettings")

@@ -18,28 +18,46 @@ import os
 from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     GROUND,
     BeamMesh2d,
+    BeamMesh3d,
     BeamSection,
+    BeamSection3d,
     BodyIndex,
     ConstraintIndex,
     FfrBeamModel,
+    FfrBeamModel3d,
     FfrBeamOptions,
+    FfrBeamOptions3d,
     ForceIndex,
     FrameState2d,
+    FrameState3d,
     InputError,
+    JointFrame,
     ModalReduction,
     ModelError,
     Reference,
+    Reference3d,
+    RigidBody3dProperties,
     RigidBodyProperties,
+    SolidShape,
     SolverSettings,
+    SpatialJointType,
     System,
     TimeLaw,
+    circular_section_3d,
     constant_law,
     constant_speed_law,
     harmonic_law,
     polynomial_law,
     rectangular_section,
+    rectangular_section_3d,
+    rotation_from_axis_angle,
+    rotation_from_quaternion,
+    shape_inertia,
+    shape_properties,
+    shape_volume,
     spin_up_law,
     tabulated_law,
+    world_joint_frame,
 )
 from . import _flexmbd
 
@@ -134,10 +152,13 @@ class Scene:
     def solver(self):
         return self._native.solver
 
-    def add_output(self, output, spatial=False):
+    def add_output(self, output, spatial=None):
         """An output of the scene format ({"type": "point", "name": ..., "body": ..., "point": [...]},
-        "deflection" or "energy"): extra result columns."""
-        self._native.add_output_json(json.dumps(output), spatial)
+        "deflection" or "energy"): extra result columns. ``spatial``: the keys of a spatial
+        scene (3-component points); None: spatial if the system has a spatial body."""
+        if spatial is None:
+            spatial = self.system.is_spatial
+        self._native.add_output_json(json.dumps(output), bool(spatial))
 
     def modes(self, count=10, steady=False, at=None):
         """The model's lowest modes (docs/modes.md), linearised about

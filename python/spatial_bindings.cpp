@@ -1,0 +1,567 @@
+// Python bindings of the spatial builders (builders/spatial_builders.hpp) and the objects
+// they take: frame states and orientations, rigid body properties and solid shapes, joint
+// frames, spatial beam sections, meshes and models. Names are the C++ ones in snake case
+// (docs/python.md, "Spatial models"). Every argument is converted with an error naming
+// the function and the argument.
+#include <pybind11/eigen.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings_support.hpp"
+#include "bodies/ffr_beam_model_3d.hpp"
+#include "bodies/ffr_body_3d.hpp"
+#include "bodies/rigid_body_3d.hpp"
+#include "bodies/shape_inertia.hpp"
+#include "builders/spatial_builders.hpp"
+#include "elements/beam_section.hpp"
+#include "joints/world_frames.hpp"
+
+namespace flexmbd::pybind {
+
+namespace {
+
+using Law = std::shared_ptr<TimeLaw>;
+
+/// A rotation given as a 3 x 3 matrix (body axes in world axes: its columns), 4 Euler
+/// parameters (e0, e1, e2, e3) or an (axis, angle) pair; None: the identity.
+Mat3 orientationArg(const py::handle& h, const char* fn, const char* arg) {
+  if (h.is_none()) return Mat3::Identity();
+  constexpr const char* expected =
+      "a rotation: a 3 x 3 matrix, a quaternion (e0, e1, e2, e3) or an (axis, angle) pair";
+  if (py::isinstance<py::str>(h)) badArgument(fn, arg, expected, h);
+  try {
+    const Mat3 R = h.cast<Mat3>();
+    if (!R.allFinite() || !((R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-9) ||
+        !(R.determinant() > 0.0)) {
+      throw InputError(std::string(fn) + ": " + arg +
+                       " is not a rotation matrix (expected orthonormal columns, determinant +1, to 1e-9)");
+    }
+    return R;
+  } catch (const py::cast_error&) {
+  }
+  try {
+    const Vec4 p = h.cast<Vec4>();
+    if (!p.allFinite() || !(p.norm() > 0.0)) {
+      throw InputError(std::string(fn) + ": " + arg + ": the quaternion must be finite and not all zero");
+    }
+    return rotationFromQuaternion(p);
+  } catch (const py::cast_error&) {
+  }
+  if (py::isinstance<py::sequence>(h) && py::len(h) == 2) {
+    const py::sequence s = h.cast<py::sequence>();
+    Vec3 axis;
+    double angle = 0.0;
+    try {
+      axis = s[0].cast<Vec3>();
+      angle = s[1].cast<double>();
+    } catch (const py::cast_error&) {
+      badArgument(fn, arg, expected, h);
+    }
+    if (!axis.allFinite() || !(axis.norm() > 0.0)) {
+      throw InputError(std::string(fn) + ": " + arg + ": the axis must be a finite non-zero vector");
+    }
+    if (!std::isfinite(angle)) throw InputError(std::string(fn) + ": " + arg + ": the angle must be finite");
+    return rotationFromAxisAngle(axis, angle);
+  }
+  badArgument(fn, arg, expected, h);
+}
+
+/// 3 principal moments (body axes) or a 3 x 3 tensor.
+Mat3 inertiaArg(const py::handle& h, const char* fn) {
+  constexpr const char* expected = "3 principal moments (Ixx, Iyy, Izz) or a 3 x 3 tensor";
+  if (py::isinstance<py::str>(h) || h.is_none()) badArgument(fn, "inertia", expected, h);
+  try {
+    return h.cast<Mat3>();
+  } catch (const py::cast_error&) {
+  }
+  try {
+    const Vec3 I = h.cast<Vec3>();
+    for (int k = 0; k < 3; ++k) {
+      if (!(I[k] > 0.0) || !std::isfinite(I[k])) {
+        throw InputError(std::string(fn) + ": inertia[" + std::to_string(k) + "] must be > 0, got " +
+                         std::to_string(I[k]));
+      }
+    }
+    return I.asDiagonal();
+  } catch (const py::cast_error&) {
+  }
+  badArgument(fn, "inertia", expected, h);
+}
+
+double positiveArg(const py::handle& h, const char* fn, const char* arg) {
+  const double v = numberArg(h, fn, arg);
+  if (!(v > 0.0) || !std::isfinite(v)) throw InputError(std::string(fn) + ": " + arg + " must be > 0, got " + pyRepr(h));
+  return v;
+}
+double nonNegativeArg(const py::handle& h, const char* fn, const char* arg) {
+  const double v = numberArg(h, fn, arg);
+  if (!(v >= 0.0) || !std::isfinite(v)) {
+    throw InputError(std::string(fn) + ": " + arg + " must be >= 0, got " + pyRepr(h));
+  }
+  return v;
+}
+int intArg(const py::handle& h, const char* fn, const char* arg) {
+  if (!py::isinstance<py::int_>(h) || py::isinstance<py::bool_>(h)) badArgument(fn, arg, "an integer", h);
+  return h.cast<int>();
+}
+
+Law lawArg(const py::handle& h, const char* fn, const char* arg) {
+  if (h.is_none()) return nullptr;
+  if (!py::isinstance<TimeLaw>(h)) badArgument(fn, arg, "a time law (flexmbd.constant_law(...), ...) or None", h);
+  return h.cast<Law>();
+}
+
+JointFrame frameArg(const py::handle& h, const char* fn, const char* arg) {
+  if (h.is_none()) return JointFrame{};
+  if (!py::isinstance<JointFrame>(h)) badArgument(fn, arg, "a JointFrame (flexmbd.JointFrame(point, axis=...))", h);
+  return h.cast<JointFrame>();
+}
+
+SpatialJointType jointTypeArg(const py::handle& h, const char* fn) {
+  if (py::isinstance<SpatialJointType>(h)) return h.cast<SpatialJointType>();
+  if (!py::isinstance<py::str>(h)) badArgument(fn, "type", "a joint type name (\"revolute\", ...) or SpatialJointType", h);
+  try {
+    return spatialJointTypeFromString(h.cast<std::string>());
+  } catch (const InputError& e) {
+    throw InputError(std::string(fn) + ": type: " + e.what());
+  }
+}
+
+std::array<double, 6> sixArg(const py::handle& h, const char* fn, const char* arg) {
+  if (h.is_none()) return {};
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  const Vec6 v = argumentAs<Vec6>(h, fn, arg, "6 numbers (x, y, z, rx, ry, rz)");
+  std::array<double, 6> a{};
+  for (int k = 0; k < 6; ++k) a[k] = v[k];
+  return a;
+}
+
+/// Shear modulus from exactly one of shear_modulus or poisson_ratio (isotropic: G = E / (2 (1 + nu))).
+double shearModulusArg(double E, const py::handle& G, const py::handle& nu, const char* fn) {
+  if (G.is_none() == nu.is_none()) throw InputError(std::string(fn) + ": give exactly one of shear_modulus or poisson_ratio");
+  if (!G.is_none()) return positiveArg(G, fn, "shear_modulus");
+  const double v = numberArg(nu, fn, "poisson_ratio");
+  if (!(v > -1.0 && v < 0.5)) throw InputError(std::string(fn) + ": poisson_ratio must be in (-1, 0.5), got " + pyRepr(nu));
+  return E / (2.0 * (1.0 + v));
+}
+
+
+int axisIndexArg(const py::handle& h, const char* fn) {
+  if (py::isinstance<py::str>(h)) {
+    const std::string a = h.cast<std::string>();
+    if (a == "x" || a == "y" || a == "z") return a[0] - 'x';
+  }
+  throw InputError(std::string(fn) + ": axis must be \"x\", \"y\" or \"z\" (the body axis along the shape's axis), got " +
+                   pyRepr(h));
+}
+
+bool isSpatialBody(const Body& b) {
+  return dynamic_cast<const RigidBody3d*>(&b) != nullptr || dynamic_cast<const FfrBody3d*>(&b) != nullptr;
+}
+
+}  // namespace
+
+void bindSpatial(py::module_& m, py::class_<System>& system) {
+  // ----- orientations, frame states, rigid body properties ---------------------------------
+  m.def(
+      "rotation_from_axis_angle",
+      [](const py::object& axis, const py::object& angle) {
+        return rotationFromAxisAngle(vec3Arg(axis, "rotation_from_axis_angle", "axis"),
+                                     numberArg(angle, "rotation_from_axis_angle", "angle"));
+      },
+      py::arg("axis"), py::arg("angle"), "The rotation matrix by angle (rad) about axis (C++ rotationFromAxisAngle)");
+  m.def(
+      "rotation_from_quaternion",
+      [](const py::object& q) {
+        return rotationFromQuaternion(argumentAs<Vec4>(q, "rotation_from_quaternion", "quaternion", "4 numbers (e0, e1, e2, e3)"));
+      },
+      py::arg("quaternion"), "The rotation matrix of Euler parameters (e0, e1, e2, e3), normalised");
+
+  py::class_<FrameState3d>(m, "FrameState3d")
+      .def(py::init([](const py::object& position, const py::object& orientation, const py::object& velocity,
+                       const py::object& angularVelocity) {
+             constexpr const char* fn = "FrameState3d";
+             FrameState3d s;
+             s.position = vec3Arg(position, fn, "position");
+             s.orientation = orientationArg(orientation, fn, "orientation");
+             s.velocity = vec3Arg(velocity, fn, "velocity");
+             s.angularVelocity = vec3Arg(angularVelocity, fn, "angular_velocity");
+             return s;
+           }),
+           py::arg("position") = py::make_tuple(0, 0, 0), py::arg("orientation") = py::none(),
+           py::arg("velocity") = py::make_tuple(0, 0, 0), py::arg("angular_velocity") = py::make_tuple(0, 0, 0),
+           "Initial state of a spatial body frame: position and velocity (world), orientation (a 3 x 3 rotation "
+           "matrix, a quaternion (e0, e1, e2, e3) or an (axis, angle) pair), angular velocity (body axes)")
+      .def_readwrite("position", &FrameState3d::position)
+      .def_readwrite("orientation", &FrameState3d::orientation)
+      .def_readwrite("velocity", &FrameState3d::velocity)
+      .def_readwrite("angular_velocity", &FrameState3d::angularVelocity);
+
+  py::class_<RigidBody3dProperties>(m, "RigidBody3dProperties")
+      .def(py::init([](const py::object& mass, const py::object& inertia) {
+             RigidBody3dProperties p;
+             p.mass = positiveArg(mass, "RigidBody3dProperties", "mass");
+             p.inertia = inertiaArg(inertia, "RigidBody3dProperties");
+             return p;
+           }),
+           py::arg("mass"), py::arg("inertia"),
+           "Mass (kg) and inertia about the centre of mass (body axes: 3 principal moments or a 3 x 3 tensor)")
+      .def_readwrite("mass", &RigidBody3dProperties::mass)
+      .def_readwrite("inertia", &RigidBody3dProperties::inertia);
+
+  // ----- solid shapes (bodies/shape_inertia.hpp) -----------------------------------------------
+  py::class_<SolidShape>(m, "SolidShape")
+      .def_static(
+          "box",
+          [](const py::object& size) {
+            SolidShape s;
+            s.type = SolidShape::Type::Box;
+            s.size = vec3Arg(size, "SolidShape.box", "size");
+            return s;
+          },
+          py::arg("size"), "A box of edge lengths (along body x, y, z), centred on the body frame")
+      .def_static(
+          "cylinder",
+          [](const py::object& radius, const py::object& length, const py::object& axis) {
+            SolidShape s;
+            s.type = SolidShape::Type::Cylinder;
+            s.radius = positiveArg(radius, "SolidShape.cylinder", "radius");
+            s.length = positiveArg(length, "SolidShape.cylinder", "length");
+            s.axis = axisIndexArg(axis, "SolidShape.cylinder");
+            return s;
+          },
+          py::arg("radius"), py::arg("length"), py::arg("axis") = "z")
+      .def_static(
+          "tube",
+          [](const py::object& outer, const py::object& inner, const py::object& length, const py::object& axis) {
+            constexpr const char* fn = "SolidShape.tube";
+            SolidShape s;
+            s.type = SolidShape::Type::Tube;
+            s.radius = positiveArg(outer, fn, "outer_radius");
+            s.innerRadius = nonNegativeArg(inner, fn, "inner_radius");
+            if (!(s.innerRadius < s.radius)) throw InputError(std::string(fn) + ": inner_radius must be < outer_radius");
+            s.length = positiveArg(length, fn, "length");
+            s.axis = axisIndexArg(axis, fn);
+            return s;
+          },
+          py::arg("outer_radius"), py::arg("inner_radius"), py::arg("length"), py::arg("axis") = "z")
+      .def_static(
+          "sphere",
+          [](const py::object& radius) {
+            SolidShape s;
+            s.type = SolidShape::Type::Sphere;
+            s.radius = positiveArg(radius, "SolidShape.sphere", "radius");
+            return s;
+          },
+          py::arg("radius"))
+      .def_property_readonly("volume", [](const SolidShape& s) { return shapeVolume(s); });
+  m.def(
+      "shape_properties",
+      [](const SolidShape& s, const py::object& mass, const py::object& density) {
+        if (mass.is_none() == density.is_none()) throw InputError("shape_properties: give exactly one of mass or density");
+        return mass.is_none() ? shapeProperties(s, 0.0, positiveArg(density, "shape_properties", "density"))
+                              : shapeProperties(s, positiveArg(mass, "shape_properties", "mass"), 0.0);
+      },
+      py::arg("shape"), py::arg("mass") = py::none(), py::arg("density") = py::none(),
+      "RigidBody3dProperties of a body that is the shape: the mass given, or density x volume");
+  m.def("shape_volume", &shapeVolume, py::arg("shape"));
+  m.def(
+      "shape_inertia", [](const SolidShape& s, const py::object& mass) { return shapeInertia(s, positiveArg(mass, "shape_inertia", "mass")); },
+      py::arg("shape"), py::arg("mass"));
+
+  // ----- joint frames (joints/frame_pair.hpp, joints/world_frames.hpp) -------------------------
+  py::class_<JointFrame>(m, "JointFrame")
+      .def(py::init([](const py::object& point, const py::object& axis, const py::object& orientation) {
+             constexpr const char* fn = "JointFrame";
+             if (!axis.is_none() && !orientation.is_none()) throw InputError("JointFrame: give either axis or orientation, not both");
+             const Vec3 p = vec3Arg(point, fn, "point");
+             if (!axis.is_none()) return jointFrameFromAxis(p, vec3Arg(axis, fn, "axis"));
+             JointFrame f;
+             f.point = p;
+             f.axes = orientationArg(orientation, fn, "orientation");
+             return f;
+           }),
+           py::arg("point") = py::make_tuple(0, 0, 0), py::arg("axis") = py::none(), py::arg("orientation") = py::none(),
+           "A frame fixed in a body (body axes): origin point; z axis along axis (x: the body axis least aligned "
+           "with it, made perpendicular), or the axes of a rotation (orientation), or the body axes")
+      .def_readwrite("point", &JointFrame::point)
+      .def_readwrite("axes", &JointFrame::axes);
+  m.def(
+      "world_joint_frame",
+      [](const py::object& point, const py::object& axis, const py::object& xAxis) {
+        constexpr const char* fn = "world_joint_frame";
+        const Vec3 p = vec3Arg(point, fn, "point"), a = vec3Arg(axis, fn, "axis");
+        if (xAxis.is_none()) return worldJointFrame(p, a, nullptr, fn);
+        const Vec3 x = vec3Arg(xAxis, fn, "x_axis");
+        return worldJointFrame(p, a, &x, fn);
+      },
+      py::arg("point"), py::arg("axis"), py::arg("x_axis") = py::none(),
+      "A frame in world axes: origin point, z along axis, x along x_axis made perpendicular (C++ worldJointFrame)");
+  py::enum_<SpatialJointType>(m, "SpatialJointType")
+      .value("SPHERICAL", SpatialJointType::Spherical)
+      .value("REVOLUTE", SpatialJointType::Revolute)
+      .value("PRISMATIC", SpatialJointType::Prismatic)
+      .value("CYLINDRICAL", SpatialJointType::Cylindrical)
+      .value("UNIVERSAL", SpatialJointType::Universal)
+      .value("FIXED", SpatialJointType::Fixed)
+      .value("PLANAR", SpatialJointType::Planar);
+
+  // ----- spatial beams (elements/beam_section.hpp, bodies/ffr_beam_model_3d.hpp) -----------------
+  py::class_<BeamSection3d>(m, "BeamSection3d")
+      .def(py::init([](const py::object& area, const py::object& iy, const py::object& iz, const py::object& j,
+                       const py::object& E, const py::object& G, const py::object& nu, const py::object& rho,
+                       const py::object& damping) {
+             constexpr const char* fn = "BeamSection3d";
+             BeamSection3d s;
+             s.area = positiveArg(area, fn, "area");
+             s.inertiaY = positiveArg(iy, fn, "inertia_y");
+             s.inertiaZ = positiveArg(iz, fn, "inertia_z");
+             s.torsionConstant = positiveArg(j, fn, "torsion_constant");
+             s.youngsModulus = positiveArg(E, fn, "youngs_modulus");
+             s.shearModulus = shearModulusArg(s.youngsModulus, G, nu, fn);
+             s.density = positiveArg(rho, fn, "density");
+             s.damping = nonNegativeArg(damping, fn, "damping");
+             return s;
+           }),
+           py::arg("area"), py::arg("inertia_y"), py::arg("inertia_z"), py::arg("torsion_constant"),
+           py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(), py::arg("poisson_ratio") = py::none(),
+           py::arg("density"), py::arg("damping") = 0.0)
+      .def_readwrite("area", &BeamSection3d::area)
+      .def_readwrite("inertia_y", &BeamSection3d::inertiaY)
+      .def_readwrite("inertia_z", &BeamSection3d::inertiaZ)
+      .def_readwrite("torsion_constant", &BeamSection3d::torsionConstant)
+      .def_readwrite("youngs_modulus", &BeamSection3d::youngsModulus)
+      .def_readwrite("shear_modulus", &BeamSection3d::shearModulus)
+      .def_readwrite("density", &BeamSection3d::density)
+      .def_readwrite("damping", &BeamSection3d::damping);
+  m.def(
+      "rectangular_section_3d",
+      [](const py::object& w, const py::object& h, const py::object& E, const py::object& G, const py::object& nu,
+         const py::object& rho, const py::object& damping) {
+        constexpr const char* fn = "rectangular_section_3d";
+        const double e = positiveArg(E, fn, "youngs_modulus");
+        return rectangularSection3d(positiveArg(w, fn, "width"), positiveArg(h, fn, "height"), e,
+                                    shearModulusArg(e, G, nu, fn), positiveArg(rho, fn, "density"),
+                                    nonNegativeArg(damping, fn, "damping"));
+      },
+      py::arg("width"), py::arg("height"), py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(),
+      py::arg("poisson_ratio") = py::none(), py::arg("density"), py::arg("damping") = 0.0,
+      "width along the section's y axis, height along z; exactly one of shear_modulus or poisson_ratio");
+  m.def(
+      "circular_section_3d",
+      [](const py::object& d, const py::object& E, const py::object& G, const py::object& nu, const py::object& rho,
+         const py::object& damping) {
+        constexpr const char* fn = "circular_section_3d";
+        const double e = positiveArg(E, fn, "youngs_modulus");
+        return circularSection3d(positiveArg(d, fn, "diameter"), e, shearModulusArg(e, G, nu, fn),
+                                 positiveArg(rho, fn, "density"), nonNegativeArg(damping, fn, "damping"));
+      },
+      py::arg("diameter"), py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(),
+      py::arg("poisson_ratio") = py::none(), py::arg("density"), py::arg("damping") = 0.0);
+  py::class_<BeamMesh3d>(m, "BeamMesh3d")
+      .def(py::init([](const std::vector<Vec3>& nodes, const std::vector<std::pair<int, int>>& elements,
+                       const BeamSection3d& section, const py::object& yAxis) {
+             BeamMesh3d mesh;
+             mesh.nodes = nodes;
+             const Vec3 y = vec3Arg(yAxis, "BeamMesh3d", "y_axis");
+             for (const auto& [a, b] : elements) mesh.elements.push_back({a, b, section, y});
+             return mesh;
+           }),
+           py::arg("nodes"), py::arg("elements"), py::arg("section"), py::arg("y_axis") = py::make_tuple(0, 1, 0),
+           "nodes [[x, y, z], ...] (body frame), elements [(i, j), ...] with one section and y axis hint")
+      .def_static(
+          "straight",
+          [](const py::object& length, const py::object& elements, const BeamSection3d& section, const py::object& origin,
+             const py::object& yAxis) {
+            constexpr const char* fn = "BeamMesh3d.straight";
+            return BeamMesh3d::straight(positiveArg(length, fn, "length"), intArg(elements, fn, "elements"), section,
+                                        vec3Arg(origin, fn, "origin"), vec3Arg(yAxis, fn, "y_axis"));
+          },
+          py::arg("length"), py::arg("elements"), py::arg("section"), py::arg("origin") = py::make_tuple(0, 0, 0),
+          py::arg("y_axis") = py::make_tuple(0, 1, 0), "A straight beam along the body x axis from origin")
+      .def_readonly("nodes", &BeamMesh3d::nodes);
+  py::enum_<ReferenceConditions3d::Type>(m, "Reference3d")
+      .value("CLAMPED", ReferenceConditions3d::Type::Clamped)
+      .value("PINNED_PINNED", ReferenceConditions3d::Type::PinnedPinned)
+      .value("FREE_FREE", ReferenceConditions3d::Type::FreeFree);
+  py::class_<FfrBeamOptions3d>(m, "FfrBeamOptions3d")
+      .def(py::init([](ReferenceConditions3d::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
+                       bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes) {
+             FfrBeamOptions3d o;
+             o.reference.type = type;
+             o.reference.nodeA = nodeA;
+             o.reference.nodeB = nodeB;
+             o.modes = modes;
+             o.modeSet = std::move(modeSet);
+             o.geometricStiffening = stiffening;
+             o.reduction = reduction;
+             o.interfaceNodes = std::move(interfaceNodes);
+             o.inertiaModes = inertiaModes;
+             return o;
+           }),
+           py::arg("reference") = ReferenceConditions3d::Type::Clamped, py::arg("node_a") = 0, py::arg("node_b") = -1,
+           py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{}, py::arg("geometric_stiffening") = false,
+           py::arg("reduction") = ModalReduction::Normal, py::arg("interface_nodes") = std::vector<int>{},
+           py::arg("inertia_modes") = false);
+  py::class_<FfrBeamModel3d, std::shared_ptr<FfrBeamModel3d>>(m, "FfrBeamModel3d")
+      .def(py::init([](BeamMesh3d mesh, const FfrBeamOptions3d& o, const std::string& owner) {
+             return std::make_shared<FfrBeamModel3d>(std::move(mesh), o, owner);
+           }),
+           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model")
+      .def("natural_frequencies", &FfrBeamModel3d::naturalFrequencies, "rad/s, ascending (frame held fixed)")
+      .def_property_readonly("num_elastic", &FfrBeamModel3d::numElastic);
+
+  // ----- the builders: methods of System ------------------------------------------------------
+  system
+      .def(
+          "add_rigid_body_3d",
+          [](System& s, const std::string& name, const py::object& props, const py::object& init) {
+            constexpr const char* fn = "add_rigid_body_3d";
+            if (!py::isinstance<RigidBody3dProperties>(props)) {
+              badArgument(fn, "properties", "RigidBody3dProperties (or flexmbd.shape_properties(...))", props);
+            }
+            if (!init.is_none() && !py::isinstance<FrameState3d>(init)) badArgument(fn, "initial", "a FrameState3d", init);
+            return addRigidBody3d(s, name, props.cast<RigidBody3dProperties>(),
+                                  init.is_none() ? FrameState3d{} : init.cast<FrameState3d>());
+          },
+          py::arg("name"), py::arg("properties"), py::arg("initial") = py::none())
+      .def(
+          "add_flexible_body_3d",
+          [](System& s, const std::string& name, const py::object& model, const py::object& init,
+             std::optional<VecX> qf, std::optional<VecX> qfDot) {
+            constexpr const char* fn = "add_flexible_body_3d";
+            if (!py::isinstance<FfrBeamModel3d>(model)) badArgument(fn, "model", "an FfrBeamModel3d", model);
+            if (!init.is_none() && !py::isinstance<FrameState3d>(init)) badArgument(fn, "initial", "a FrameState3d", init);
+            return addFlexibleBody3d(s, name, std::shared_ptr<const FfrBeamModel3d>(model.cast<std::shared_ptr<FfrBeamModel3d>>()),
+                                     init.is_none() ? FrameState3d{} : init.cast<FrameState3d>(), qf ? *qf : VecX(),
+                                     qfDot ? *qfDot : VecX());
+          },
+          py::arg("name"), py::arg("model"), py::arg("initial") = py::none(),
+          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none())
+      .def(
+          "add_spatial_joint",
+          [](System& s, const std::string& name, const py::object& type, const py::object& bi, const py::object& fi,
+             const py::object& bj, const py::object& fj) {
+            constexpr const char* fn = "add_spatial_joint";
+            return addSpatialJoint(s, name, jointTypeArg(type, fn), body(s, bi, fn, "body_i"), frameArg(fi, fn, "frame_i"),
+                                   body(s, bj, fn, "body_j"), frameArg(fj, fn, "frame_j"));
+          },
+          py::arg("name"), py::arg("type"), py::arg("body_i"), py::arg("frame_i"), py::arg("body_j"), py::arg("frame_j"),
+          "A joint between frame_i of body_i and frame_j of body_j (JointFrame, body axes; None: the body frame)")
+      .def(
+          "add_spatial_joint_at_world",
+          [](System& s, const std::string& name, const py::object& type, const py::object& bi, const py::object& bj,
+             const py::object& point, const py::object& axis, const py::object& xAxis, const py::object& orientation) {
+            constexpr const char* fn = "add_spatial_joint_at_world";
+            const SpatialJointType t = jointTypeArg(type, fn);
+            const BodyIndex i = body(s, bi, fn, "body_i"), j = body(s, bj, fn, "body_j");
+            const Vec3 p = vec3Arg(point, fn, "point");
+            if (!orientation.is_none()) {
+              if (!axis.is_none() || !xAxis.is_none()) throw InputError(std::string(fn) + ": give either axis (with x_axis) or orientation, not both");
+              JointFrame w;
+              w.point = p;
+              w.axes = orientationArg(orientation, fn, "orientation");
+              return addSpatialJointAtWorld(s, name, t, i, j, w);
+            }
+            std::optional<Vec3> a, x;
+            if (!axis.is_none()) a = vec3Arg(axis, fn, "axis");
+            if (!xAxis.is_none()) x = vec3Arg(xAxis, fn, "x_axis");
+            return addSpatialJointAtWorld(s, name, t, i, j, p, a ? &*a : nullptr, x ? &*x : nullptr);
+          },
+          py::arg("name"), py::arg("type"), py::arg("body_i"), py::arg("body_j"), py::arg("point"),
+          py::arg("axis") = py::none(), py::arg("x_axis") = py::none(), py::arg("orientation") = py::none(),
+          "A joint placed in the world (initial configuration): point, joint axis (not for spherical and fixed "
+          "joints), x_axis (universal joints: the cross's pin on body_i), or the frame's orientation")
+      .def(
+          "add_joint_angle_driver",
+          [](System& s, const std::string& name, const py::object& j, const py::object& law) {
+            constexpr const char* fn = "add_joint_angle_driver";
+            const Law l = lawArg(law, fn, "law");
+            if (!l) badArgument(fn, "law", "a time law", law);
+            return addJointAngleDriver(s, name, joint(s, j, fn, "joint"), l);
+          },
+          py::arg("name"), py::arg("joint"), py::arg("law"))
+      .def(
+          "add_joint_displacement_driver",
+          [](System& s, const std::string& name, const py::object& j, const py::object& law) {
+            constexpr const char* fn = "add_joint_displacement_driver";
+            const Law l = lawArg(law, fn, "law");
+            if (!l) badArgument(fn, "law", "a time law", law);
+            return addJointDisplacementDriver(s, name, joint(s, j, fn, "joint"), l);
+          },
+          py::arg("name"), py::arg("joint"), py::arg("law"))
+      .def(
+          "initial_joint_angle",
+          [](const System& s, const py::object& j) { return initialJointAngle(s, joint(s, j, "initial_joint_angle")); },
+          py::arg("joint"))
+      .def(
+          "add_spatial_spring_damper",
+          [](System& s, const std::string& name, const py::object& bi, const py::object& pi, const py::object& bj,
+             const py::object& pj, const py::object& k, const py::object& c, const py::object& l0) {
+            constexpr const char* fn = "add_spatial_spring_damper";
+            std::optional<double> freeLength;
+            if (!l0.is_none()) freeLength = nonNegativeArg(l0, fn, "free_length");
+            return addSpatialSpringDamper(s, name, body(s, bi, fn, "body_i"), vec3Arg(pi, fn, "point_i"),
+                                          body(s, bj, fn, "body_j"), vec3Arg(pj, fn, "point_j"),
+                                          nonNegativeArg(k, fn, "stiffness"), nonNegativeArg(c, fn, "damping"), freeLength);
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
+          py::arg("stiffness"), py::arg("damping") = 0.0, py::arg("free_length") = py::none(),
+          "free_length None: the points' initial distance")
+      .def(
+          "add_spatial_rotational_spring_damper",
+          [](System& s, const std::string& name, const py::object& j, const py::object& k, const py::object& c,
+             const py::object& a0) {
+            constexpr const char* fn = "add_spatial_rotational_spring_damper";
+            std::optional<double> freeAngle;
+            if (!a0.is_none()) freeAngle = numberArg(a0, fn, "free_angle");
+            return addSpatialRotationalSpringDamper(s, name, joint(s, j, fn, "joint"), nonNegativeArg(k, fn, "stiffness"),
+                                                    nonNegativeArg(c, fn, "damping"), freeAngle);
+          },
+          py::arg("name"), py::arg("joint"), py::arg("stiffness"), py::arg("damping") = 0.0,
+          py::arg("free_angle") = py::none(), "free_angle None: the joint's initial angle")
+      .def(
+          "add_spatial_bushing",
+          [](System& s, const std::string& name, const py::object& bi, const py::object& fi, const py::object& bj,
+             const py::object& fj, const py::object& k, const py::object& c) {
+            constexpr const char* fn = "add_spatial_bushing";
+            if (k.is_none()) badArgument(fn, "stiffness", "6 numbers (x, y, z, rx, ry, rz)", k);
+            return addSpatialBushing(s, name, body(s, bi, fn, "body_i"), frameArg(fi, fn, "frame_i"),
+                                     body(s, bj, fn, "body_j"), frameArg(fj, fn, "frame_j"), sixArg(k, fn, "stiffness"),
+                                     sixArg(c, fn, "damping"));
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("frame_i"), py::arg("body_j"), py::arg("frame_j"),
+          py::arg("stiffness"), py::arg("damping") = py::none())
+      .def(
+          "add_spatial_applied_load",
+          [](System& s, const std::string& name, const py::object& b, const py::object& point, const py::object& fx,
+             const py::object& fy, const py::object& fz, const py::object& tx, const py::object& ty,
+             const py::object& tz) {
+            constexpr const char* fn = "add_spatial_applied_load";
+            const std::array<TimeLawPtr, 6> laws = {lawArg(fx, fn, "force_x"),  lawArg(fy, fn, "force_y"),
+                                                    lawArg(fz, fn, "force_z"),  lawArg(tx, fn, "torque_x"),
+                                                    lawArg(ty, fn, "torque_y"), lawArg(tz, fn, "torque_z")};
+            return addSpatialAppliedLoad(s, name, body(s, b, fn, "body"), vec3Arg(point, fn, "point"), laws);
+          },
+          py::arg("name"), py::arg("body"), py::arg("point") = py::make_tuple(0, 0, 0), py::arg("force_x") = py::none(),
+          py::arg("force_y") = py::none(), py::arg("force_z") = py::none(), py::arg("torque_x") = py::none(),
+          py::arg("torque_y") = py::none(), py::arg("torque_z") = py::none(), "Force and torque laws, world axes")
+      .def_property_readonly(
+          "is_spatial",
+          [](const System& s) {
+            for (int b = 1; b < s.numBodies(); ++b) {
+              if (isSpatialBody(s.body(BodyIndex(b)))) return true;
+            }
+            return false;
+          },
+          "True if a body is spatial (its outputs are spatial)");
+}
+
+}  // namespace flexmbd::pybind
