@@ -41,7 +41,7 @@ struct AugmentedLagrangianOptions {
 
 /// The ALI3-P integrator on a finalized System. State: positions q, velocities v,
 /// accelerations a (all consistent after the projections) and the multiplier estimate
-/// lambda* of the augmented Lagrangian. Dense linear algebra (nq x nq): meant for
+/// lambda* of the augmented Lagrangian. Dense linear algebra (nv x nv): meant for
 /// mechanisms and for short bridges of larger models.
 class AugmentedLagrangianIntegrator {
  public:
