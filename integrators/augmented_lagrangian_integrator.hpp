@@ -10,9 +10,16 @@
 // singular positions (change points, dead centres) where the index-2 and index-3 DAE
 // integrators stop: the engine uses it as a bridge across them (integrators/simulation.cpp)
 // and as an integrator of its own ("ali3p").
+//
+// Models whose velocities are not coordinate rates (q' = T(q) v: spatial bodies with Euler
+// parameters) are integrated in velocity space: the unknown of a step is its displacement
+// d (nv), q_{n+1} = q_n (+) d by each body's own increment (Body::applyIncrement), the
+// trapezoidal rule relates d, v and a as it relates q_{n+1} - q_n, v and a for T = I, and
+// Newton's corrections are velocity-space increments (docs/formulations.md).
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "core/dae_system.hpp"
 #include "integrators/dae_integrator.hpp"
@@ -27,16 +34,19 @@ struct AugmentedLagrangianOptions {
   double maxStepSize = 0.0;      ///< 0: no limit
   double minStepSize = 1e-14;    ///< failure below this
   double lengthScale = 1.0;      ///< model size: the scale of round-off in positions and constraints
+  /// Constraint equations released as redundant (ascending; docs/formulations.md, "Redundant
+  /// constraints"): left out of G, g and the multipliers, as in DaeSystem.
+  std::vector<int> released;
 };
 
 /// The ALI3-P integrator on a finalized System. State: positions q, velocities v,
 /// accelerations a (all consistent after the projections) and the multiplier estimate
-/// lambda* of the augmented Lagrangian. Dense linear algebra (nq x nq): meant for
+/// lambda* of the augmented Lagrangian. Dense linear algebra (nv x nv): meant for
 /// mechanisms and for short bridges of larger models.
 class AugmentedLagrangianIntegrator {
  public:
-  /// q0, v0 must satisfy the position and velocity constraints (e.g. from
-  /// computeConsistentState); a0 and lambda0 are the consistent accelerations and
+  /// q0 (nq), v0 (nv) must satisfy the position and velocity constraints (e.g. from
+  /// computeConsistentState); a0 (nv) and lambda0 (m) are the consistent accelerations and
   /// multipliers there. @throws InputError on bad options.
   AugmentedLagrangianIntegrator(const System& sys, double t0, const VecX& q0, const VecX& v0, const VecX& a0,
                                 const VecX& lambda0, const AugmentedLagrangianOptions& options);
@@ -53,10 +63,12 @@ class AugmentedLagrangianIntegrator {
   const VecX& v() const;
   const VecX& a() const;
   const VecX& lambda() const;
-  /// Positions and velocities at t in the last step [t_{n-1}, t_n] (cubic Hermite
-  /// interpolation of q from (q, v) and of v from (v, a) at both ends).
+  /// Positions and velocities at t in the last step [t_{n-1}, t_n]: cubic Hermite
+  /// interpolation of the displacement from q_{n-1} (0 and d at the ends, rates v), applied
+  /// as q_{n-1} (+) d(t), and of v from (v, a) at both ends. Allocates (outputs only).
   void interpolate(double t, VecX& q, VecX& v) const;
-  /// Smallest/largest singular value of G at the current positions (1 without constraints).
+  /// Smallest/largest singular value of G (released equations left out) at the current
+  /// positions (1 without constraints).
   double constraintConditioning() const;
   IntegratorStats stats() const;
   /// Steps accepted although their error estimate exceeded 1, because it did not fall as

@@ -74,14 +74,14 @@ AugmentedLagrangianOptions crossingOptions(const RunContext& ctx, double regular
   bo.minStepSize = ctx.options.minStepSize;
   bo.lengthScale = ctx.modelSize;
   bo.initialStepSize = regularStep / kCoreStepDivisor;
+  bo.released = ctx.dae.releasedEquations();  // as the run integrates them
   return bo;
 }
 
 }  // namespace
 
 bool mayCrossSingularPositions(const System& sys, const SolverSettings& settings, IntegratorKind kind) {
-  return settings.crossSingular && kind != IntegratorKind::AugmentedLagrangian && sys.numConstraintEquations() > 0 &&
-         sys.velocitiesAreCoordinateRates();
+  return settings.crossSingular && kind != IntegratorKind::AugmentedLagrangian && sys.numConstraintEquations() > 0;
 }
 
 double constraintConditioning(const MatX& G) {

@@ -13,8 +13,8 @@
 namespace flexmbd {
 
 /// A run may cross singular positions with ALI3-P: the settings allow it
-/// (crossSingular), the run is not on ALI3-P already, the model has constraints, and its
-/// velocities are its coordinates' rates (ALI3-P is planar, q' = v, so far).
+/// (crossSingular), the run is not on ALI3-P already, and the model has constraints
+/// (planar or spatial: ALI3-P integrates q' = T(q) v in velocity space).
 bool mayCrossSingularPositions(const System& sys, const SolverSettings& settings, IntegratorKind kind);
 
 /// What singularityDiagnosis measured: the message, and whether it found the mechanism at

@@ -118,6 +118,26 @@ TEST_F(Cli, ValidRunOfTheExample) {
   EXPECT_GT(summary.at("steps").get<long>(), 0);
 }
 
+TEST_F(Cli, SpatialSceneRunsWithTheAugmentedLagrangianIntegrator) {
+  // examples/spatial_four_bar.json (Euler parameters, three redundant equations released)
+  // with "integrator": "ali3p": refused as planar-only before issue 25; now it runs to the
+  // end (exit 0) and conserves the energy of the undriven swing to the order-2 method's
+  // global error (kSecondOrderPerRtol = 1e4 rtol, tests/test_spatial_ali3p.cpp).
+  nlohmann::json j = nlohmann::json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_four_bar.json"));
+  j["solver"]["integrator"] = "ali3p";
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("run " + shellQuote(writeScene("spatial_ali3p.json", j).string()) + " --out " +
+                          shellQuote(out.string()) + " --t-end 0.5 --quiet");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "ok");
+  EXPECT_EQ(summary.at("integrator"), "ali3p");
+  EXPECT_DOUBLE_EQ(summary.at("t_reached").get<double>(), 0.5);
+  EXPECT_EQ(summary.at("redundant_constraints").size(), 3u);
+  const double e0 = summary.at("energy_start").get<double>(), e1 = summary.at("energy_end").get<double>();
+  EXPECT_LT(std::abs(e1 - e0), 1e4 * j["solver"]["rtol"].get<double>() * std::abs(e0));
+}
+
 // Needs computeConsistentState's redundancy check (ModelError naming the driver).
 TEST_F(Cli, ConflictingDriversExitWith2) {
   nlohmann::json j = example();
