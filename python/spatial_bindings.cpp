@@ -391,9 +391,13 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .value("CLAMPED", ReferenceConditions3d::Type::Clamped)
       .value("PINNED_PINNED", ReferenceConditions3d::Type::PinnedPinned)
       .value("FREE_FREE", ReferenceConditions3d::Type::FreeFree);
+  py::enum_<BeamTheory>(m, "BeamTheory")
+      .value("EULER_BERNOULLI", BeamTheory::EulerBernoulli)
+      .value("RAYLEIGH", BeamTheory::Rayleigh);
   py::class_<FfrBeamOptions3d>(m, "FfrBeamOptions3d")
       .def(py::init([](ReferenceConditions3d::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
-                       bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes) {
+                       bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes,
+                       BeamTheory theory) {
              FfrBeamOptions3d o;
              o.reference.type = type;
              o.reference.nodeA = nodeA;
@@ -404,12 +408,13 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
              o.reduction = reduction;
              o.interfaceNodes = std::move(interfaceNodes);
              o.inertiaModes = inertiaModes;
+             o.theory = theory;
              return o;
            }),
            py::arg("reference") = ReferenceConditions3d::Type::Clamped, py::arg("node_a") = 0, py::arg("node_b") = -1,
            py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{}, py::arg("geometric_stiffening") = false,
            py::arg("reduction") = ModalReduction::Normal, py::arg("interface_nodes") = std::vector<int>{},
-           py::arg("inertia_modes") = false);
+           py::arg("inertia_modes") = false, py::arg("theory") = BeamTheory::EulerBernoulli);
   py::class_<FfrBeamModel3d, std::shared_ptr<FfrBeamModel3d>>(m, "FfrBeamModel3d")
       .def(py::init([](BeamMesh3d mesh, const FfrBeamOptions3d& o, const std::string& owner) {
              return std::make_shared<FfrBeamModel3d>(std::move(mesh), o, owner);

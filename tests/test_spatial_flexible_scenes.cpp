@@ -346,7 +346,8 @@ TEST(SpatialFlexibleScene, BeamTheoryKeyGivesTheRayleighModelOfTheApi) {
     expectMatrixNear(MatX(a.hI[i]), MatX(b.hI[i]), 1e-14, "H_i", mscale);
     for (int l = 0; l < 3; ++l) expectMatrixNear(MatX(a.rKL[i][l]), MatX(b.rKL[i][l]), 1e-14, "R_kl", mscale);
   }
-  const FfrInvariants3d& eb = flexBody(parseScene(pendulumScene())).invariants();
+  const Scene ebScene = parseScene(pendulumScene());
+  const FfrInvariants3d& eb = flexBody(ebScene).invariants();
   EXPECT_GT(MatX(a.mff - eb.mff).cwiseAbs().maxCoeff(), 1e-6 * mscale);  // the rotary inertia
   j["bodies"][0]["beam_theory"] = "timoshenko";
   expectInputError([&] { parseScene(j); }, {"bodies[0] (\"beam\")", "beam_theory", "\"euler_bernoulli\" or \"rayleigh\"",

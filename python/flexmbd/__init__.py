@@ -21,6 +21,7 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     BeamMesh3d,
     BeamSection,
     BeamSection3d,
+    BeamTheory,
     BodyIndex,
     ConstraintIndex,
     FfrBeamModel,
