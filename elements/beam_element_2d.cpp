@@ -1,20 +1,53 @@
 #include "elements/beam_element_2d.hpp"
 
-#include <array>
 #include <cmath>
 
 #include "core/errors.hpp"
+#include "elements/beam_element_3d.hpp"
 
 namespace flexmbd {
 namespace {
 
-// 5-point Gauss-Legendre rule mapped to [0, 1]: exact up to degree 9.
-constexpr std::array<double, 5> kGaussXi = {
-    0.5 - 0.5 * 0.9061798459386640, 0.5 - 0.5 * 0.5384693101056831, 0.5,
-    0.5 + 0.5 * 0.5384693101056831, 0.5 + 0.5 * 0.9061798459386640};
-constexpr std::array<double, 5> kGaussW = {0.5 * 0.2369268850561891, 0.5 * 0.4786286704993665,
-                                           0.5 * 0.5688888888888889, 0.5 * 0.4786286704993665,
-                                           0.5 * 0.2369268850561891};
+// The planar element is the spatial BeamElement3d restricted to its x-y plane: its six
+// coordinates (u1, v1, psi1, u2, v2, psi2) are the spatial element's (u, v, tz) at both
+// nodes (psi = v' = tz), every integral and matrix the corresponding block (issue 25:
+// one element code for planar and spatial).
+constexpr int kInPlane[6] = {0, 1, 5, 6, 7, 11};
+
+BeamElement2d::Mat6 inPlane(const BeamElement3d::Mat12& A) {
+  BeamElement2d::Mat6 B;
+  for (int i = 0; i < 6; ++i) {
+    for (int j = 0; j < 6; ++j) B(i, j) = A(kInPlane[i], kInPlane[j]);
+  }
+  return B;
+}
+
+BeamElement2d::Row6 inPlane(const BeamElement3d::Row12& r) {
+  BeamElement2d::Row6 b;
+  for (int j = 0; j < 6; ++j) b(j) = r(kInPlane[j]);
+  return b;
+}
+
+/// Rows x, y of a spatial 3 x 12 block, in-plane columns.
+BeamElement2d::Mat26 inPlane(const BeamElement3d::Mat3x12& A) {
+  BeamElement2d::Mat26 B;
+  for (int k = 0; k < 2; ++k) B.row(k) = inPlane(BeamElement3d::Row12(A.row(k)));
+  return B;
+}
+
+/// The spatial section of a planar one: Iz = I for the x-y plane; the out-of-plane
+/// properties (Iy, J, G) only enter coordinates the planar element drops, so any valid
+/// values do (Iy = J = I, G = E / 2).
+BeamSection3d planarSection3d(const BeamSection& s) {
+  BeamSection3d t;
+  t.area = s.area;
+  t.inertiaY = t.inertiaZ = t.torsionConstant = s.inertia;
+  t.youngsModulus = s.youngsModulus;
+  t.shearModulus = 0.5 * s.youngsModulus;
+  t.density = s.density;
+  t.damping = s.damping;
+  return t;
+}
 
 }  // namespace
 
@@ -39,105 +72,48 @@ BeamElement2d::BeamElement2d(const Vec2& start, const Vec2& end, const BeamSecti
   T_.block<2, 2>(3, 3) = Rt;
   T_(5, 5) = 1.0;
 
-  const double rhoA = section.massPerLength(), l = l_;
-  mass_ = rhoA * l;
-  sBar_.setZero();
-  sX_.setZero();
-  sXX_.setZero();
-  sYY_.setZero();
-  sXY_.setZero();
-  for (size_t g = 0; g < kGaussXi.size(); ++g) {
-    const double xi = kGaussXi[g], w = kGaussW[g] * rhoA * l;  // dx = l dxi
-    const Mat26 S = shape(xi, l);
-    sBar_ += w * S;
-    sX_ += w * xi * l * S;
-    sXX_ += w * S.row(0).transpose() * S.row(0);
-    sYY_ += w * S.row(1).transpose() * S.row(1);
-    sXY_ += w * S.row(0).transpose() * S.row(1);
-  }
-  // Euler-Bernoulli stiffness (closed form): axial EA/l, bending EI/l^3 (Hermite cubics).
-  const double ea = section.axialStiffness() / l, ei = section.bendingStiffness() / (l * l * l);
-  K_.setZero();
-  K_(0, 0) = K_(3, 3) = ea;
-  K_(0, 3) = K_(3, 0) = -ea;
-  const int b[4] = {1, 2, 4, 5};
-  const double kb[4][4] = {{12, 6 * l, -12, 6 * l},
-                           {6 * l, 4 * l * l, -6 * l, 2 * l * l},
-                           {-12, -6 * l, 12, -6 * l},
-                           {6 * l, 2 * l * l, -6 * l, 4 * l * l}};
-  for (int i = 0; i < 4; ++i) {
-    for (int j = 0; j < 4; ++j) K_(b[i], b[j]) = ei * kb[i][j];
-  }
-  Kb_ = K_;
-  Kb_(0, 0) = Kb_(3, 3) = Kb_(0, 3) = Kb_(3, 0) = 0.0;
-  // Slope-shape integral G = int_0^l b^T b dx (degree 4: the 5-point rule is exact);
-  // its transverse block is the classical geometric stiffness (1/(30 l)) [36, 3l, ...].
-  G_.setZero();
-  for (size_t g = 0; g < kGaussXi.size(); ++g) {
-    const Row6 bg = slopeShape(kGaussXi[g], l);
-    G_ += (kGaussW[g] * l) * bg.transpose() * bg;
-  }
+  // the spatial element along its own x axis (element frame = its frame), restricted
+  const BeamElement3d el(Vec3::Zero(), Vec3(l_, 0.0, 0.0), Vec3::UnitY(), planarSection3d(section), owner);
+  mass_ = el.mass();
+  sBar_ = inPlane(el.sBar());
+  sX_ = inPlane(el.positionShapeIntegral(0));
+  sXX_ = inPlane(el.sKL(0, 0));
+  sYY_ = inPlane(el.sKL(1, 1));
+  sXY_ = inPlane(el.sKL(0, 1));
+  K_ = inPlane(el.stiffness());
+  G_ = inPlane(el.slopeIntegral());  // transverse block: the classical (1/(30 l)) [36, 3l, ...]
+  Mat6 Kb = K_;  // bending: the axial entries zero
+  Kb(0, 0) = Kb(3, 3) = Kb(0, 3) = Kb(3, 0) = 0.0;
+  energy_ = BeamStrainEnergy<6>(axialStrainShape(l_), G_, K_, Kb, section.axialStiffness(), l_);
 }
 
-BeamElement2d::Mat26 BeamElement2d::shape(double xi, double l) {
-  const double x2 = xi * xi, x3 = x2 * xi;
-  Mat26 S;
-  S << 1 - xi, 0, 0, xi, 0, 0,  //
-      0, 1 - 3 * x2 + 2 * x3, l * (xi - 2 * x2 + x3), 0, 3 * x2 - 2 * x3, l * (x3 - x2);
-  return S;
-}
+BeamElement2d::Mat26 BeamElement2d::shape(double xi, double l) { return inPlane(BeamElement3d::shape(xi, l)); }
 
 BeamElement2d::Row6 BeamElement2d::slopeShape(double xi, double l) {
-  Row6 r;
-  r << 0, (-6 * xi + 6 * xi * xi) / l, 1 - 4 * xi + 3 * xi * xi, 0, (6 * xi - 6 * xi * xi) / l,
-      3 * xi * xi - 2 * xi;
-  return r;
+  return inPlane(BeamElement3d::slopeShapeY(xi, l));
 }
 
 BeamElement2d::Row6 BeamElement2d::curvatureShape(double xi, double l) {
-  Row6 r;
-  r << 0, (-6 + 12 * xi) / (l * l), (-4 + 6 * xi) / l, 0, (6 - 12 * xi) / (l * l), (6 * xi - 2) / l;
-  return r;
+  return inPlane(BeamElement3d::curvatureShapeY(xi, l));
 }
 
-BeamElement2d::Row6 BeamElement2d::axialStrainShape(double l) {
-  Row6 r;
-  r << -1 / l, 0, 0, 1 / l, 0, 0;
-  return r;
-}
+BeamElement2d::Row6 BeamElement2d::axialStrainShape(double l) { return inPlane(BeamElement3d::axialStrainShape(l)); }
 
-// Membrane locking and the averaged membrane strain: Stolarski & Belytschko, "Membrane
-// locking and reduced integration for curved elements", J. Appl. Mech. 49 (1982);
-// Crisfield, Non-linear Finite Element Analysis of Solids and Structures vol. 1 (1991).
-// With a = axialStrainShape, G = int b^T b dx and d = a^T + G e / l:
+// The strain energy: BeamStrainEnergy (elements/beam_strain_energy.hpp), shared with the
+// spatial element.
 
 double BeamElement2d::membraneStrain(const Vec6& e, bool stiffening) const {
-  const double du = axialStrainShape(l_).dot(e);
-  if (!stiffening) return du;
-  return du + 0.5 * e.dot(G_ * e) / l_;  // eps_m = a e + e^T G e / (2l)
+  return energy_.membraneStrain(e, stiffening);
 }
 
-double BeamElement2d::strainEnergy(const Vec6& e, bool stiffening) const {
-  if (!stiffening) return 0.5 * e.dot(K_ * e);
-  const double eps = membraneStrain(e, true);
-  // U = EA l eps_m^2 / 2 + e^T K_b e / 2 (int EI kappa^2 / 2 dx)
-  return 0.5 * section_.axialStiffness() * l_ * eps * eps + 0.5 * e.dot(Kb_ * e);
-}
+double BeamElement2d::strainEnergy(const Vec6& e, bool stiffening) const { return energy_.energy(e, stiffening); }
 
 BeamElement2d::Vec6 BeamElement2d::strainEnergyGradient(const Vec6& e, bool stiffening) const {
-  if (!stiffening) return K_ * e;
-  const double eps = membraneStrain(e, true);
-  const Vec6 d = axialStrainShape(l_).transpose() + G_ * e / l_;  // d eps_m / de
-  // dU/de = EA l eps_m d + K_b e
-  return (section_.axialStiffness() * l_ * eps) * d + Kb_ * e;
+  return energy_.gradient(e, stiffening);
 }
 
 BeamElement2d::Mat6 BeamElement2d::strainEnergyHessian(const Vec6& e, bool stiffening) const {
-  if (!stiffening) return K_;
-  const double EA = section_.axialStiffness(), eps = membraneStrain(e, true);
-  const Vec6 d = axialStrainShape(l_).transpose() + G_ * e / l_;
-  // d2U/de2 = EA l d d^T + EA eps_m G (geometric stiffness, N = EA eps_m) + K_b
-  return (EA * l_) * d * d.transpose() + (EA * eps) * G_ + Kb_;
+  return energy_.hessian(e, stiffening);
 }
 
 Vec2 BeamElement2d::sectionForces(const Vec6& e, double xi, bool stiffening) const {

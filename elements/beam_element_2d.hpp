@@ -6,6 +6,7 @@
 
 #include "core/types.hpp"
 #include "elements/beam_section.hpp"
+#include "elements/beam_strain_energy.hpp"
 
 namespace flexmbd {
 
@@ -15,8 +16,11 @@ namespace flexmbd {
 /// constant transformation from body-frame nodal displacements (ux, uy, psi) to element
 /// coordinates is T = diag(R(beta)^T, 1, R(beta)^T, 1) (document 003, C^ij).
 ///
-/// Everything constant is computed once, at construction, by 5-point Gauss-Legendre
-/// quadrature, exact for polynomials up to degree 9 (the integrands here reach 8).
+/// Everything constant is computed once, at construction, as the x-y restriction of the
+/// spatial BeamElement3d along the element's axis (its coordinates u, v, tz; one element
+/// code for planar and spatial, issue 25): 5-point Gauss-Legendre quadrature, exact for
+/// polynomials up to degree 9 (the integrands here reach 6). The strain energy is
+/// BeamStrainEnergy, shared with the spatial element.
 class BeamElement2d {
  public:
   using Vec6 = Eigen::Matrix<double, 6, 1>;
@@ -83,8 +87,8 @@ class BeamElement2d {
   double mass_ = 0.0;
   Mat26 sBar_, sX_;
   Mat6 sXX_, sYY_, sXY_, K_;
-  Mat6 Kb_;  // bending part of K_ (axial entries zero): int EI c^T c dx
-  Mat6 G_;   // int b^T b dx
+  Mat6 G_;  // int b^T b dx
+  BeamStrainEnergy<6> energy_;
 };
 
 }  // namespace flexmbd

@@ -153,8 +153,9 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
       K_(bendZ[i], bendZ[j]) = eiy * sign[i] * sign[j] * kb[i][j];
     }
   }
-  Kb_ = K_;
-  Kb_(kU, kU) = Kb_(kU + kNode2, kU + kNode2) = Kb_(kU, kU + kNode2) = Kb_(kU + kNode2, kU) = 0.0;
+  Mat12 Kb = K_;  // bending and torsion: the axial entries zero
+  Kb(kU, kU) = Kb(kU + kNode2, kU + kNode2) = Kb(kU, kU + kNode2) = Kb(kU + kNode2, kU) = 0.0;
+  energy_ = BeamStrainEnergy<12>(axialStrainShape(l), G_, K_, Kb, section.axialStiffness(), l);
 }
 
 const BeamElement3d::Mat12& BeamElement3d::sKL(int k, int l) const {
@@ -272,38 +273,21 @@ BeamElement3d::Row12 BeamElement3d::curvatureShapeZ(double xi, double l) {
   return r;
 }
 
-// Membrane locking and the averaged membrane strain: Stolarski & Belytschko, J. Appl.
-// Mech. 49 (1982); Crisfield, Non-linear FEA of Solids and Structures vol. 1 (1991);
-// as BeamElement2d, with both bending planes. With a = axialStrainShape,
-// G = int (by^T by + bz^T bz) dx and d = a^T + G e / l:
+// The strain energy: BeamStrainEnergy (elements/beam_strain_energy.hpp), shared with the
+// planar element.
 
 double BeamElement3d::membraneStrain(const Vec12& e, bool stiffening) const {
-  const double du = axialStrainShape(l_).dot(e);
-  if (!stiffening) return du;
-  return du + 0.5 * e.dot(G_ * e) / l_;  // eps_m = a e + e^T G e / (2l)
+  return energy_.membraneStrain(e, stiffening);
 }
 
-double BeamElement3d::strainEnergy(const Vec12& e, bool stiffening) const {
-  if (!stiffening) return 0.5 * e.dot(K_ * e);  // U = e^T K e / 2
-  const double eps = membraneStrain(e, true);
-  // U = EA l eps_m^2 / 2 + e^T K_b e / 2 (bending and torsion)
-  return 0.5 * section_.axialStiffness() * l_ * eps * eps + 0.5 * e.dot(Kb_ * e);
-}
+double BeamElement3d::strainEnergy(const Vec12& e, bool stiffening) const { return energy_.energy(e, stiffening); }
 
 BeamElement3d::Vec12 BeamElement3d::strainEnergyGradient(const Vec12& e, bool stiffening) const {
-  if (!stiffening) return K_ * e;
-  const double eps = membraneStrain(e, true);
-  const Vec12 d = axialStrainShape(l_).transpose() + G_ * e / l_;  // d eps_m / de
-  // dU/de = EA l eps_m d + K_b e
-  return (section_.axialStiffness() * l_ * eps) * d + Kb_ * e;
+  return energy_.gradient(e, stiffening);
 }
 
 BeamElement3d::Mat12 BeamElement3d::strainEnergyHessian(const Vec12& e, bool stiffening) const {
-  if (!stiffening) return K_;
-  const double EA = section_.axialStiffness(), eps = membraneStrain(e, true);
-  const Vec12 d = axialStrainShape(l_).transpose() + G_ * e / l_;
-  // d2U/de2 = EA l d d^T + EA eps_m G (geometric stiffness, N = EA eps_m) + K_b
-  return (EA * l_) * d * d.transpose() + (EA * eps) * G_ + Kb_;
+  return energy_.hessian(e, stiffening);
 }
 
 BeamSectionForces3d BeamElement3d::sectionForces(const Vec12& e, double xi, bool stiffening) const {

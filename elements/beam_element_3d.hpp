@@ -9,6 +9,7 @@
 
 #include "core/types.hpp"
 #include "elements/beam_section.hpp"
+#include "elements/beam_strain_energy.hpp"
 
 namespace flexmbd {
 
@@ -197,8 +198,8 @@ class BeamElement3d {
   Mat3x12 skewXS_;
   Row12 dotXS_;
   Mat12 K_;
-  Mat12 Kb_;  // bending and torsion part of K_ (axial entries zero)
-  Mat12 G_;   // int (by^T by + bz^T bz) dx
+  Mat12 G_;  // int (by^T by + bz^T bz) dx
+  BeamStrainEnergy<12> energy_;
 };
 
 }  // namespace flexmbd
