@@ -4,7 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/errors.hpp"
 #include "integrators/elastic_modes.hpp"
+#include "integrators/linearization.hpp"
 #include "integrators/quasi_static_start.hpp"
 
 namespace flexmbd {
@@ -18,6 +20,32 @@ std::string fmt(double x) {
 }
 
 }  // namespace
+
+FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings) {
+  FastestRate r;
+  // the reduction's dense SVD of G is O(nv^3): large models are not analysed
+  if (sys.numVelocities() > kMaxStiffnessAnalysisVelocities) return r;
+  try {
+    const ConsistentState init =
+        computeConsistentState(sys, settings.tStart, sys.initialCoordinates(), sys.initialVelocities());
+    ReferenceState ref;
+    ref.t = settings.tStart;
+    ref.q = init.q, ref.v = init.v, ref.a = init.a, ref.lambda = init.lambda;
+    const ReducedSystem red = reduce(linearize(sys, ref));
+    const int nx = static_cast<int>(red.M.rows());
+    if (nx == 0 || nx > kMaxStiffnessAnalysisSize) return r;
+    ModesOptions o;
+    o.count = 2 * nx;  // all of them: the fastest is the last
+    o.solver = EigenSolverKind::Dense;
+    for (const Mode& m : computeModes(red, o)) {
+      if (m.omega > r.omega) r.omega = m.omega, r.dampingRatio = m.dampingRatio;
+    }
+    r.analysed = true;
+  } catch (const InputError&) {  // not assembled, redundant, a singular mass: no estimate
+    return FastestRate{};
+  }
+  return r;
+}
 
 double outputNyquistFrequency(const SolverSettings& settings) { return M_PI / settings.outputStep; }
 
@@ -36,7 +64,24 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
   }
   const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
   if (std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) == kinds.end()) {
+    // stiff force elements (issue 25, item 6; docs/stability.md, "Stiff force elements"):
+    // the model's fastest linearised eigenvalue at the start above the output Nyquist
+    // frequency: a stiff spring or damper, whose fast motion is not content. BDF's sharp
+    // local error estimate then lets the errors of a free (neutrally stable) motion, the
+    // phase of a free spin, add up to 100 ... 1500 times rtol (the free A05 governor);
+    // Radau IIA's stays within 60 times rtol there.
+    const FastestRate fast = fastestLinearRate(sys, settings);
+    if (fast.analysed && fast.omega > kStiffRateOverNyquist * outputNyquistFrequency(settings)) {
+      c.kind = IntegratorKind::Radau5;
+      c.reason = "no elastic coordinates, but the linearised model's fastest eigenvalue at the start, |s| = " +
+                 fmt(fast.omega) + " /s (damping ratio " + fmt(fast.dampingRatio) +
+                 "), is above the output Nyquist frequency " + fmt(outputNyquistFrequency(settings)) +
+                 " rad/s: stiff force elements, radau5 (L-stable Radau IIA; BDF's errors on a free motion grow to "
+                 "hundreds of times rtol there, docs/stability.md)";
+      return c;
+    }
     c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
+    if (fast.analysed) c.reason += " (fastest linearised eigenvalue " + fmt(fast.omega) + " /s)";
     return c;
   }
   std::vector<std::string> skipped;

@@ -34,6 +34,28 @@ struct IntegratorChoice {
   std::vector<EnergyVelocityWeight> energyWeights;
 };
 
+/// Models without elastic coordinates and with more independent coordinates than this are
+/// not analysed for stiffness (dense eigenproblem of the reduced linearised model).
+inline constexpr int kMaxStiffnessAnalysisSize = 400;
+inline constexpr int kMaxStiffnessAnalysisVelocities = 1200;  ///< nor with more velocities (dense SVD of G)
+
+/// A model without elastic coordinates goes to Radau IIA (radau5) when its fastest
+/// linearised eigenvalue |s| exceeds this times the output Nyquist frequency: a motion
+/// that fast is below what any output shows, the mark of a stiff force element (the A05
+/// governor: 8,120 /s against 314 rad/s; its soft variant, k and c / 100: ~200 /s, stays
+/// with IDA).
+inline constexpr double kStiffRateOverNyquist = 1.0;
+
+/// The fastest eigenvalue of the model linearised at its consistent start (linearize,
+/// reduce, computeModes over all modes); analysed = false if the model could not be
+/// linearised or is larger than kMaxStiffnessAnalysisSize independent coordinates.
+struct FastestRate {
+  bool analysed = false;
+  double omega = 0.0;         ///< |s| (rad/s or 1/s)
+  double dampingRatio = 0.0;  ///< -Re(s) / |s|
+};
+FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings);
+
 /// The highest natural frequency an output step resolves: the Nyquist frequency pi / dt.
 double outputNyquistFrequency(const SolverSettings& settings);
 
@@ -44,6 +66,9 @@ double outputNyquistFrequency(const SolverSettings& settings);
 /// not resolve where BDF3-5 are unstable near the imaginary axis and must resolve them,
 /// with that body's elastic velocities weighed in energy at its highest frequency (the
 /// velocity test asks no more of a mode than the position test does of the fastest one).
+/// A model without elastic coordinates: IDA, unless its fastest linearised eigenvalue at
+/// the start is above the output Nyquist frequency (fastestLinearRate: a stiff spring or
+/// damper); then radau5 (docs/stability.md, "Stiff force elements").
 /// @pre sys is finalized, settings validated.
 IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& settings);
 
