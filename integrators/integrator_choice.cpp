@@ -76,8 +76,8 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
       c.reason = "no elastic coordinates, but the linearised model's fastest eigenvalue at the start, |s| = " +
                  fmt(fast.omega) + " /s (damping ratio " + fmt(fast.dampingRatio) +
                  "), is above the output Nyquist frequency " + fmt(outputNyquistFrequency(settings)) +
-                 " rad/s: stiff force elements, radau5 (L-stable Radau IIA; BDF's errors on a free motion grow to "
-                 "hundreds of times rtol there, docs/stability.md)";
+                 " rad/s (a stiff spring or damper, or a fast spin): radau5 (L-stable Radau IIA; BDF's errors on a "
+                 "free motion grew to hundreds of times rtol on such a model, docs/stability.md)";
       return c;
     }
     c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
