@@ -37,7 +37,7 @@ struct IntegratorChoice {
 /// Models without elastic coordinates and with more independent coordinates than this are
 /// not analysed for stiffness (dense eigenproblem of the reduced linearised model).
 inline constexpr int kMaxStiffnessAnalysisSize = 400;
-inline constexpr int kMaxStiffnessAnalysisVelocities = 600;  ///< nor with more velocities (dense SVD of G)
+inline constexpr int kMaxStiffnessAnalysisVelocities = 300;  ///< nor with more velocities (dense SVD of G: +0.2 s at 300, a planar chain of 100 links; +1 s at 600)
 
 /// A model without elastic coordinates goes to Radau IIA (radau5) when its fastest
 /// linearised eigenvalue |s| exceeds this times the output Nyquist frequency: a motion
