@@ -19,6 +19,11 @@ std::string fmt(double x) {
   return os.str();
 }
 
+bool hasElasticCoordinates(const System& sys) {
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  return std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) != kinds.end();
+}
+
 }  // namespace
 
 FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings) {
@@ -49,21 +54,33 @@ FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings)
 
 double outputNyquistFrequency(const SolverSettings& settings) { return M_PI / settings.outputStep; }
 
+std::string stiffModelIdaWarning(const System& sys, const SolverSettings& settings) {
+  if (hasElasticCoordinates(sys)) return "";
+  const FastestRate fast = fastestLinearRate(sys, settings);
+  const double nyquist = outputNyquistFrequency(settings);
+  if (!fast.analysed || fast.omega <= kStiffRateOverNyquist * nyquist) return "";
+  return "ida on a stiff model: its fastest linearised eigenvalue at the start, |s| = " + fmt(fast.omega) +
+         " /s, is above the output Nyquist frequency " + fmt(nyquist) +
+         " rad/s; BDF's per-step errors can add up to hundreds of times rtol along a free motion there (the free "
+         "A05 governor: 270 to 1,500 x rtol); \"integrator\": \"auto\" takes radau5 (docs/stability.md, section 7)";
+}
+
 IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& settings) {
   IntegratorChoice c;
   if (settings.integrator != IntegratorKind::Automatic) {
     c.kind = settings.integrator;
     c.reason = "given in the settings";
+    if (c.kind == IntegratorKind::Ida) c.warning = stiffModelIdaWarning(sys, settings);
     return c;
   }
   c.kind = IntegratorKind::Ida;
   if (settings.finiteDifferenceJacobian || settings.maxOrder != 5) {
     c.reason = std::string("IDA's own option ") + (settings.finiteDifferenceJacobian ? "fd_jacobian" : "max_order") +
                " given: ida";
+    c.warning = stiffModelIdaWarning(sys, settings);
     return c;
   }
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
-  if (std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) == kinds.end()) {
+  if (!hasElasticCoordinates(sys)) {
     // stiff force elements (issue 25, item 6; docs/stability.md, "Stiff force elements"):
     // the model's fastest linearised eigenvalue at the start above the output Nyquist
     // frequency: a stiff spring or damper, whose fast motion is not content. BDF's sharp

@@ -32,6 +32,10 @@ struct IntegratorChoice {
   /// Bodies whose elastic velocities are weighed in energy (Radau IIA only; empty for a
   /// choice given in the settings).
   std::vector<EnergyVelocityWeight> energyWeights;
+  /// IDA on a stiff model without elastic coordinates (given in the settings, or kept by
+  /// IDA's own options): a warning for summary.json that its error may be hundreds of
+  /// times rtol there ("" otherwise; docs/stability.md, section 7).
+  std::string warning;
 };
 
 /// Models without elastic coordinates and with more independent coordinates than this are
@@ -55,6 +59,11 @@ struct FastestRate {
   double dampingRatio = 0.0;  ///< -Re(s) / |s|
 };
 FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings);
+
+/// The warning IntegratorChoice::warning carries when IDA runs a model without elastic
+/// coordinates whose fastest linearised eigenvalue is above the output Nyquist frequency;
+/// "" otherwise.
+std::string stiffModelIdaWarning(const System& sys, const SolverSettings& settings);
 
 /// The highest natural frequency an output step resolves: the Nyquist frequency pi / dt.
 double outputNyquistFrequency(const SolverSettings& settings);
