@@ -46,7 +46,7 @@ inline constexpr int kMaxStiffnessAnalysisVelocities = 300;  ///< nor with more 
 /// A model without elastic coordinates goes to Radau IIA (radau5) when its fastest
 /// linearised eigenvalue |s| exceeds this times the output Nyquist frequency: a motion
 /// that fast is below what any output shows, the mark of a stiff force element (the A05
-/// governor: 8,120 /s against 314 rad/s; its soft variant, k and c / 100: ~200 /s, stays
+/// governor: 8,120 /s against 314 rad/s; its soft variant, k and c / 100: 45 /s, stays
 /// with IDA).
 inline constexpr double kStiffRateOverNyquist = 1.0;
 

@@ -110,7 +110,7 @@ TEST(StiffSpatialAccuracy, AutoChoosesRadau5ForTheStiffGovernor) {
   // the overdamped sleeve-spring mode, -c / m of the 3 kg sleeve and the arms: measured
   // 8,120 /s, 26 times the output Nyquist frequency 314 rad/s (the bound: a factor 10)
   EXPECT_GT(fast.omega, 10.0 * outputNyquistFrequency(s.solver));
-  // the soft variant (k and c / 100: fastest |s| ~ 200 /s, below 314 rad/s) keeps IDA, whose
+  // the soft variant (k and c / 100: fastest |s| 45 /s, below 314 rad/s) keeps IDA, whose
   // error there was measured at 80 / 147 times rtol 1e-6 / 1e-8
   Scene soft = parseScene(freeGovernor(2.0 * M_PI, 0.01));
   EXPECT_EQ(chooseIntegrator(soft.system, soft.solver).kind, IntegratorKind::Ida);
