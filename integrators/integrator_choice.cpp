@@ -4,7 +4,9 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/errors.hpp"
 #include "integrators/elastic_modes.hpp"
+#include "integrators/linearization.hpp"
 #include "integrators/quasi_static_start.hpp"
 
 namespace flexmbd {
@@ -17,26 +19,86 @@ std::string fmt(double x) {
   return os.str();
 }
 
+bool hasElasticCoordinates(const System& sys) {
+  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
+  return std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) != kinds.end();
+}
+
 }  // namespace
 
+FastestRate fastestLinearRate(const System& sys, const SolverSettings& settings) {
+  FastestRate r;
+  // the reduction's dense SVD of G is O(nv^3): large models are not analysed
+  if (sys.numVelocities() > kMaxStiffnessAnalysisVelocities) return r;
+  try {
+    const ConsistentState init =
+        computeConsistentState(sys, settings.tStart, sys.initialCoordinates(), sys.initialVelocities());
+    ReferenceState ref;
+    ref.t = settings.tStart;
+    ref.q = init.q, ref.v = init.v, ref.a = init.a, ref.lambda = init.lambda;
+    const ReducedSystem red = reduce(linearize(sys, ref));
+    const int nx = static_cast<int>(red.M.rows());
+    if (nx == 0 || nx > kMaxStiffnessAnalysisSize) return r;
+    ModesOptions o;
+    o.count = 2 * nx;  // all of them: the fastest is the last
+    o.solver = EigenSolverKind::Dense;
+    for (const Mode& m : computeModes(red, o)) {
+      if (m.omega > r.omega) r.omega = m.omega, r.dampingRatio = m.dampingRatio;
+    }
+    r.analysed = true;
+  } catch (const InputError&) {  // not assembled, redundant, a singular mass: no estimate
+    return FastestRate{};
+  }
+  return r;
+}
+
 double outputNyquistFrequency(const SolverSettings& settings) { return M_PI / settings.outputStep; }
+
+std::string stiffModelIdaWarning(const System& sys, const SolverSettings& settings) {
+  if (hasElasticCoordinates(sys)) return "";
+  const FastestRate fast = fastestLinearRate(sys, settings);
+  const double nyquist = outputNyquistFrequency(settings);
+  if (!fast.analysed || fast.omega <= kStiffRateOverNyquist * nyquist) return "";
+  return "ida on a stiff model: its fastest linearised eigenvalue at the start, |s| = " + fmt(fast.omega) +
+         " /s, is above the output Nyquist frequency " + fmt(nyquist) +
+         " rad/s; BDF's per-step errors can add up to hundreds of times rtol along a free motion there (the free "
+         "A05 governor: 270 to 1,500 x rtol); \"integrator\": \"auto\" takes radau5 (docs/stability.md, section 7)";
+}
 
 IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& settings) {
   IntegratorChoice c;
   if (settings.integrator != IntegratorKind::Automatic) {
     c.kind = settings.integrator;
     c.reason = "given in the settings";
+    if (c.kind == IntegratorKind::Ida) c.warning = stiffModelIdaWarning(sys, settings);
     return c;
   }
   c.kind = IntegratorKind::Ida;
   if (settings.finiteDifferenceJacobian || settings.maxOrder != 5) {
     c.reason = std::string("IDA's own option ") + (settings.finiteDifferenceJacobian ? "fd_jacobian" : "max_order") +
                " given: ida";
+    c.warning = stiffModelIdaWarning(sys, settings);
     return c;
   }
-  const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
-  if (std::find(kinds.begin(), kinds.end(), CoordinateKind::Elastic) == kinds.end()) {
+  if (!hasElasticCoordinates(sys)) {
+    // stiff force elements (issue 25, item 6; docs/stability.md, "Stiff force elements"):
+    // the model's fastest linearised eigenvalue at the start above the output Nyquist
+    // frequency: a stiff spring or damper, whose fast motion is not content. BDF's sharp
+    // local error estimate then lets the errors of a free (neutrally stable) motion, the
+    // phase of a free spin, add up to 100 ... 1500 times rtol (the free A05 governor);
+    // Radau IIA's stays within 60 times rtol there.
+    const FastestRate fast = fastestLinearRate(sys, settings);
+    if (fast.analysed && fast.omega > kStiffRateOverNyquist * outputNyquistFrequency(settings)) {
+      c.kind = IntegratorKind::Radau5;
+      c.reason = "no elastic coordinates, but the linearised model's fastest eigenvalue at the start, |s| = " +
+                 fmt(fast.omega) + " /s (damping ratio " + fmt(fast.dampingRatio) +
+                 "), is above the output Nyquist frequency " + fmt(outputNyquistFrequency(settings)) +
+                 " rad/s (a stiff spring or damper, or a fast spin): radau5 (L-stable Radau IIA; BDF's errors on a "
+                 "free motion grew to hundreds of times rtol on such a model, docs/stability.md)";
+      return c;
+    }
     c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
+    if (fast.analysed) c.reason += " (fastest linearised eigenvalue " + fmt(fast.omega) + " /s)";
     return c;
   }
   std::vector<std::string> skipped;

@@ -168,6 +168,7 @@ ChosenIntegrator chooseIntegratorOptions(const System& sys, const DaeSystem& dae
   const IntegratorChoice picked = chooseIntegrator(sys, settings);
   choice.kind = picked.kind;
   choice.reason = picked.reason;
+  choice.warning = picked.warning;
   choice.scales = scales ? *scales : modelScales(sys, settings);
   choice.tolerances = classTolerances(settings, choice.scales);
   IntegratorOptions& o = choice.options;

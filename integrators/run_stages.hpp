@@ -68,6 +68,7 @@ struct ChosenIntegrator {
   std::string reason;  ///< why this integrator (one line)
   IntegratorOptions options;
   std::string orderLimit;  ///< why options.maxOrder is below settings.maxOrder ("" if it is not)
+  std::string warning;     ///< IntegratorChoice::warning: for summary.json's warnings ("" if none)
   ModelScales scales;          ///< the model's sizes the default class tolerances follow
   ClassTolerances tolerances;  ///< the absolute tolerances by coordinate class (options.atol)
 };

@@ -191,6 +191,7 @@ SimulationSummary simulate(const System& sys, const SolverSettings& settings,
   for (const int r : dae.releasedEquations()) summary.redundantConstraints.push_back(sys.describeEquation(r));
   summary.modalParticipation = participation.result();
   for (const std::string& w : participation.warnings()) summary.warnings.push_back(w);
+  if (!choice.warning.empty()) summary.warnings.push_back(choice.warning);
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
   return summary;
 }
