@@ -120,28 +120,24 @@ FfrBeamModel3d::FfrBeamModel3d(BeamMesh3d mesh, const FfrBeamOptions3d& options,
       for (int a = 0; a < 3; ++a) xs += C(k, a) * el.positionShapeIntegral(a);
       ps[k] = s[k] * sb + C * xs * T;
     }
-    // S_kl = int rho N_k^T N_l dV = T^T (sum_ab C(k, a) C(l, b) S_ab^e) T
-    std::array<BeamElement3d::Mat12, 9> skl;
-    for (int k = 0; k < 3; ++k) {
-      for (int l = 0; l < 3; ++l) {
-        BeamElement3d::Mat12 acc = BeamElement3d::Mat12::Zero();
-        for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) acc += (C(k, a) * C(l, b)) * el.sKL(a, b);
+    // a tensor of element matrices in body axes: X_kl = T^T (sum_ab C(k, a) C(l, b) X_ab^e) T
+    const auto toBody = [&](auto elementMatrix) {
+      std::array<BeamElement3d::Mat12, 9> out;
+      for (int k = 0; k < 3; ++k) {
+        for (int l = 0; l < 3; ++l) {
+          BeamElement3d::Mat12 acc = BeamElement3d::Mat12::Zero();
+          for (int a = 0; a < 3; ++a) {
+            for (int b = 0; b < 3; ++b) acc += (C(k, a) * C(l, b)) * elementMatrix(a, b);
+          }
+          out[3 * k + l] = T.transpose() * acc * T;
         }
-        skl[3 * k + l] = T.transpose() * acc * T;
       }
-    }
-    // R_kl likewise (int rho u2 dV = 0 over each section: no terms from the start s)
-    std::array<BeamElement3d::Mat12, 9> rkl;
-    for (int k = 0; k < 3; ++k) {
-      for (int l = 0; l < 3; ++l) {
-        BeamElement3d::Mat12 acc = BeamElement3d::Mat12::Zero();
-        for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) acc += (C(k, a) * C(l, b)) * el.sectionRotationMoment(a, b);
-        }
-        rkl[3 * k + l] = T.transpose() * acc * T;
-      }
-    }
+      return out;
+    };
+    // S_kl = int rho N_k^T N_l dV; R_kl likewise (int rho u2 dV = 0 over each section: no
+    // terms from the start s)
+    const auto skl = toBody([&](int a, int b) -> const BeamElement3d::Mat12& { return el.sKL(a, b); });
+    const auto rkl = toBody([&](int a, int b) -> const BeamElement3d::Mat12& { return el.sectionRotationMoment(a, b); });
     // H_i: int rho u0 x u2 dV = C int rho x0 x u2 dV (+ s x int rho u2 dV = 0): a vector
     std::array<BeamElement3d::Mat12, 3> hi;
     for (int i = 0; i < 3; ++i) {

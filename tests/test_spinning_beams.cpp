@@ -79,12 +79,10 @@ VecX twistWeights(const FfrBeamModel3d& m) {
   return w;
 }
 
-/// The torsional frequencies (rad/s, ascending) of the body's elastic equations
-/// m_ff q'' = Q_f(q, q') linearised about q_f = 0 with its frame spinning at `w` (body
-/// axes) and held (R'' = 0, w' = 0), as in test_ffr_spatial_validation. A mode is
-/// torsional when its twist coordinates hold more than 99% of its norm; a divergent one
-/// (real pair) reports -rate.
-std::vector<double> torsionalFrequencies(const FfrBody3d& body, const VecX& twist, const Vec3& w) {
+/// The eigen-decomposition of the body's elastic equations m_ff q'' = Q_f(q, q')
+/// linearised about q_f = 0 with its frame spinning at `w` (body axes) and held
+/// (R'' = 0, w' = 0), first-order form [q; q'].
+Eigen::EigenSolver<MatX> spinningLinearisation(const FfrBody3d& body, const Vec3& w) {
   const int nf = body.numElastic(), nq = 7 + nf, nv = 6 + nf;
   VecX q = body.initialCoordinates(), v = VecX::Zero(nv);
   v.segment<3>(3) = w;
@@ -95,7 +93,15 @@ std::vector<double> torsionalFrequencies(const FfrBody3d& body, const VecX& twis
   A.topRightCorner(nf, nf).setIdentity();
   A.bottomLeftCorner(nf, nf) = Minv * dQdq.block(6, 7, nf, nf);
   A.bottomRightCorner(nf, nf) = Minv * dQdv.block(6, 6, nf, nf);
-  const Eigen::EigenSolver<MatX> es(A);
+  return Eigen::EigenSolver<MatX>(A);
+}
+
+/// The torsional frequencies (rad/s, ascending) at spin `w` (spinningLinearisation): a
+/// mode is torsional when its twist coordinates hold more than 99% of its norm; a
+/// divergent one (real pair) reports -rate.
+std::vector<double> torsionalFrequencies(const FfrBody3d& body, const VecX& twist, const Vec3& w) {
+  const int nf = body.numElastic();
+  const Eigen::EigenSolver<MatX> es = spinningLinearisation(body, w);
   std::vector<double> out;
   for (int k = 0; k < 2 * nf; ++k) {
     const std::complex<double> lam = es.eigenvalues()[k];
@@ -312,18 +318,8 @@ namespace {
 /// Omega about x (positive imaginary parts of the linearised m_ff q'' = Q_f; bending: less
 /// than 1% of the mode in twist and axial coordinates).
 std::vector<double> bendingFrequencies(const FfrBody3d& body, const FfrBeamModel3d& m, double Omega) {
-  const int nf = body.numElastic(), nq = 7 + nf, nv = 6 + nf;
-  const VecX q = body.initialCoordinates();
-  VecX v = VecX::Zero(nv);
-  v[3] = Omega;
-  MatX dQdq = MatX::Zero(nv, nq), dQdv = MatX::Zero(nv, nv);
-  body.addInternalForceJacobians(q, v, dQdq, dQdv);
-  const MatX Minv = MatX(body.invariants().mff).inverse();
-  MatX A = MatX::Zero(2 * nf, 2 * nf);
-  A.topRightCorner(nf, nf).setIdentity();
-  A.bottomLeftCorner(nf, nf) = Minv * dQdq.block(6, 7, nf, nf);
-  A.bottomRightCorner(nf, nf) = Minv * dQdv.block(6, 6, nf, nf);
-  const Eigen::EigenSolver<MatX> es(A);
+  const int nf = body.numElastic();
+  const Eigen::EigenSolver<MatX> es = spinningLinearisation(body, Vec3(Omega, 0.0, 0.0));
   const MatX B(m.basis());
   const int nn = static_cast<int>(m.mesh().nodes.size());
   std::vector<double> out;
