@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "integrators/elastic_modes.hpp"
 #include "integrators/linearization.hpp"
 #include "integrators/quasi_static_start.hpp"
@@ -12,12 +12,8 @@
 namespace flexmbd {
 namespace {
 
-std::string fmt(double x) {
-  std::ostringstream os;
-  os.precision(3);
-  os << x;
-  return os.str();
-}
+/// Figures in the choice's reason: three significant digits.
+std::string fig(double x) { return fmt(x, 3); }
 
 bool hasElasticCoordinates(const System& sys) {
   const std::vector<CoordinateKind> kinds = sys.coordinateKinds();
@@ -59,8 +55,8 @@ std::string stiffModelIdaWarning(const System& sys, const SolverSettings& settin
   const FastestRate fast = fastestLinearRate(sys, settings);
   const double nyquist = outputNyquistFrequency(settings);
   if (!fast.analysed || fast.omega <= kStiffRateOverNyquist * nyquist) return "";
-  return "ida on a stiff model: its fastest linearised eigenvalue at the start, |s| = " + fmt(fast.omega) +
-         " /s, is above the output Nyquist frequency " + fmt(nyquist) +
+  return "ida on a stiff model: its fastest linearised eigenvalue at the start, |s| = " + fig(fast.omega) +
+         " /s, is above the output Nyquist frequency " + fig(nyquist) +
          " rad/s; BDF's per-step errors can add up to hundreds of times rtol along a free motion there (the free "
          "A05 governor: 270 to 1,500 x rtol); \"integrator\": \"auto\" takes radau5 (docs/stability.md, section 7)";
 }
@@ -91,14 +87,14 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
     if (fast.analysed && fast.omega > kStiffRateOverNyquist * outputNyquistFrequency(settings)) {
       c.kind = IntegratorKind::Radau5;
       c.reason = "no elastic coordinates, but the linearised model's fastest eigenvalue at the start, |s| = " +
-                 fmt(fast.omega) + " /s (damping ratio " + fmt(fast.dampingRatio) +
-                 "), is above the output Nyquist frequency " + fmt(outputNyquistFrequency(settings)) +
+                 fig(fast.omega) + " /s (damping ratio " + fig(fast.dampingRatio) +
+                 "), is above the output Nyquist frequency " + fig(outputNyquistFrequency(settings)) +
                  " rad/s (a stiff spring or damper, or a fast spin): radau5 (L-stable Radau IIA; BDF's errors on a "
                  "free motion grew to hundreds of times rtol on such a model, docs/stability.md)";
       return c;
     }
     c.reason = "no elastic coordinates: ida (variable-order BDF) on the smooth rigid motion";
-    if (fast.analysed) c.reason += " (fastest linearised eigenvalue " + fmt(fast.omega) + " /s)";
+    if (fast.analysed) c.reason += " (fastest linearised eigenvalue " + fig(fast.omega) + " /s)";
     return c;
   }
   std::vector<std::string> skipped;
@@ -123,21 +119,21 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
       // the model keeps modes faster than its outputs: each is content, to be resolved
       // over many periods, where the high orders take the longest steps
       c.kind = IntegratorKind::Radau;
-      c.reason = "elastic modes up to " + fmt(topModal) + " rad/s, above the output Nyquist frequency " +
-                 fmt(nyquist) +
+      c.reason = "elastic modes up to " + fig(topModal) + " rad/s, above the output Nyquist frequency " +
+                 fig(nyquist) +
                  " rad/s and kept by the model (each one is content, resolved over many periods): radau "
                  "(Radau IIA, orders 5 to 13)";
     } else {
-      c.reason = "elastic modes up to " + fmt(topModal) + " rad/s, below the output Nyquist frequency " +
-                 fmt(nyquist) + " rad/s: ida (variable-order BDF)";
+      c.reason = "elastic modes up to " + fig(topModal) + " rad/s, below the output Nyquist frequency " +
+                 fig(nyquist) + " rad/s: ida (variable-order BDF)";
     }
     return c;
   }
   // order 5: the mesh modes are damped, not resolved, and the higher orders' costlier
   // steps do not pay there (demo rod: radau 2,706 steps and 1.3 times radau5's CPU)
   c.kind = IntegratorKind::Radau5;
-  c.reason = "nodal body '" + fastest->name + "' has elastic modes up to " + fmt(fastest->omega[fastest->size() - 1]) +
-             " rad/s, above the output Nyquist frequency " + fmt(nyquist) +
+  c.reason = "nodal body '" + fastest->name + "' has elastic modes up to " + fig(fastest->omega[fastest->size() - 1]) +
+             " rad/s, above the output Nyquist frequency " + fig(nyquist) +
              " rad/s: radau5 (L-stable: damps the mesh modes it does not resolve), elastic velocity errors weighed "
              "in energy (atol of q_f' = omega_max x atol of q_f)";
   return c;
@@ -158,9 +154,9 @@ ConsistentState elasticStartState(const System& sys, const SolverSettings& setti
   if (settings.elasticStart != ElasticStart::QuasiStatic) return init;
   const double cutoff = settings.quasiStaticAbove.value_or(outputNyquistFrequency(settings));
   const QuasiStaticStart qs = quasiStaticElasticStart(sys, settings.tStart, init, elasticModes(sys), cutoff);
-  report = "quasi-static: " + std::to_string(qs.modes) + " elastic modes above " + fmt(cutoff) +
+  report = "quasi-static: " + std::to_string(qs.modes) + " elastic modes above " + fig(cutoff) +
            " rad/s started at their quasi-static deflection and rate (" + std::to_string(qs.iterations) +
-           " iterations, remaining modal acceleration / omega^2 " + fmt(qs.residual) + ")";
+           " iterations, remaining modal acceleration / omega^2 " + fig(qs.residual) + ")";
   return qs.state;
 }
 

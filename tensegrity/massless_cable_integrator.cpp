@@ -5,21 +5,17 @@
 #include <cmath>
 #include <ctime>
 #include <optional>
-#include <sstream>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "tensegrity/member_contact_detector.hpp"
 
 namespace flexmbd {
 
 namespace {
 
-std::string num(double x) {
-  std::ostringstream os;
-  os.precision(6);
-  os << x;
-  return os.str();
-}
+/// Figures in messages: six significant digits (core/number_text.hpp).
+std::string num(double x) { return fmt(x, 6); }
 
 /// y = [u_free, v_free]; y' = [v_free, M^-1 (f - g)].
 class TensegrityOde : public OdeSystem {
