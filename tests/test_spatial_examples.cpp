@@ -161,6 +161,26 @@ TEST(SpatialExample, HeavyTopKeepsItsIntegralsAndTheExactSteadyPrecession) {
 
 // ----- spinning blade: Campbell diagram -------------------------------------------------
 
+namespace {
+
+/// The rows of a campbell.csv (speed, f1_hz, f2_hz, ..., zeta...), header checked.
+std::vector<std::vector<double>> readCampbell(const fs::path& file) {
+  std::ifstream in(file);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line.rfind("speed,f1_hz,f2_hz,f3_hz", 0), 0u) << line;
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::istringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
 TEST_F(Cli, SpatialExampleSpinningBladeFollowsSouthwellAndThePropellerMoment) {
   // `flexmbd modes examples/spinning_blade.json --steady --sweep motor:0:40:5`: the blade
   // linearised about its steady stretched state at 0, 10, ..., 40 rad/s.
@@ -175,17 +195,7 @@ TEST_F(Cli, SpatialExampleSpinningBladeFollowsSouthwellAndThePropellerMoment) {
                           " --count 3 --steady --sweep motor:0:40:5 --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(out / "campbell.png"));
-  std::ifstream in(out / "campbell.csv");
-  std::string line;
-  std::getline(in, line);
-  ASSERT_EQ(line.rfind("speed,f1_hz,f2_hz,f3_hz", 0), 0u) << line;
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::istringstream ls(line);
-    for (std::string cell; std::getline(ls, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
+  const std::vector<std::vector<double>> rows = readCampbell(out / "campbell.csv");
   ASSERT_EQ(rows.size(), 5u);
   // Which column is which: at rest the first is the clamped-free torsion mode
   // (pi / 2L) sqrt(G J / rho Ip), the second the first flap mode 3.5160 / L^2 sqrt(E Iy /
@@ -221,6 +231,77 @@ TEST_F(Cli, SpatialExampleSpinningBladeFollowsSouthwellAndThePropellerMoment) {
     if (k == 1) EXPECT_NEAR(K, 1.1933, kSouthwellSmall);
     EXPECT_NEAR(K, 1.19, kSouthwellRange) << Om;
     EXPECT_NEAR(c, propeller, kPropeller) << Om;
+  }
+}
+
+// ----- Rayleigh rotor: forward and backward whirl -----------------------------------------
+
+TEST_F(Cli, SpatialExampleRayleighRotorWhirlsForwardAndBackwardAndKeepsItsTorsion) {
+  // `flexmbd modes examples/rayleigh_rotor.json --sweep motor:0:600:4 --count 5`, and the
+  // same scene with "beam_theory": "euler_bernoulli". The body frame turns with the shaft,
+  // so an axisymmetric rotor's whirl at omega_F (forward) and omega_B (backward) in the
+  // fixed frame is seen at omega_F - Omega and omega_B + Omega (f1, f2 of the first
+  // bending pair): the gyroscopic split is s = omega_F - omega_B = 2 Omega - (w2 - w1).
+  // Facts: (1) Euler-Bernoulli (no rotary inertia, no gyroscopic moment): s = 0; (2)
+  // Rayleigh: s > 0 and, to first order in Omega, s / Omega = Ip Q / (A + I Q) with
+  // Q = int phi'^2 dx / int phi^2 dx of the non-rotating mode phi (the gyroscopic term's
+  // Rayleigh quotient; for a sine mode Q = k^2, the simply supported closed form of Genta,
+  // Dynamics of Rotating Systems, sec. 4.9): here phi is the clamped-pinned mode
+  // cosh bx - cos bx - sigma (sinh bx - sin bx), bL = 3.9266023; (3) the torsion mode (f5)
+  // does not move with the spin (the sections' second-order rotation).
+  //  - kNoSplit 1e-6 rad/s per rad/s of spin: the CSV's 12 digits on ~200 Hz and the
+  //    eigensolver's round-off (1e-9 relative) against s ~ 0.004 Omega.
+  //  - kLinear 2e-2: s / Omega varies with Omega only through the gyroscopic coupling to the
+  //    higher modes (second order in Omega rho Ip k^2 / (m omega): ~1e-3 here); 2e-2 with margin.
+  //  - kTorsion 1e-9: the torsion frequency at each speed is the same eigenvalue of the same
+  //    matrices (the spin terms cancel exactly in the twist block): CSV digits.
+  //  - kRatio 1e-3 against the Rayleigh quotient: the 8-element mode's error (~1e-5), the
+  //    second-order coupling above, the quotient's midpoint quadrature (4000 points, ~1e-7).
+  constexpr double kNoSplit = 1e-6, kLinear = 2e-2, kTorsion = 1e-9, kRatio = 1e-3;
+  const json j = exampleJson("rayleigh_rotor.json");
+  ASSERT_EQ(j["bodies"][0]["beam_theory"], "rayleigh");
+  json eb = j;
+  eb["bodies"][0]["beam_theory"] = "euler_bernoulli";
+  const fs::path ebScene = dir_ / "rotor_eb.json";
+  std::ofstream(ebScene) << eb.dump(1);
+  const std::string rayScene = std::string(FLEXMBD_SOURCE_DIR) + "/examples/rayleigh_rotor.json";
+  auto sweep = [&](const std::string& scene, const std::string& name) {
+    const fs::path out = dir_ / name;
+    const CliResult r = run("modes " + shellQuote(scene) + " --out " + shellQuote(out.string()) +
+                            " --count 5 --sweep motor:0:600:4 --quiet");
+    EXPECT_EQ(r.status, 0) << r.err;
+    return readCampbell(out / "campbell.csv");
+  };
+  const auto ray = sweep(rayScene, "rayleigh"), ebr = sweep(ebScene.string(), "euler_bernoulli");
+  ASSERT_EQ(ray.size(), 4u);
+  ASSERT_EQ(ebr.size(), 4u);
+  const json& sec = j["bodies"][0]["section"];
+  const double A = sec["area"], I = sec["inertia_z"], Ip = I + sec["inertia_y"].get<double>();
+  const double L = j["bodies"][0]["beam"]["length"], b = 3.9266023 / L;
+  const double sigma = (std::cosh(b * L) - std::cos(b * L)) / (std::sinh(b * L) - std::sin(b * L));
+  double phi2 = 0, dphi2 = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const double x = (i + 0.5) * L / 4000;
+    const double phi = std::cosh(b * x) - std::cos(b * x) - sigma * (std::sinh(b * x) - std::sin(b * x));
+    const double dphi = b * (std::sinh(b * x) + std::sin(b * x) - sigma * (std::cosh(b * x) - std::cos(b * x)));
+    phi2 += phi * phi;
+    dphi2 += dphi * dphi;
+  }
+  const double Q = dphi2 / phi2, continuum = Ip * Q / (A + I * Q);
+  double first = 0;
+  for (std::size_t n = 1; n < ray.size(); ++n) {
+    const double Om = ray[n][0];
+    const double s = 2 * Om - 2 * M_PI * (ray[n][2] - ray[n][1]);
+    const double sEb = 2 * Om - 2 * M_PI * (ebr[n][2] - ebr[n][1]);
+    std::printf("[ figures ] Rayleigh rotor at %3.0f rad/s: whirl %.6f / %.6f Hz (rotating frame), split %.6f rad/s, "
+                "s / Omega %.7f (Rayleigh quotient %.7f); Euler-Bernoulli split %.2e; torsion %.9f Hz\n",
+                Om, ray[n][1], ray[n][2], s, s / Om, continuum, sEb, ray[n][5]);
+    if (n == 1) first = s / Om;
+    EXPECT_GT(s, 0.0);
+    EXPECT_NEAR(s / Om, first, kLinear * first) << Om;
+    EXPECT_NEAR(s / Om, continuum, kRatio * continuum) << Om;
+    EXPECT_LT(std::abs(sEb), kNoSplit * Om) << Om;
+    EXPECT_NEAR(ray[n][5] / ray[0][5], 1.0, kTorsion) << Om;
   }
 }
 
