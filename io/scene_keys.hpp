@@ -77,7 +77,9 @@ inline const Keys kInvariantsBody3d = {"name",        "type",       "position", 
 inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_bar", "position_shape_x",
                                    "position_shape_y", "position_shape_z", "s_xx", "s_xy", "s_xz",
                                    "s_yy",  "s_yz",         "s_zz",          "m_ff",  "k_ff",
-                                   "d_ff",  "points"};
+                                   "d_ff",  "points",       "r_xx",          "r_xy",  "r_xz",
+                                   "r_yy",  "r_yz",         "r_zz",          "h_x",   "h_y",
+                                   "h_z"};
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames", "world"};

@@ -250,6 +250,19 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
       if (l != k) inv.sKL[l][k] = SpMat(inv.sKL[k][l].transpose());  // S_lk = S_kl^T
     }
   }
+  // optional: the sections' second-order rotation (absent: none, the first-order field)
+  static const char* const kRkl[3][3] = {{"r_xx", "r_xy", "r_xz"}, {nullptr, "r_yy", "r_yz"}, {nullptr, nullptr, "r_zz"}};
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      if (!iv.has(kRkl[k][l])) continue;
+      inv.rKL[k][l] = sizedMatrix(iv, kRkl[k][l], nf, nf, nf).sparseView(1.0, 0.0);
+      if (l != k) inv.rKL[l][k] = inv.rKL[k][l];  // R_lk = R_kl
+    }
+  }
+  static const char* const kH[3] = {"h_x", "h_y", "h_z"};
+  for (int i = 0; i < 3; ++i) {
+    if (iv.has(kH[i])) inv.hI[i] = sizedMatrix(iv, kH[i], nf, nf, nf).sparseView(1.0, 0.0);
+  }
   inv.kff = sizedMatrix(iv, "k_ff", nf, nf, nf).sparseView(1.0, 0.0);
   inv.dff = (iv.has("d_ff") ? sizedMatrix(iv, "d_ff", nf, nf, nf) : MatX::Zero(nf, nf)).sparseView(1.0, 0.0);
   const json& pts = iv.array("points");

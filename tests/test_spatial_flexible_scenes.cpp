@@ -68,6 +68,12 @@ json invariantsJson(const FfrInvariants3d& inv) {
     j[std::string("position_shape_") + axis[k]] = matrixJson(inv.positionShape[k]);
     for (int l = k; l < 3; ++l) j[std::string("s_") + axis[k] + axis[l]] = matrixJson(MatX(inv.sKL[k][l]));
   }
+  for (int k = 0; k < 3; ++k) {  // optional: the sections' second-order rotation
+    for (int l = k; l < 3; ++l) {
+      if (inv.rKL[k][l].size() != 0) j[std::string("r_") + axis[k] + axis[l]] = matrixJson(MatX(inv.rKL[k][l]));
+    }
+    if (inv.hI[k].size() != 0) j[std::string("h_") + axis[k]] = matrixJson(MatX(inv.hI[k]));
+  }
   j["k_ff"] = matrixJson(MatX(inv.kff));
   j["d_ff"] = matrixJson(MatX(inv.dff));
   json pts = json::array();
@@ -133,7 +139,13 @@ TEST(SpatialFlexibleScene, GivenInvariantsReproduceTheBeamMeshBody) {
   // (17 significant digits) run the same motion: the bodies differ only in the order of
   // summation of K_ff q_f, so the two runs agree to the integrator's round-off
   // amplification; bound 1e-9 of the coordinates' scale (the runs take the same steps).
-  Scene mesh = parseScene(pendulumScene());
+  // Euler-Bernoulli and Rayleigh: the optional r_kl and h_i keys carry the sections'
+  // second-order rotation.
+  for (const char* theory : {"euler_bernoulli", "rayleigh"}) {
+  SCOPED_TRACE(theory);
+  json meshScene = pendulumScene();
+  meshScene["bodies"][0]["beam_theory"] = theory;
+  Scene mesh = parseScene(meshScene);
   json j = pendulumScene();
   json& b = j["bodies"][0];
   const FfrInvariants3d& inv = flexBody(mesh).invariants();
@@ -154,7 +166,9 @@ TEST(SpatialFlexibleScene, GivenInvariantsReproduceTheBeamMeshBody) {
   // the motion is not trivial: the frame turned and the beam bent
   EXPECT_GT((a.back() - a.front()).segment(4, 4).norm(), 1e-2);
   EXPECT_GT(a.back().tail(24).cwiseAbs().maxCoeff(), 1e-7);
-  std::printf("[ figures ] given invariants vs beam mesh, %zu rows: largest difference %.2e\n", a.size(), worst);
+  std::printf("[ figures ] given invariants vs beam mesh (%s), %zu rows: largest difference %.2e\n", theory,
+              a.size(), worst);
+  }
 }
 
 TEST(SpatialFlexibleScene, DeflectionOutputMatchesTheCantileverStatics) {
@@ -231,6 +245,9 @@ TEST(SpatialFlexibleScene, BadInputNamesTheBodyAndTheKey) {
                    {"invariants", "s_xy", "24 x 24", "got 1 x 1"});
   expectInputError([&] { parseScene(given([](json& i) { i["s_yy"][0][1] = 5.0; })); }, {"beam", "s_yy", "symmetric"});
   expectInputError([&] { parseScene(given([](json& i) { i.erase("position_shape_y"); })); }, {"position_shape_y"});
+  expectInputError([&] { parseScene(given([](json& i) { i["r_xy"] = json::array({json::array({1.0})}); })); },
+                   {"invariants", "r_xy", "24 x 24", "got 1 x 1"});
+  expectInputError([&] { parseScene(given([](json& i) { i["h_z"] = i["s_xy"]; })); }, {"beam", "h_z", "symmetric"});
   expectInputError([&] { parseScene(given([](json& i) { i["points"][0]["rotation_shape"] = json::array(); })); },
                    {"points[0]", "rotation_shape"});
 }
