@@ -53,6 +53,9 @@ class FfrBody3d final : public Body {
             VecX qf0 = {}, VecX qf0dot = {});
 
   const FfrInvariants3d& invariants() const { return inv_; }
+  /// m_ff, K_ff, D_ff: the modal analysis of the integrator choice, the elastic tolerances
+  /// and the BDF stability check use them as for planar bodies.
+  ElasticMatrices elasticMatrices() const override { return {&inv_.mff, &inv_.kff, &inv_.dff}; }
   /// The generating beam model, or null (invariants given directly).
   const FfrBeamModel3d* model() const { return model_.get(); }
   int numElastic() const { return nf_; }
