@@ -113,8 +113,8 @@ IntegratorChoice chooseIntegrator(const System& sys, const SolverSettings& setti
   }
   if (!fastest) {
     if (modes.empty()) {
-      c.reason = "elastic bodies without a modal analysis (spatial, or above " + std::to_string(kMaxElasticModesSize) +
-                 " elastic coordinates): ida";
+      c.reason = "elastic bodies without a modal analysis (above " + std::to_string(kMaxElasticModesSize) +
+                 " elastic coordinates each): ida";
     } else if (topModal > nyquist) {
       // the model keeps modes faster than its outputs: each is content, to be resolved
       // over many periods, where the high orders take the longest steps
