@@ -11,6 +11,7 @@
 #include "bodies/shape_inertia.hpp"
 #include "io/beam_model_reader.hpp"
 #include "builders/planar_builders.hpp"
+#include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
@@ -473,7 +474,8 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
     r.allowOnly(scenekeys::kRotationalSpringDamper, forA);
     const std::string name = r.name("name");
     const std::string jointName = r.name("joint");
-    const SpatialJoint& joint = spatialJoint(sys, lookupJoint(sys, jointName, r), r);
+    const ConstraintIndex jointIndex = lookupJoint(sys, jointName, r);
+    const SpatialJoint& joint = spatialJoint(sys, jointIndex, r);
     if (joint.type() != SpatialJointType::Revolute && joint.type() != SpatialJointType::Cylindrical) {
       r.fail("a rotational_spring_damper needs a revolute or cylindrical joint, but joint " + inQuotes(jointName) +
              " is " + joint.typeName());
@@ -486,16 +488,7 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
       freeAngle = r.number("free_angle");
     } else {
       // the joint angle in the initial positions
-      freeAngle = located(r.where(), [&] {
-        const VecX qi = sys.body(bi).initialCoordinates(), qj = sys.body(bj).initialCoordinates();
-        BodyStates states;
-        states.add(sys.body(bi), qi.data(), nullptr);
-        states.add(sys.body(bj), qj.data(), nullptr);
-        KinematicsWork w;
-        double theta = 0.0;
-        evaluateJointAngle(states, joint.frameI(), joint.frameJ(), w, theta, w.row7, nullptr);
-        return theta;
-      });
+      freeAngle = located(r.where(), [&] { return initialJointAngle(sys, jointIndex); });
     }
     located(r.where(), [&] {
       return sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(name, bi, joint.frameI(), bj, joint.frameJ(),
