@@ -419,13 +419,9 @@ FfrPoint3d FfrBeamModel3d::materialPoint(int e, double xi) const {
   p.position = el.start() + C * Vec3(xi * l, 0.0, 0.0);
   p.shape = Mat3X::Zero(3, numElastic());
   p.rotationShape = Mat3X::Zero(3, numElastic());
-  // section rotation in element axes: (tx, ty, tz) = (twist, -dw_z/dx, dw_y/dx)
-  BeamElement3d::Mat3x12 rot;
-  rot.row(0) = BeamElement3d::twistShape(xi);
-  rot.row(1) = -BeamElement3d::slopeShapeZ(xi, l);
-  rot.row(2) = BeamElement3d::slopeShapeY(xi, l);
-  const Mat3X shape = C * BeamElement3d::shape(xi, l) * TB;
-  const Mat3X rotation = C * rot * TB;
+  // section rotation in element axes: (tx, ty, tz) (Euler-Bernoulli: twist, -dw_z/dx, dw_y/dx)
+  const Mat3X shape = C * BeamElement3d::shape(xi, l, el.shear()) * TB;
+  const Mat3X rotation = C * BeamElement3d::rotationShape(xi, l, el.shear()) * TB;
   for (size_t k = 0; k < eb.cols.size(); ++k) {
     p.shape.col(eb.cols[k]) = shape.col(k);
     p.rotationShape.col(eb.cols[k]) = rotation.col(k);

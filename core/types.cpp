@@ -21,4 +21,13 @@ void requirePositive(double x, const std::string& what) {
   }
 }
 
+void requireNonNegative(double x, const std::string& what) {
+  requireFinite(x, what);
+  if (!(x >= 0.0)) {
+    std::ostringstream os;
+    os << what << " must be >= 0, got " << x;
+    throw InputError(os.str());
+  }
+}
+
 }  // namespace flexmbd

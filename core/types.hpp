@@ -59,5 +59,7 @@ inline constexpr BodyIndex kGround{0};
 void requireFinite(double x, const std::string& what);
 /// Throws InputError naming `what` unless x > 0 and finite.
 void requirePositive(double x, const std::string& what);
+/// Throws InputError naming `what` unless x >= 0 and finite.
+void requireNonNegative(double x, const std::string& what);
 
 }  // namespace flexmbd

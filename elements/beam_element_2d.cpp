@@ -35,26 +35,37 @@ BeamElement2d::Mat26 inPlane(const BeamElement3d::Mat3x12& A) {
   return B;
 }
 
-/// The spatial section of a planar one: Iz = I for the x-y plane; the out-of-plane
-/// properties (Iy, J, G) only enter coordinates the planar element drops, so any valid
-/// values do (Iy = J = I, G = E / 2).
+/// The spatial section of a planar one: Iz = I for the x-y plane, G and kappa_y its
+/// shear (Timoshenko); the out-of-plane properties (Iy, J, kappa_z) only enter
+/// coordinates the planar element drops, so any valid values do (Iy = J = I, kappa_z = 1,
+/// G = E / 2 where not given).
 BeamSection3d planarSection3d(const BeamSection& s) {
   BeamSection3d t;
   t.area = s.area;
   t.inertiaY = t.inertiaZ = t.torsionConstant = s.inertia;
   t.youngsModulus = s.youngsModulus;
-  t.shearModulus = 0.5 * s.youngsModulus;
+  t.shearModulus = s.shearModulus > 0.0 ? s.shearModulus : 0.5 * s.youngsModulus;
   t.density = s.density;
   t.damping = s.damping;
+  t.shearFactorY = s.shearFactor;
+  t.shearFactorZ = 1.0;
   return t;
 }
 
 }  // namespace
 
 BeamElement2d::BeamElement2d(const Vec2& start, const Vec2& end, const BeamSection& section,
-                             const std::string& owner)
-    : start_(start), section_(section) {
+                             const std::string& owner, BeamTheory theory)
+    : start_(start), section_(section), theory_(theory) {
   section.validate(owner);
+  if (theory == BeamTheory::Timoshenko && !(section.shearModulus > 0.0)) {
+    throw InputError(owner + ": a Timoshenko beam needs the section's shear_modulus, got " +
+                     std::to_string(section.shearModulus));
+  }
+  if (theory == BeamTheory::Timoshenko && !(section.shearFactor > 0.0)) {
+    throw InputError(owner + ": a Timoshenko beam needs the section's shear_factor (e.g. 5/6 for a rectangle), got " +
+                     std::to_string(section.shearFactor));
+  }
   for (int k = 0; k < 2; ++k) {
     requireFinite(start[k], owner + ": node coordinate");
     requireFinite(end[k], owner + ": node coordinate");
@@ -73,10 +84,15 @@ BeamElement2d::BeamElement2d(const Vec2& start, const Vec2& end, const BeamSecti
   T_(5, 5) = 1.0;
 
   // the spatial element along its own x axis (element frame = its frame), restricted
-  const BeamElement3d el(Vec3::Zero(), Vec3(l_, 0.0, 0.0), Vec3::UnitY(), planarSection3d(section), owner);
+  const BeamElement3d el(Vec3::Zero(), Vec3(l_, 0.0, 0.0), Vec3::UnitY(), planarSection3d(section), owner, theory);
+  shear_ = el.shear().y;
   mass_ = el.mass();
   sBar_ = inPlane(el.sBar());
   sX_ = inPlane(el.positionShapeIntegral(0));
+  sY_ = inPlane(el.positionShapeIntegral(1));
+  // the sections' own inertia and second-order rotation, where the theory turns them
+  sectionMoment_ = theory == BeamTheory::EulerBernoulli ? 0.0 : el.secondMoment()(1, 1);  // rho I l
+  rYY_ = inPlane(el.sectionRotationMoment(1, 1));
   sXX_ = inPlane(el.sKL(0, 0));
   sYY_ = inPlane(el.sKL(1, 1));
   sXY_ = inPlane(el.sKL(0, 1));
@@ -87,14 +103,20 @@ BeamElement2d::BeamElement2d(const Vec2& start, const Vec2& end, const BeamSecti
   energy_ = BeamStrainEnergy<6>(axialStrainShape(l_), G_, K_, Kb, section.axialStiffness(), l_);
 }
 
-BeamElement2d::Mat26 BeamElement2d::shape(double xi, double l) { return inPlane(BeamElement3d::shape(xi, l)); }
-
-BeamElement2d::Row6 BeamElement2d::slopeShape(double xi, double l) {
-  return inPlane(BeamElement3d::slopeShapeY(xi, l));
+BeamElement2d::Mat26 BeamElement2d::shape(double xi, double l, double phi) {
+  return inPlane(BeamElement3d::shape(xi, l, BeamShear{phi, 0.0}));
 }
 
-BeamElement2d::Row6 BeamElement2d::curvatureShape(double xi, double l) {
-  return inPlane(BeamElement3d::curvatureShapeY(xi, l));
+BeamElement2d::Row6 BeamElement2d::slopeShape(double xi, double l, double phi) {
+  return inPlane(BeamElement3d::slopeShapeY(xi, l, BeamShear{phi, 0.0}));
+}
+
+BeamElement2d::Row6 BeamElement2d::curvatureShape(double xi, double l, double phi) {
+  return inPlane(BeamElement3d::curvatureShapeY(xi, l, BeamShear{phi, 0.0}));
+}
+
+BeamElement2d::Row6 BeamElement2d::rotationShape(double xi, double l, double phi) {
+  return inPlane(BeamElement3d::Row12(BeamElement3d::rotationShape(xi, l, BeamShear{phi, 0.0}).row(2)));  // tz
 }
 
 BeamElement2d::Row6 BeamElement2d::axialStrainShape(double l) { return inPlane(BeamElement3d::axialStrainShape(l)); }
@@ -119,7 +141,7 @@ BeamElement2d::Mat6 BeamElement2d::strainEnergyHessian(const Vec6& e, bool stiff
 Vec2 BeamElement2d::sectionForces(const Vec6& e, double xi, bool stiffening) const {
   // N = EA eps_m (constant per element, consistent with U), M = EI kappa(xi)
   return Vec2(section_.axialStiffness() * membraneStrain(e, stiffening),
-              section_.bendingStiffness() * curvatureShape(xi, l_).dot(e));
+              section_.bendingStiffness() * curvatureShape(xi, l_, shear_).dot(e));
 }
 
 }  // namespace flexmbd

@@ -1,4 +1,4 @@
-// Planar Euler-Bernoulli beam element of the floating frame of reference formulation
+// Planar beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
 // (source document 003; Shabana, Dynamics of Multibody Systems, ch. 6-7).
 #pragma once
 
@@ -29,25 +29,33 @@ class BeamElement2d {
   using Mat26 = Eigen::Matrix<double, 2, 6>;
 
   /// @throws InputError naming `owner` if the element has zero length or the section
-  /// is invalid.
+  /// is invalid (Timoshenko: without shear modulus and shear factor).
   BeamElement2d(const Vec2& start, const Vec2& end, const BeamSection& section,
-                const std::string& owner);
+                const std::string& owner, BeamTheory theory = BeamTheory::EulerBernoulli);
 
   double length() const { return l_; }
   double angle() const { return beta_; }  ///< of the element axis in the body frame
   const Vec2& start() const { return start_; }
   const BeamSection& section() const { return section_; }
+  BeamTheory theory() const { return theory_; }
+  /// phi = 12 EI / (kappa G A l^2) of a Timoshenko element (the spatial element's
+  /// BeamShear::y); 0 otherwise.
+  double shear() const { return shear_; }
   /// Body-frame nodal displacements -> element coordinates (6 x 6, constant).
   const Mat6& transformation() const { return T_; }
 
-  /// Shape functions S(xi), xi = x / l (document 003):
+  /// Shape functions S(xi), xi = x / l (document 003; `phi` = shear(): Timoshenko's
+  /// interdependent interpolation, BeamElement3d; phi = 0):
   ///   w_x = [1-xi, 0, 0, xi, 0, 0] e,
   ///   w_y = [0, 1-3xi^2+2xi^3, l(xi-2xi^2+xi^3), 0, 3xi^2-2xi^3, l(xi^3-xi^2)] e.
-  static Mat26 shape(double xi, double l);
+  static Mat26 shape(double xi, double l, double phi = 0.0);
   /// d w_y / dx (slope), d2 w_y / dx2 (curvature), d w_x / dx (axial strain) rows.
-  static Row6 slopeShape(double xi, double l);
-  static Row6 curvatureShape(double xi, double l);
+  static Row6 slopeShape(double xi, double l, double phi = 0.0);
+  static Row6 curvatureShape(double xi, double l, double phi = 0.0);
   static Row6 axialStrainShape(double l);
+  /// The section rotation psi(xi) (1 x 6): the slope v' (phi = 0), Timoshenko's
+  /// interpolated rotation otherwise. What a joint on the section turns with.
+  static Row6 rotationShape(double xi, double l, double phi = 0.0);
 
   // ----- inertia shape integrals, element frame (document 003) -------------------
   double mass() const { return mass_; }           ///< rho A l
@@ -56,6 +64,17 @@ class BeamElement2d {
   const Mat6& sXX() const { return sXX_; }        ///< S_xx = int rho S_x^T S_x dV
   const Mat6& sYY() const { return sYY_; }        ///< S_yy = int rho S_y^T S_y dV
   const Mat6& sXY() const { return sXY_; }        ///< S_xy = int rho S_x^T S_y dV
+  /// int rho y S dV (y across the element; zero for Euler-Bernoulli, whose field is the
+  /// centre line's): row x = -rho I int psi under Rayleigh and Timoshenko, which turn the
+  /// sections by psi (S_x gains -y psi).
+  const Mat26& sY() const { return sY_; }
+  /// int rho y^2 dV = rho I l: the sections' own second moment (Rayleigh, Timoshenko;
+  /// zero for Euler-Bernoulli).
+  double sectionMoment() const { return sectionMoment_; }
+  /// R = -rho I int psi^T psi dx (6 x 6): the second-order change of int rho |u0 + u|^2 dV
+  /// by the sections' rotation (points on circles; BeamElement3d::sectionRotationMoment's
+  /// R_yy in the plane); zero for Euler-Bernoulli.
+  const Mat6& sectionRotationMoment() const { return rYY_; }
   /// Linear stiffness (axial EA/l and Hermite bending EI/l^3 blocks), element frame.
   const Mat6& stiffness() const { return K_; }
 
@@ -83,10 +102,12 @@ class BeamElement2d {
   Vec2 start_;
   double l_ = 0.0, beta_ = 0.0;
   BeamSection section_;
+  BeamTheory theory_ = BeamTheory::EulerBernoulli;
+  double shear_ = 0.0;
   Mat6 T_;
-  double mass_ = 0.0;
-  Mat26 sBar_, sX_;
-  Mat6 sXX_, sYY_, sXY_, K_;
+  double mass_ = 0.0, sectionMoment_ = 0.0;
+  Mat26 sBar_, sX_, sY_;
+  Mat6 sXX_, sYY_, sXY_, K_, rYY_;
   Mat6 G_;  // int b^T b dx
   BeamStrainEnergy<6> energy_;
 };

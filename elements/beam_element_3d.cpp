@@ -59,6 +59,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   for (int n = 0; n < 4; ++n) T_.block<3, 3>(3 * n, 3 * n) = C_.transpose();  // e = T q (document 003, C^ij)
 
   const double l = l_, rhoA = section.massPerLength();
+  if (theory == BeamTheory::Timoshenko) shear_ = section.shearFlexibility(l, owner);
   const double rIy = section.density * section.inertiaY, rIz = section.density * section.inertiaZ;
   mass_ = rhoA * l;
   firstMoment_.setZero();
@@ -71,8 +72,8 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   G_.setZero();
   for (size_t g = 0; g < kGaussXi.size(); ++g) {
     const double xi = kGaussXi[g], w = kGaussW[g] * l, x = xi * l;  // dx = l dxi
-    const Mat3x12 Sc = shape(xi, l);
-    const Mat3x12 Phi = sectionRotationShape(xi, l, theory);
+    const Mat3x12 Sc = shape(xi, l, shear_);
+    const Mat3x12 Phi = sectionRotationShape(xi, l, theory, shear_);
     const Row12 px = Phi.row(0), py = Phi.row(1), pz = Phi.row(2);  // tx, ty, tz
     firstMoment_.x() += w * rhoA * x;                     // int rho x dV
     secondMoment_(0, 0) += w * rhoA * x * x;              // int rho x^2 dV
@@ -109,7 +110,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
     hI_[0] += (w * (rIz - rIy)) * sym(py, pz);  // H_x: rho (Iz - Iy) ty tz
     hI_[1] += (w * rIy) * sym(px, pz);          // H_y: rho Iy tx tz
     hI_[2] -= (w * rIz) * sym(px, py);          // H_z: -rho Iz tx ty
-    const Row12 by = slopeShapeY(xi, l), bz = slopeShapeZ(xi, l);
+    const Row12 by = slopeShapeY(xi, l, shear_), bz = slopeShapeZ(xi, l, shear_);
     G_ += w * (by.transpose() * by + bz.transpose() * bz);  // int (by^T by + bz^T bz) dx
   }
   // S_lk = S_kl^T and S_kk = S_kk^T exactly (the quadrature sums differ in the last bit)
@@ -129,18 +130,22 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   skewXS_.row(2) = xS_[0].row(1) - xS_[1].row(0);
   dotXS_ = xS_[0].row(0) + xS_[1].row(1) + xS_[2].row(2);  // x0 . u
 
-  // Euler-Bernoulli stiffness, closed form (Przemieniecki, Theory of Matrix Structural
-  // Analysis, sec. 5.6): axial EA/l, torsion GJ/l, Hermite bending EIz/l^3, EIy/l^3.
+  // Stiffness, closed form (Przemieniecki, Theory of Matrix Structural Analysis, sec. 5.6):
+  // axial EA/l, torsion GJ/l, bending EIz/((1 + phi_y) l^3), EIy/((1 + phi_z) l^3) with the
+  // shear terms (4 + phi) l^2, (2 - phi) l^2 (phi = 0: Euler-Bernoulli's Hermite matrix).
   K_.setZero();
   const double ea = section.axialStiffness() / l, gj = section.torsionStiffness() / l;
   for (const auto& [dof, k] : {std::pair<int, double>{kU, ea}, std::pair<int, double>{kTx, gj}}) {
     K_(dof, dof) = K_(dof + kNode2, dof + kNode2) = k;
     K_(dof, dof + kNode2) = K_(dof + kNode2, dof) = -k;
   }
-  const double kb[4][4] = {{12, 6 * l, -12, 6 * l},
-                           {6 * l, 4 * l * l, -6 * l, 2 * l * l},
-                           {-12, -6 * l, 12, -6 * l},
-                           {6 * l, 2 * l * l, -6 * l, 4 * l * l}};
+  const auto bendingMatrix = [l](double phi, int i, int j) {
+    const double kb[4][4] = {{12, 6 * l, -12, 6 * l},
+                             {6 * l, (4 + phi) * l * l, -6 * l, (2 - phi) * l * l},
+                             {-12, -6 * l, 12, -6 * l},
+                             {6 * l, (2 - phi) * l * l, -6 * l, (4 + phi) * l * l}};
+    return kb[i][j] / (1.0 + phi);
+  };
   // x-y plane (v, tz): the Hermite matrix as it is; x-z plane (w, ty): ty = -w', so the
   // rotation rows and columns change sign.
   const int bendY[4] = {kV, kTz, kV + kNode2, kTz + kNode2};
@@ -149,8 +154,8 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   const double eiz = section.bendingStiffnessZ() / (l * l * l), eiy = section.bendingStiffnessY() / (l * l * l);
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 4; ++j) {
-      K_(bendY[i], bendY[j]) = eiz * kb[i][j];
-      K_(bendZ[i], bendZ[j]) = eiy * sign[i] * sign[j] * kb[i][j];
+      K_(bendY[i], bendY[j]) = eiz * bendingMatrix(shear_.y, i, j);
+      K_(bendZ[i], bendZ[j]) = eiy * sign[i] * sign[j] * bendingMatrix(shear_.z, i, j);
     }
   }
   Mat12 Kb = K_;  // bending and torsion: the axial entries zero
@@ -180,20 +185,65 @@ const BeamElement3d::Mat3x12& BeamElement3d::positionShapeIntegral(int k) const 
   return xS_[k];
 }
 
-BeamElement3d::Mat3x12 BeamElement3d::shape(double xi, double l) {
-  const double x2 = xi * xi, x3 = x2 * xi;
-  const double h1 = 1 - 3 * x2 + 2 * x3, h2 = l * (xi - 2 * x2 + x3), h3 = 3 * x2 - 2 * x3, h4 = l * (x3 - x2);
+namespace {
+
+/// The four coefficients of one bending plane's field at xi for the plane's nodal
+/// coordinates (d1, r1, d2, r2) = (displacement, section rotation) at both nodes.
+using PlaneRow = std::array<double, 4>;
+
+// Shear-flexible bending of one plane (x-y: d = v, r = tz; x-z: d = w, r = -ty), the
+// interdependent interpolation of Timoshenko's beam (Przemieniecki, Theory of Matrix
+// Structural Analysis, sec. 5.6; Reddy, Int. J. Numer. Meth. Eng. 40 (1997)):
+// the exact static solution for end loads, phi = 12 EI / (kappa G A l^2) (phi = 0:
+// the Hermite cubics of Euler-Bernoulli, r = d').
+PlaneRow planeDisplacement(double xi, double l, double phi) {
+  const double x2 = xi * xi, x3 = x2 * xi, f = 1.0 / (1.0 + phi);
+  return {f * (1 - 3 * x2 + 2 * x3 + phi * (1 - xi)), f * l * (xi - 2 * x2 + x3 + 0.5 * phi * (xi - x2)),
+          f * (3 * x2 - 2 * x3 + phi * xi), f * l * (x3 - x2 + 0.5 * phi * (x2 - xi))};
+}
+PlaneRow planeSlope(double xi, double l, double phi) {  // d/dx of planeDisplacement
+  const double x2 = xi * xi, f = 1.0 / (1.0 + phi);
+  return {f * (-6 * xi + 6 * x2 - phi) / l, f * (1 - 4 * xi + 3 * x2 + 0.5 * phi * (1 - 2 * xi)),
+          f * (6 * xi - 6 * x2 + phi) / l, f * (3 * x2 - 2 * xi + 0.5 * phi * (2 * xi - 1))};
+}
+PlaneRow planeCurvature(double xi, double l, double phi) {  // d2/dx2 of planeDisplacement (= d r / dx)
+  const double f = 1.0 / (1.0 + phi);
+  return {f * (-6 + 12 * xi) / (l * l), f * (-4 + 6 * xi - phi) / l, f * (6 - 12 * xi) / (l * l),
+          f * (6 * xi - 2 + phi) / l};
+}
+PlaneRow planeRotation(double xi, double l, double phi) {  // the section rotation r(xi)
+  const double x2 = xi * xi, f = 1.0 / (1.0 + phi);
+  return {f * 6 * (x2 - xi) / l, f * (1 - 4 * xi + 3 * x2 + phi * (1 - xi)), f * 6 * (xi - x2) / l,
+          f * (3 * x2 - 2 * xi + phi * xi)};
+}
+
+/// A plane's row as a 12-row: x-y plane at (v, tz), x-z plane at (w, ty) with r = -ty
+/// (ty = -w' under Euler-Bernoulli), so the ty entries change sign.
+BeamElement3d::Row12 rowY(const PlaneRow& c) {
+  BeamElement3d::Row12 r = BeamElement3d::Row12::Zero();
+  r(kV) = c[0];
+  r(kTz) = c[1];
+  r(kV + kNode2) = c[2];
+  r(kTz + kNode2) = c[3];
+  return r;
+}
+BeamElement3d::Row12 rowZ(const PlaneRow& c) {
+  BeamElement3d::Row12 r = BeamElement3d::Row12::Zero();
+  r(kW) = c[0];
+  r(kTy) = -c[1];
+  r(kW + kNode2) = c[2];
+  r(kTy + kNode2) = -c[3];
+  return r;
+}
+
+}  // namespace
+
+BeamElement3d::Mat3x12 BeamElement3d::shape(double xi, double l, const BeamShear& shear) {
   Mat3x12 S = Mat3x12::Zero();
   S(0, kU) = 1 - xi;  // w_x = (1-xi) u1 + xi u2
   S(0, kU + kNode2) = xi;
-  S(1, kV) = h1;  // w_y = h1 v1 + h2 tz1 + h3 v2 + h4 tz2
-  S(1, kTz) = h2;
-  S(1, kV + kNode2) = h3;
-  S(1, kTz + kNode2) = h4;
-  S(2, kW) = h1;  // w_z = h1 w1 - h2 ty1 + h3 w2 - h4 ty2
-  S(2, kTy) = -h2;
-  S(2, kW + kNode2) = h3;
-  S(2, kTy + kNode2) = -h4;
+  S.row(1) = rowY(planeDisplacement(xi, l, shear.y));  // w_y: v1, tz1, v2, tz2
+  S.row(2) = rowZ(planeDisplacement(xi, l, shear.z));  // w_z: w1, -ty1, w2, -ty2
   return S;
 }
 
@@ -204,19 +254,25 @@ BeamElement3d::Row12 BeamElement3d::twistShape(double xi) {
   return r;
 }
 
-BeamElement3d::Mat3x12 BeamElement3d::sectionRotationShape(double xi, double l, BeamTheory theory) {
-  Mat3x12 Phi = Mat3x12::Zero();
+BeamElement3d::Mat3x12 BeamElement3d::rotationShape(double xi, double l, const BeamShear& shear) {
+  Mat3x12 Phi;
   Phi.row(0) = twistShape(xi);
-  if (theory == BeamTheory::Rayleigh) {
-    Phi.row(1) = -slopeShapeZ(xi, l);  // ty = -w'
-    Phi.row(2) = slopeShapeY(xi, l);   // tz = v'
-  }
+  Phi.row(1) = -rowZ(planeRotation(xi, l, shear.z));  // ty = -r_z
+  Phi.row(2) = rowY(planeRotation(xi, l, shear.y));   // tz = r_y
   return Phi;
 }
 
-BeamElement3d::Mat3x12 BeamElement3d::pointShape(double xi, double y, double z, double l, BeamTheory theory) {
-  Mat3x12 S = shape(xi, l);
-  const Mat3x12 Phi = sectionRotationShape(xi, l, theory);
+BeamElement3d::Mat3x12 BeamElement3d::sectionRotationShape(double xi, double l, BeamTheory theory,
+                                                           const BeamShear& shear) {
+  Mat3x12 Phi = rotationShape(xi, l, shear);
+  if (theory == BeamTheory::EulerBernoulli) Phi.bottomRows<2>().setZero();  // twist only
+  return Phi;
+}
+
+BeamElement3d::Mat3x12 BeamElement3d::pointShape(double xi, double y, double z, double l, BeamTheory theory,
+                                                 const BeamShear& shear) {
+  Mat3x12 S = shape(xi, l, shear);
+  const Mat3x12 Phi = sectionRotationShape(xi, l, theory, shear);
   S.row(0) += z * Phi.row(1) - y * Phi.row(2);  // phi x (0, y, z) = (z ty - y tz, -z tx, y tx)
   S.row(1) -= z * Phi.row(0);
   S.row(2) += y * Phi.row(0);
@@ -237,40 +293,28 @@ BeamElement3d::Row12 BeamElement3d::twistRateShape(double l) {
   return r;
 }
 
-BeamElement3d::Row12 BeamElement3d::slopeShapeY(double xi, double l) {
-  Row12 r = Row12::Zero();  // v' = h1' v1 + h2' tz1 + h3' v2 + h4' tz2 (d/dx)
-  r(kV) = (-6 * xi + 6 * xi * xi) / l;
-  r(kTz) = 1 - 4 * xi + 3 * xi * xi;
-  r(kV + kNode2) = (6 * xi - 6 * xi * xi) / l;
-  r(kTz + kNode2) = 3 * xi * xi - 2 * xi;
-  return r;
+BeamElement3d::Row12 BeamElement3d::slopeShapeY(double xi, double l, const BeamShear& shear) {
+  return rowY(planeSlope(xi, l, shear.y));  // v'
 }
 
-BeamElement3d::Row12 BeamElement3d::slopeShapeZ(double xi, double l) {
-  Row12 r = Row12::Zero();  // w' = h1' w1 - h2' ty1 + h3' w2 - h4' ty2
-  r(kW) = (-6 * xi + 6 * xi * xi) / l;
-  r(kTy) = -(1 - 4 * xi + 3 * xi * xi);
-  r(kW + kNode2) = (6 * xi - 6 * xi * xi) / l;
-  r(kTy + kNode2) = -(3 * xi * xi - 2 * xi);
-  return r;
+BeamElement3d::Row12 BeamElement3d::slopeShapeZ(double xi, double l, const BeamShear& shear) {
+  return rowZ(planeSlope(xi, l, shear.z));  // w'
 }
 
-BeamElement3d::Row12 BeamElement3d::curvatureShapeY(double xi, double l) {
-  Row12 r = Row12::Zero();  // v'' = h1'' v1 + h2'' tz1 + h3'' v2 + h4'' tz2
-  r(kV) = (-6 + 12 * xi) / (l * l);
-  r(kTz) = (-4 + 6 * xi) / l;
-  r(kV + kNode2) = (6 - 12 * xi) / (l * l);
-  r(kTz + kNode2) = (6 * xi - 2) / l;
-  return r;
+BeamElement3d::Row12 BeamElement3d::curvatureShapeY(double xi, double l, const BeamShear& shear) {
+  return rowY(planeCurvature(xi, l, shear.y));  // v'' = tz'
 }
 
-BeamElement3d::Row12 BeamElement3d::curvatureShapeZ(double xi, double l) {
-  Row12 r = Row12::Zero();  // w'' = h1'' w1 - h2'' ty1 + h3'' w2 - h4'' ty2
-  r(kW) = (-6 + 12 * xi) / (l * l);
-  r(kTy) = -(-4 + 6 * xi) / l;
-  r(kW + kNode2) = (6 - 12 * xi) / (l * l);
-  r(kTy + kNode2) = -(6 * xi - 2) / l;
-  return r;
+BeamElement3d::Row12 BeamElement3d::curvatureShapeZ(double xi, double l, const BeamShear& shear) {
+  return rowZ(planeCurvature(xi, l, shear.z));  // w'' = -ty'
+}
+
+BeamElement3d::Row12 BeamElement3d::shearStrainShapeY(double l, const BeamShear& shear) {
+  return slopeShapeY(0.0, l, shear) - rowY(planeRotation(0.0, l, shear.y));  // gamma_y = v' - tz (constant)
+}
+
+BeamElement3d::Row12 BeamElement3d::shearStrainShapeZ(double l, const BeamShear& shear) {
+  return slopeShapeZ(0.0, l, shear) - rowZ(planeRotation(0.0, l, shear.z));  // gamma_z = w' + ty (constant)
 }
 
 // The strain energy: BeamStrainEnergy (elements/beam_strain_energy.hpp), shared with the
@@ -295,11 +339,12 @@ BeamSectionForces3d BeamElement3d::sectionForces(const Vec12& e, double xi, bool
   BeamSectionForces3d f;
   f.N = s.axialStiffness() * membraneStrain(e, stiffening);  // N = EA eps (constant, consistent with U)
   f.Mx = s.torsionStiffness() * twistRateShape(l_).dot(e);    // Mx = GJ tx'
-  f.My = -s.bendingStiffnessY() * curvatureShapeZ(xi, l_).dot(e);  // My = EIy ty' = -EIy w''
-  f.Mz = s.bendingStiffnessZ() * curvatureShapeY(xi, l_).dot(e);   // Mz = EIz tz' = EIz v''
+  f.My = -s.bendingStiffnessY() * curvatureShapeZ(xi, l_, shear_).dot(e);  // My = EIy ty' = -EIy w''
+  f.Mz = s.bendingStiffnessZ() * curvatureShapeY(xi, l_, shear_).dot(e);   // Mz = EIz tz' = EIz v''
   // the curvatures are linear in xi: v''' = (v''(1) - v''(0)) / l, likewise w'''
-  const double v3 = (curvatureShapeY(1.0, l_) - curvatureShapeY(0.0, l_)).dot(e) / l_;
-  const double w3 = (curvatureShapeZ(1.0, l_) - curvatureShapeZ(0.0, l_)).dot(e) / l_;
+  // (Timoshenko: v'' = tz' as the shear strain is constant, and EIz tz'' = -kappa G A gamma_y)
+  const double v3 = (curvatureShapeY(1.0, l_, shear_) - curvatureShapeY(0.0, l_, shear_)).dot(e) / l_;
+  const double w3 = (curvatureShapeZ(1.0, l_, shear_) - curvatureShapeZ(0.0, l_, shear_)).dot(e) / l_;
   f.Qy = -s.bendingStiffnessZ() * v3;  // dMz/dx + Qy = 0 (moment balance of a slice)
   f.Qz = -s.bendingStiffnessY() * w3;  // dMy/dx - Qz = 0
   return f;

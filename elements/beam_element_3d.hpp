@@ -1,4 +1,4 @@
-// Spatial Euler-Bernoulli beam element of the floating frame of reference formulation
+// Spatial beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
 // (source document 003; Shabana, Dynamics of Multibody Systems, ch. 5-6; Przemieniecki,
 // Theory of Matrix Structural Analysis, sec. 5.6). docs/spatial-flexible.md.
 #pragma once
@@ -41,7 +41,13 @@ struct BeamSectionForces3d {
 ///   w_y = h1 v1 + h2 tz1 + h3 v2 + h4 tz2,
 ///   w_z = h1 w1 - h2 ty1 + h3 w2 - h4 ty2,
 ///   h1 = 1 - 3xi^2 + 2xi^3, h2 = l (xi - 2xi^2 + xi^3), h3 = 3xi^2 - 2xi^3, h4 = l (xi^3 - xi^2),
-/// twist tx(xi) = (1-xi) tx1 + xi tx2 (`twistShape()`). A material point (x, y, z) of the
+/// twist tx(xi) = (1-xi) tx1 + xi tx2 (`twistShape()`). Under BeamTheory::Timoshenko the
+/// bending fields are the interdependent interpolation of the shear-flexible beam
+/// (`BeamShear`, phi = 12 EI / (kappa G A l^2); phi = 0 gives the cubics above): the
+/// nodal ty, tz are then the sections' own rotations, not the slopes, the shear strain
+/// gamma = v' - tz is constant along the element and the stiffness is Przemieniecki's
+/// shear-deformable matrix (exact for end loads, free of shear locking as l / h grows).
+/// A material point (x, y, z) of the
 /// element (y, z in the section) moves by
 ///   u = S(x, y, z) e = S_c e + tx e_x cross (0, y, z) = S_c e + (0, -z tx, y tx)  (`pointShape()`).
 /// The rotation of the section by the twist is kept (it gives the torsional inertia
@@ -50,7 +56,8 @@ struct BeamSectionForces3d {
 /// inertia of bending) is kept under BeamTheory::Rayleigh and neglected under
 /// Euler-Bernoulli (the default), as in the planar BeamElement2d (centre-line field
 /// only), so a spatial Euler-Bernoulli element in a plane has exactly the planar
-/// element's inertia. Shear deformation and warping are neglected.
+/// element's inertia. Timoshenko keeps the sections' rotation as Rayleigh does, by
+/// their own rotation. Warping is neglected.
 ///
 /// Everything constant is computed once, at construction: along x by 5-point
 /// Gauss-Legendre quadrature (exact to degree 9; the integrands here reach 6), over the
@@ -77,6 +84,8 @@ class BeamElement3d {
   const Vec3& end() const { return end_; }                  ///< end node, body frame
   const BeamSection3d& section() const { return section_; }
   BeamTheory theory() const { return theory_; }
+  /// phi_y, phi_z of a Timoshenko element (BeamSection3d::shearFlexibility); zero otherwise.
+  const BeamShear& shear() const { return shear_; }
   /// C (3 x 3): columns = element x, y, z axes in the body frame; x_body = start + C x_el.
   const Mat3& rotation() const { return C_; }
   /// T (12 x 12, constant) = blockdiag(C^T, C^T, C^T, C^T): body-frame nodal coordinates
@@ -84,28 +93,38 @@ class BeamElement3d {
   const Mat12& transformation() const { return T_; }
 
   // ----- shape functions (element frame, xi = x / l) ------------------------------
+  // `shear`: the element's shear flexibility (`shear()`); zero, the default, for
+  // Euler-Bernoulli and Rayleigh elements.
   /// Centre-line shape S_c(xi) (3 x 12): w = S_c e, as in the class comment.
-  static Mat3x12 shape(double xi, double l);
+  static Mat3x12 shape(double xi, double l, const BeamShear& shear = {});
   /// Twist tx(xi) = twistShape(xi) e (1 x 12): (1-xi) at tx1, xi at tx2.
   static Row12 twistShape(double xi);
-  /// The section's small rotation phi(xi) = Phi e (3 x 12, element axes): row x the
-  /// twist tx; rows y, z the bending rotations ty = -w', tz = v' under Rayleigh, zero
-  /// under Euler-Bernoulli (whose field does not turn the sections by the slopes).
-  static Mat3x12 sectionRotationShape(double xi, double l, BeamTheory theory);
+  /// The cross-section's small rotation (tx, ty, tz)(xi) = rotationShape e (3 x 12,
+  /// element axes): the twist, and the bending rotations ty = -w', tz = v' (Timoshenko:
+  /// the interpolated section rotations). What a joint on the section turns with.
+  static Mat3x12 rotationShape(double xi, double l, const BeamShear& shear = {});
+  /// The section rotation of the inertia field phi(xi) = Phi e (3 x 12): rotationShape
+  /// under Rayleigh and Timoshenko; under Euler-Bernoulli the twist only (rows y, z
+  /// zero: its field does not turn the sections by the slopes).
+  static Mat3x12 sectionRotationShape(double xi, double l, BeamTheory theory, const BeamShear& shear = {});
   /// Point shape S(xi, y, z) (3 x 12): S_c(xi) e + phi(xi) x (0, y, z), y, z in the
   /// section: S_c + rows (z ty - y tz, -z tx, y tx) (ty = tz = 0 under Euler-Bernoulli).
   static Mat3x12 pointShape(double xi, double y, double z, double l,
-                            BeamTheory theory = BeamTheory::EulerBernoulli);
+                            BeamTheory theory = BeamTheory::EulerBernoulli, const BeamShear& shear = {});
   /// d w_x / dx (1 x 12, constant): the axial strain row a.
   static Row12 axialStrainShape(double l);
   /// d tx / dx (1 x 12, constant): the twist rate row.
   static Row12 twistRateShape(double l);
-  /// d w_y / dx = tz(xi) and d w_z / dx = -ty(xi) (1 x 12): the slope rows.
-  static Row12 slopeShapeY(double xi, double l);
-  static Row12 slopeShapeZ(double xi, double l);
-  /// d2 w_y / dx2 and d2 w_z / dx2 (1 x 12): the curvature rows.
-  static Row12 curvatureShapeY(double xi, double l);
-  static Row12 curvatureShapeZ(double xi, double l);
+  /// d w_y / dx and d w_z / dx (1 x 12): the slope rows (Euler-Bernoulli: tz(xi), -ty(xi)).
+  static Row12 slopeShapeY(double xi, double l, const BeamShear& shear = {});
+  static Row12 slopeShapeZ(double xi, double l, const BeamShear& shear = {});
+  /// d2 w_y / dx2 = tz' and d2 w_z / dx2 = -ty' (1 x 12): the curvature rows.
+  static Row12 curvatureShapeY(double xi, double l, const BeamShear& shear = {});
+  static Row12 curvatureShapeZ(double xi, double l, const BeamShear& shear = {});
+  /// The shear strains gamma_y = v' - tz and gamma_z = w' + ty (1 x 12, constant along
+  /// the element; zero rows for shear = 0).
+  static Row12 shearStrainShapeY(double l, const BeamShear& shear);
+  static Row12 shearStrainShapeZ(double l, const BeamShear& shear);
 
   // ----- inertia shape integrals (element frame, origin at the start node) -------
   double mass() const { return mass_; }                       ///< m = int rho dV = rho A l, kg
@@ -156,7 +175,9 @@ class BeamElement3d {
   // ----- stiffness and strain energy (element frame) -----------------------------
   /// Linear stiffness K (12 x 12), the classic Przemieniecki matrix: axial EA/l, torsion
   /// GJ/l, bending EIz/l^3 (x-y plane: v, tz) and EIy/l^3 (x-z plane: w, ty, with
-  /// ty = -w'). Body frame: T^T K T. Damping D = section().damping K.
+  /// ty = -w'); Timoshenko: the shear-deformable bending blocks (factor 1/(1 + phi),
+  /// (4 + phi) l^2 and (2 - phi) l^2 on the rotations), e^T K e / 2 = int (EI psi'^2 +
+  /// kappa G A gamma^2) / 2 dx. Body frame: T^T K T. Damping D = section().damping K.
   const Mat12& stiffness() const { return K_; }
   /// G = int_0^l (by^T by + bz^T bz) dx (12 x 12, constant), by, bz = slope rows: the
   /// slope integral of the membrane strain, (1/2) int (v'^2 + w'^2) dx = e^T G e / 2;
@@ -193,6 +214,7 @@ class BeamElement3d {
   std::array<Mat12, 9> rKL_;  // R_kl at index 3 k + l (sectionRotationMoment)
   std::array<Mat12, 3> hI_;   // H_i (sectionRotationCoupling)
   BeamTheory theory_ = BeamTheory::EulerBernoulli;
+  BeamShear shear_;  // zero unless Timoshenko
   Mat12 massMatrix_;
   std::array<Mat3x12, 3> xS_;  // int rho x0_k S dV
   Mat3x12 skewXS_;

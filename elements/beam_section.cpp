@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "core/errors.hpp"
 #include "core/types.hpp"
@@ -14,12 +15,9 @@ void BeamSection::validate(const std::string& owner) const {
   requirePositive(inertia, owner + ": section inertia (second moment of area)");
   requirePositive(youngsModulus, owner + ": section youngs_modulus");
   requirePositive(density, owner + ": section density");
-  requireFinite(damping, owner + ": section damping");
-  if (damping < 0.0) {
-    std::ostringstream os;
-    os << owner << ": section damping must be >= 0, got " << damping;
-    throw InputError(os.str());
-  }
+  requireNonNegative(damping, owner + ": section damping");
+  requireNonNegative(shearModulus, owner + ": section shear_modulus");
+  requireNonNegative(shearFactor, owner + ": section shear_factor");
 }
 
 BeamSection rectangularSection(double width, double height, double youngsModulus, double density,
@@ -41,12 +39,34 @@ void BeamSection3d::validate(const std::string& owner) const {
   requirePositive(youngsModulus, owner + ": section youngs_modulus");
   requirePositive(shearModulus, owner + ": section shear_modulus");
   requirePositive(density, owner + ": section density");
-  requireFinite(damping, owner + ": section damping");
-  if (damping < 0.0) {
-    std::ostringstream os;
-    os << owner << ": section damping must be >= 0, got " << damping;
-    throw InputError(os.str());
+  requireNonNegative(damping, owner + ": section damping");
+  requireNonNegative(shearFactorY, owner + ": section shear_factor_y");
+  requireNonNegative(shearFactorZ, owner + ": section shear_factor_z");
+}
+
+BeamShear BeamSection3d::shearFlexibility(double l, const std::string& owner) const {
+  for (const auto& [kappa, key] : {std::pair<double, const char*>{shearFactorY, "shear_factor_y"},
+                                   std::pair<double, const char*>{shearFactorZ, "shear_factor_z"}}) {
+    if (!(kappa > 0.0)) {
+      std::ostringstream os;
+      os << owner << ": a Timoshenko beam needs the section's " << key
+         << " (shear correction factor, e.g. 5/6 for a rectangle), got " << kappa;
+      throw InputError(os.str());
+    }
   }
+  const double gal2 = shearModulus * area * l * l;
+  // phi = 12 E I / (kappa G A l^2) (Przemieniecki sec. 5.6)
+  return {12.0 * bendingStiffnessZ() / (shearFactorY * gal2), 12.0 * bendingStiffnessY() / (shearFactorZ * gal2)};
+}
+
+double rectangleShearFactor(double youngsModulus, double shearModulus) {
+  const double nu = youngsModulus / (2.0 * shearModulus) - 1.0;  // isotropic: G = E / (2 (1 + nu))
+  return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);                 // Cowper (1966), table 1
+}
+
+double circleShearFactor(double youngsModulus, double shearModulus) {
+  const double nu = youngsModulus / (2.0 * shearModulus) - 1.0;
+  return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);  // Cowper (1966), table 1
 }
 
 BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsModulus, double shearModulus,
@@ -69,6 +89,7 @@ BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsM
   s.shearModulus = shearModulus;
   s.density = density;
   s.damping = damping;
+  s.shearFactorY = s.shearFactorZ = rectangleShearFactor(youngsModulus, shearModulus);
   return s;
 }
 
@@ -84,6 +105,7 @@ BeamSection3d circularSection3d(double diameter, double youngsModulus, double sh
   s.shearModulus = shearModulus;
   s.density = density;
   s.damping = damping;
+  s.shearFactorY = s.shearFactorZ = circleShearFactor(youngsModulus, shearModulus);
   return s;
 }
 

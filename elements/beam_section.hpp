@@ -6,12 +6,23 @@
 
 namespace flexmbd {
 
-/// The beam theory of an element's inertia (issue 25; docs/spatial-flexible.md):
+/// The beam theory of an element (issue 25; docs/spatial-flexible.md):
 /// Euler-Bernoulli keeps the centre line's inertia and the sections' rotation by the
 /// twist; Rayleigh adds the rotary inertia of the sections turned by the bending slopes
 /// (rho I int v'^2 dx: the gyroscopic moments of a spinning shaft). Both keep the
 /// Euler-Bernoulli kinematics (sections normal to the centre line, no shear strain).
-enum class BeamTheory { EulerBernoulli, Rayleigh };
+/// Timoshenko adds the shear strain gamma = v' - psi (sections turn by their own
+/// rotation psi, energy kappa G A gamma^2 / 2 per length) and the rotary inertia of psi.
+enum class BeamTheory { EulerBernoulli, Rayleigh, Timoshenko };
+
+/// Shear flexibility of a Timoshenko element per bending plane, phi = 12 E I /
+/// (kappa G A l^2) (Przemieniecki, Theory of Matrix Structural Analysis, sec. 5.6):
+/// `y` for the x-y plane (v, tz; E Iz, shear along y, kappa_y), `z` for the x-z plane
+/// (w, ty; E Iy, kappa_z). Zero (Euler-Bernoulli, Rayleigh): the Hermite cubics.
+struct BeamShear {
+  double y = 0.0;
+  double z = 0.0;
+};
 
 struct BeamSection {
   double area = 0.0;           ///< A, m^2
@@ -20,11 +31,15 @@ struct BeamSection {
   double density = 0.0;        ///< rho, kg/m^3
   /// Stiffness-proportional (Rayleigh) damping coefficient beta, s: D = beta K.
   double damping = 0.0;
+  /// Timoshenko only (BeamTheory::Timoshenko; 0 = not given): shear modulus G, Pa, and
+  /// shear correction factor kappa (shear stiffness kappa G A).
+  double shearModulus = 0.0;
+  double shearFactor = 0.0;
 
   double massPerLength() const { return density * area; }
   double axialStiffness() const { return youngsModulus * area; }
   double bendingStiffness() const { return youngsModulus * inertia; }
-  /// @throws InputError naming `owner` unless A, I, E, rho > 0 and damping >= 0.
+  /// @throws InputError naming `owner` unless A, I, E, rho > 0, damping, G, kappa >= 0.
   void validate(const std::string& owner) const;
 };
 
@@ -45,6 +60,10 @@ struct BeamSection3d {
   double density = 0.0;          ///< rho, kg/m^3
   /// Stiffness-proportional (Rayleigh) damping coefficient beta, s: D = beta K.
   double damping = 0.0;
+  /// Shear correction factors (Timoshenko only; 0 = not given): shear stiffness
+  /// kappa_y G A for shear along y (bending in x-y), kappa_z G A along z.
+  double shearFactorY = 0.0;
+  double shearFactorZ = 0.0;
 
   double massPerLength() const { return density * area; }         ///< rho A, kg/m
   double polarMoment() const { return inertiaY + inertiaZ; }      ///< Ip = int (y^2 + z^2) dA, m^4
@@ -53,9 +72,18 @@ struct BeamSection3d {
   double bendingStiffnessZ() const { return youngsModulus * inertiaZ; }  ///< E Iz, N m^2 (x-y plane)
   double torsionStiffness() const { return shearModulus * torsionConstant; }  ///< G J, N m^2
   /// @throws InputError naming `owner` unless A, Iy, Iz, J, E, G, rho > 0 (and finite)
-  /// and damping >= 0 (and finite).
+  /// and damping, kappa_y, kappa_z >= 0 (and finite).
   void validate(const std::string& owner) const;
+  /// phi_y = 12 E Iz / (kappa_y G A l^2), phi_z = 12 E Iy / (kappa_z G A l^2) of an
+  /// element of length l. @throws InputError naming `owner` unless both factors are > 0.
+  BeamShear shearFlexibility(double l, const std::string& owner) const;
 };
+
+/// Cowper's shear correction factors (G. R. Cowper, J. Appl. Mech. 33 (1966) 335,
+/// table 1) with Poisson's ratio nu = E / (2 G) - 1 of an isotropic material:
+/// rectangle 10 (1 + nu) / (12 + 11 nu), solid circle 6 (1 + nu) / (7 + 6 nu).
+double rectangleShearFactor(double youngsModulus, double shearModulus);
+double circleShearFactor(double youngsModulus, double shearModulus);
 
 /// Rectangular section, side `widthY` along the section's y axis and `heightZ` along z:
 /// A = b h, Iz = h b^3 / 12, Iy = b h^3 / 12, and the St Venant torsion constant of the
@@ -65,12 +93,13 @@ struct BeamSection3d {
 /// summed to n = 101 (truncation < 1e-9 relative). J = 0.1406 a^4 for a square.
 /// The material is given by E and the shear modulus G (not Poisson's ratio: G = E / (2 (1 + nu))
 /// for an isotropic material; G directly covers orthotropic rods too), as circularSection3d.
+/// The shear factors are Cowper's for the rectangle (rectangleShearFactor).
 /// No checks here: BeamSection3d::validate (called by the element) rejects bad values.
 BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsModulus, double shearModulus,
                                    double density, double damping = 0.0);
 
 /// Solid circular section of diameter d: A = pi d^2 / 4, Iy = Iz = pi d^4 / 64 and
-/// J = Ip = pi d^4 / 32 (a circle does not warp).
+/// J = Ip = pi d^4 / 32 (a circle does not warp); Cowper's shear factors (circleShearFactor).
 BeamSection3d circularSection3d(double diameter, double youngsModulus, double shearModulus, double density,
                                 double damping = 0.0);
 

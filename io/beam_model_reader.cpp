@@ -90,8 +90,11 @@ void readBeamModelOptions(const ObjectReader& r, int numNodes, Options& o) {
     const std::string theory = r.string("beam_theory", "euler_bernoulli");
     if (theory == "rayleigh") {
       o.theory = BeamTheory::Rayleigh;
+    } else if (theory == "timoshenko") {
+      o.theory = BeamTheory::Timoshenko;
     } else if (theory != "euler_bernoulli") {
-      r.fail("key \"beam_theory\" must be \"euler_bernoulli\" or \"rayleigh\", got " + inQuotes(theory));
+      r.fail("key \"beam_theory\" must be \"euler_bernoulli\", \"rayleigh\" or \"timoshenko\", got " +
+             inQuotes(theory));
     }
   }
   o.inertiaModes = r.boolean("inertia_modes", false);

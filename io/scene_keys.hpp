@@ -69,7 +69,8 @@ inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "or
                                      "elastic_coordinates",  "elastic_velocities", "reduction", "interface_nodes",
                                      "inertia_modes", "beam_theory"};
 inline const Keys kSection3d = {"area",          "inertia_y",     "inertia_z", "torsion_constant", "width",  "height",
-                                "youngs_modulus", "shear_modulus", "poisson_ratio", "density",     "damping"};
+                                "youngs_modulus", "shear_modulus", "poisson_ratio", "density",     "damping",
+                                "shear_factor_y", "shear_factor_z"};
 inline const Keys kBeam3d = {"length", "elements", "origin"};
 inline const Keys kInvariantsBody3d = {"name",        "type",       "position",            "orientation",
                                        "velocity",    "angular_velocity", "invariants",    "elastic_coordinates",

@@ -131,7 +131,9 @@ FrameState3d parseFrameState3d(const ObjectReader& r) {
 
 /// A spatial beam section: "width" and "height" (rectangle, along the section's y and z
 /// axes) or "area", "inertia_y", "inertia_z", "torsion_constant"; "youngs_modulus", one
-/// of "shear_modulus" or "poisson_ratio" (G = E / (2 (1 + nu))), "density", "damping".
+/// of "shear_modulus" or "poisson_ratio" (G = E / (2 (1 + nu))), "density", "damping";
+/// for Timoshenko beams "shear_factor_y" and "shear_factor_z" (a rectangle's default:
+/// Cowper's factor, rectangleShearFactor).
 BeamSection3d parseSection3d(const json& j, const std::string& where) {
   ObjectReader r(j, where);
   r.allowOnly(scenekeys::kSection3d, " for a spatial section");
@@ -152,9 +154,14 @@ BeamSection3d parseSection3d(const json& j, const std::string& where) {
     if (r.has("area") || r.has("inertia_y") || r.has("inertia_z") || r.has("torsion_constant")) {
       r.fail("give either width and height, or area, inertia_y, inertia_z and torsion_constant, not both");
     }
-    return rectangularSection3d(r.positive("width"), r.positive("height"), E, G, rho, damping);
+    BeamSection3d s = rectangularSection3d(r.positive("width"), r.positive("height"), E, G, rho, damping);
+    s.shearFactorY = r.positive("shear_factor_y", s.shearFactorY);
+    s.shearFactorZ = r.positive("shear_factor_z", s.shearFactorZ);
+    return s;
   }
   BeamSection3d s;
+  if (r.has("shear_factor_y")) s.shearFactorY = r.positive("shear_factor_y");
+  if (r.has("shear_factor_z")) s.shearFactorZ = r.positive("shear_factor_z");
   s.area = r.positive("area");
   s.inertiaY = r.positive("inertia_y");
   s.inertiaZ = r.positive("inertia_z");

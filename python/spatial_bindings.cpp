@@ -317,7 +317,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
   py::class_<BeamSection3d>(m, "BeamSection3d")
       .def(py::init([](const py::object& area, const py::object& iy, const py::object& iz, const py::object& j,
                        const py::object& E, const py::object& G, const py::object& nu, const py::object& rho,
-                       const py::object& damping) {
+                       const py::object& damping, const py::object& kappaY, const py::object& kappaZ) {
              constexpr const char* fn = "BeamSection3d";
              BeamSection3d s;
              s.area = positiveArg(area, fn, "area");
@@ -328,11 +328,14 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
              s.shearModulus = shearModulusArg(s.youngsModulus, G, nu, fn);
              s.density = positiveArg(rho, fn, "density");
              s.damping = nonNegativeArg(damping, fn, "damping");
+             s.shearFactorY = nonNegativeArg(kappaY, fn, "shear_factor_y");  // Timoshenko only
+             s.shearFactorZ = nonNegativeArg(kappaZ, fn, "shear_factor_z");
              return s;
            }),
            py::arg("area"), py::arg("inertia_y"), py::arg("inertia_z"), py::arg("torsion_constant"),
            py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(), py::arg("poisson_ratio") = py::none(),
-           py::arg("density"), py::arg("damping") = 0.0)
+           py::arg("density"), py::arg("damping") = 0.0, py::arg("shear_factor_y") = 0.0,
+           py::arg("shear_factor_z") = 0.0)
       .def_readwrite("area", &BeamSection3d::area)
       .def_readwrite("inertia_y", &BeamSection3d::inertiaY)
       .def_readwrite("inertia_z", &BeamSection3d::inertiaZ)
@@ -340,7 +343,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def_readwrite("youngs_modulus", &BeamSection3d::youngsModulus)
       .def_readwrite("shear_modulus", &BeamSection3d::shearModulus)
       .def_readwrite("density", &BeamSection3d::density)
-      .def_readwrite("damping", &BeamSection3d::damping);
+      .def_readwrite("damping", &BeamSection3d::damping)
+      .def_readwrite("shear_factor_y", &BeamSection3d::shearFactorY)
+      .def_readwrite("shear_factor_z", &BeamSection3d::shearFactorZ);
   m.def(
       "rectangular_section_3d",
       [](const py::object& w, const py::object& h, const py::object& E, const py::object& G, const py::object& nu,
@@ -393,7 +398,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .value("FREE_FREE", ReferenceConditions3d::Type::FreeFree);
   py::enum_<BeamTheory>(m, "BeamTheory")
       .value("EULER_BERNOULLI", BeamTheory::EulerBernoulli)
-      .value("RAYLEIGH", BeamTheory::Rayleigh);
+      .value("RAYLEIGH", BeamTheory::Rayleigh)
+      .value("TIMOSHENKO", BeamTheory::Timoshenko);
   py::class_<FfrBeamOptions3d>(m, "FfrBeamOptions3d")
       .def(py::init([](ReferenceConditions3d::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
                        bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes,

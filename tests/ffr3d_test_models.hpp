@@ -33,13 +33,13 @@ struct BeamChain3d {
   /// N (3 x nf) of the material point (xi, y, z) of element e (element frame).
   Mat3X pointShape(int e, double xi, double y, double z) const {
     const BeamElement3d& el = elements[e];
-    return el.rotation() * BeamElement3d::pointShape(xi, y, z, el.length(), el.theory()) * el.transformation() *
+    return el.rotation() * BeamElement3d::pointShape(xi, y, z, el.length(), el.theory(), el.shear()) * el.transformation() *
            selection(e);
   }
   /// The section rotation phi = Phi q_f (3 x nf, element axes) at xi of element e.
   Mat3X sectionRotation(int e, double xi) const {
     const BeamElement3d& el = elements[e];
-    return BeamElement3d::sectionRotationShape(xi, el.length(), el.theory()) * el.transformation() * selection(e);
+    return BeamElement3d::sectionRotationShape(xi, el.length(), el.theory(), el.shear()) * el.transformation() * selection(e);
   }
   /// u0 (body frame) of that point.
   Vec3 pointPosition(int e, double xi, double y, double z) const {

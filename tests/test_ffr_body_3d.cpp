@@ -120,8 +120,10 @@ struct Fixture {
   int nf;
 };
 
-constexpr BeamTheory kTheories[] = {BeamTheory::EulerBernoulli, BeamTheory::Rayleigh};
-const char* theoryName(BeamTheory t) { return t == BeamTheory::Rayleigh ? "Rayleigh" : "Euler-Bernoulli"; }
+constexpr BeamTheory kTheories[] = {BeamTheory::EulerBernoulli, BeamTheory::Rayleigh, BeamTheory::Timoshenko};
+const char* theoryName(BeamTheory t) {
+  return t == BeamTheory::Rayleigh ? "Rayleigh" : t == BeamTheory::Timoshenko ? "Timoshenko" : "Euler-Bernoulli";
+}
 
 /// A generic state: p of length 1.3 (the gauge is free), elastic coordinates of scale
 /// `elastic` (displacements, m) and 10 x that for rotations.
@@ -214,6 +216,7 @@ TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
     for (SpMat& R : row) R = SpMat();
   const FfrBody3d first("first order", firstOrder, someFrame());
   const Fixture rayleigh(BeamTheory::Rayleigh);  // same nodes: the same coordinates
+  const Fixture timoshenko(BeamTheory::Timoshenko);
   const auto pts = massPoints(f.chain);
   Random rnd(12);
   double worst = 0.0, worstPower = 0.0;
@@ -234,7 +237,7 @@ TEST(FfrBody3d, QuadraticVelocityForcesAreDAlembertsInertiaForces) {
     worst = std::max(worst, expectMatrixNear(Q1, Qref, kKaneTol, "quadratic velocity forces vs d'Alembert"));
     // power: v.Q_v = -1/2 v^T (dM/dt) v (the quadratic velocity forces do no work on the
     // kinetic energy other than through dM/dt)
-    for (const FfrBody3d* b : std::initializer_list<const FfrBody3d*>{&first, &f.body, &rayleigh.body}) {
+    for (const FfrBody3d* b : std::initializer_list<const FfrBody3d*>{&first, &f.body, &rayleigh.body, &timoshenko.body}) {
       const VecX Q = internalForces(*b, q, v) - internalForces(*b, q, VecX::Zero(v.size()));
       const double dMdt = (v.dot(b->massMatrix(qp) * v) - v.dot(b->massMatrix(qm) * v)) / (2.0 * h);
       const double power = v.dot(Q), scale = std::abs(dMdt) + Q.cwiseAbs().maxCoeff() * v.norm();

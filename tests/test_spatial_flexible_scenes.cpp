@@ -139,9 +139,9 @@ TEST(SpatialFlexibleScene, GivenInvariantsReproduceTheBeamMeshBody) {
   // (17 significant digits) run the same motion: the bodies differ only in the order of
   // summation of K_ff q_f, so the two runs agree to the integrator's round-off
   // amplification; bound 1e-9 of the coordinates' scale (the runs take the same steps).
-  // Euler-Bernoulli and Rayleigh: the optional r_kl and h_i keys carry the sections'
-  // second-order rotation.
-  for (const char* theory : {"euler_bernoulli", "rayleigh"}) {
+  // Euler-Bernoulli, Rayleigh and Timoshenko: the optional r_kl and h_i keys carry the
+  // sections' second-order rotation.
+  for (const char* theory : {"euler_bernoulli", "rayleigh", "timoshenko"}) {
   SCOPED_TRACE(theory);
   json meshScene = pendulumScene();
   meshScene["bodies"][0]["beam_theory"] = theory;
@@ -344,29 +344,52 @@ TEST(SpatialFlexibleScene, CraigBamptonKeysGiveTheStaticTipResponseExactly) {
   EXPECT_NEAR(cb[3], F.x(), 1e-9 * forceScale) << "N";
 }
 
-TEST(SpatialFlexibleScene, BeamTheoryKeyGivesTheRayleighModelOfTheApi) {
-  // "beam_theory": "rayleigh" builds FfrBeamOptions3d::theory = Rayleigh: the mass matrix
-  // and the sections' second-order invariants of the API model (1e-14, as above), and a
-  // mass matrix that differs from the Euler-Bernoulli one by the rotary inertia.
-  json j = pendulumScene();
-  j["bodies"][0]["beam_theory"] = "rayleigh";
-  const Scene scene = parseScene(j);
-  const BeamSection3d s = rectangularSection3d(kWidth, kHeight, kE, kE / (2.0 * (1.0 + kNu)), kRho, 1e-4);
-  FfrBeamOptions3d o;
-  o.reference.type = ReferenceConditions3d::Type::Clamped;
-  o.theory = BeamTheory::Rayleigh;
-  const FfrBeamModel3d api(BeamMesh3d::straight(kLength, 4, s, Vec3::Zero(), Vec3(0, 1, 0.2)), o, "api");
-  const FfrInvariants3d &a = flexBody(scene).invariants(), &b = api.invariants();
-  const double mscale = MatX(b.mff).cwiseAbs().maxCoeff();
-  expectMatrixNear(MatX(a.mff), MatX(b.mff), 1e-14, "m_ff", mscale);
-  for (int i = 0; i < 3; ++i) {
-    expectMatrixNear(MatX(a.hI[i]), MatX(b.hI[i]), 1e-14, "H_i", mscale);
-    for (int l = 0; l < 3; ++l) expectMatrixNear(MatX(a.rKL[i][l]), MatX(b.rKL[i][l]), 1e-14, "R_kl", mscale);
+TEST(SpatialFlexibleScene, BeamTheoryKeyGivesTheRayleighAndTimoshenkoModelsOfTheApi) {
+  // "beam_theory": "rayleigh" / "timoshenko" build FfrBeamOptions3d::theory: the mass
+  // matrix, stiffness and the sections' second-order invariants of the API model (1e-14,
+  // as above; the rectangle's shear factors are Cowper's in both), and a mass matrix that
+  // differs from the Euler-Bernoulli one by the rotary inertia.
+  for (const auto& [key, theory] : {std::pair<const char*, BeamTheory>{"rayleigh", BeamTheory::Rayleigh},
+                                    std::pair<const char*, BeamTheory>{"timoshenko", BeamTheory::Timoshenko}}) {
+    SCOPED_TRACE(key);
+    json j = pendulumScene();
+    j["bodies"][0]["beam_theory"] = key;
+    const Scene scene = parseScene(j);
+    const BeamSection3d s = rectangularSection3d(kWidth, kHeight, kE, kE / (2.0 * (1.0 + kNu)), kRho, 1e-4);
+    FfrBeamOptions3d o;
+    o.reference.type = ReferenceConditions3d::Type::Clamped;
+    o.theory = theory;
+    const FfrBeamModel3d api(BeamMesh3d::straight(kLength, 4, s, Vec3::Zero(), Vec3(0, 1, 0.2)), o, "api");
+    const FfrInvariants3d &a = flexBody(scene).invariants(), &b = api.invariants();
+    const double mscale = MatX(b.mff).cwiseAbs().maxCoeff(), kscale = MatX(b.kff).cwiseAbs().maxCoeff();
+    expectMatrixNear(MatX(a.mff), MatX(b.mff), 1e-14, "m_ff", mscale);
+    expectMatrixNear(MatX(a.kff), MatX(b.kff), 1e-14, "K_ff", kscale);
+    for (int i = 0; i < 3; ++i) {
+      expectMatrixNear(MatX(a.hI[i]), MatX(b.hI[i]), 1e-14, "H_i", mscale);
+      for (int l = 0; l < 3; ++l) expectMatrixNear(MatX(a.rKL[i][l]), MatX(b.rKL[i][l]), 1e-14, "R_kl", mscale);
+    }
+    const Scene ebScene = parseScene(pendulumScene());
+    const FfrInvariants3d& eb = flexBody(ebScene).invariants();
+    EXPECT_GT(MatX(a.mff - eb.mff).cwiseAbs().maxCoeff(), 1e-6 * mscale);  // the rotary inertia
   }
-  const Scene ebScene = parseScene(pendulumScene());
-  const FfrInvariants3d& eb = flexBody(ebScene).invariants();
-  EXPECT_GT(MatX(a.mff - eb.mff).cwiseAbs().maxCoeff(), 1e-6 * mscale);  // the rotary inertia
+  json j = pendulumScene();
+  j["bodies"][0]["beam_theory"] = "shear";
+  expectInputError([&] { parseScene(j); }, {"bodies[0] (\"beam\")", "beam_theory",
+                                            "\"euler_bernoulli\", \"rayleigh\" or \"timoshenko\"", "shear"});
+  // a section given by its constants has no shear factor unless the scene gives one
+  json& sec = j["bodies"][0]["section"];
+  const BeamSection3d s = rectangularSection3d(kWidth, kHeight, kE, kE / (2.0 * (1.0 + kNu)), kRho);
+  sec.erase("width");
+  sec.erase("height");
+  sec["area"] = s.area;
+  sec["inertia_y"] = s.inertiaY;
+  sec["inertia_z"] = s.inertiaZ;
+  sec["torsion_constant"] = s.torsionConstant;
   j["bodies"][0]["beam_theory"] = "timoshenko";
-  expectInputError([&] { parseScene(j); }, {"bodies[0] (\"beam\")", "beam_theory", "\"euler_bernoulli\" or \"rayleigh\"",
-                                            "timoshenko"});
+  expectInputError([&] { parseScene(j); }, {"beam", "Timoshenko", "shear_factor_y"});
+  sec["shear_factor_y"] = 0.85;
+  sec["shear_factor_z"] = 0.85;
+  EXPECT_NO_THROW(parseScene(j));
+  sec["shear_factor_z"] = -1.0;
+  expectInputError([&] { parseScene(j); }, {"shear_factor_z", "must be > 0"});
 }

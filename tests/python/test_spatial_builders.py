@@ -210,6 +210,29 @@ def test_rayleigh_option_lowers_bending_by_the_rotary_inertia():
     assert ratio == pytest.approx(expected, rel=1e-5)
 
 
+def test_timoshenko_option_adds_the_shear_flexibility_of_a_cantilever():
+    # The rectangle's shear factor is Cowper's, kappa = 10 (1 + nu) / (12 + 11 nu); a thick
+    # clamped beam (L/h = 3) is softer under Timoshenko than under Rayleigh by its shear
+    # flexibility (the first frequency ~6 % lower; the closed forms are checked in C++,
+    # tests/test_timoshenko.cpp); a section given by its constants needs the factors.
+    length, width, nu, E = 0.3, 0.1, 0.3, 2.1e11
+    section = flexmbd.rectangular_section_3d(width, width, youngs_modulus=E, poisson_ratio=nu, density=7800.0)
+    assert section.shear_factor_y == pytest.approx(10 * (1 + nu) / (12 + 11 * nu), rel=1e-14)
+    mesh = flexmbd.BeamMesh3d.straight(length, 8, section)
+
+    def first(theory):
+        options = flexmbd.FfrBeamOptions3d(reference=flexmbd.Reference3d.CLAMPED, theory=theory)
+        return flexmbd.FfrBeamModel3d(mesh, options).natural_frequencies()[0]
+
+    assert first(flexmbd.BeamTheory.TIMOSHENKO) < 0.97 * first(flexmbd.BeamTheory.RAYLEIGH)
+    general = flexmbd.BeamSection3d(area=section.area, inertia_y=section.inertia_y, inertia_z=section.inertia_z,
+                                    torsion_constant=section.torsion_constant, youngs_modulus=E, poisson_ratio=nu,
+                                    density=7800.0)
+    options = flexmbd.FfrBeamOptions3d(theory=flexmbd.BeamTheory.TIMOSHENKO)
+    with pytest.raises(flexmbd.InputError, match="shear_factor_y"):
+        flexmbd.FfrBeamModel3d(flexmbd.BeamMesh3d.straight(length, 2, general), options)
+
+
 @pytest.mark.parametrize("call, error, words", [
     (lambda: flexmbd.FrameState3d(position="up"), TypeError, "FrameState3d: position must be 3 numbers"),
     (lambda: flexmbd.FrameState3d(orientation=[[1, 0, 0], [0, 2, 0], [0, 0, 1]]), flexmbd.InputError,
