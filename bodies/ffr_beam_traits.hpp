@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Sparse>
@@ -24,21 +25,28 @@ namespace flexmbd {
 
 using Triplets = std::vector<Eigen::Triplet<double>>;
 
-/// Planar beams: ux, uy, psi per node (body frame), BeamElement2d.
-struct PlanarBeam {
-  static constexpr int kDim = 2;
-  static constexpr int kNodeDofs = 3;
+/// What follows from the dimension alone: a node's coordinates (Dim translations and
+/// 1 or 3 rotations), the two-node element's, points, rotations, options.
+template <int Dim>
+struct BeamDimension {
+  static constexpr int kDim = Dim;
+  static constexpr int kNodeDofs = Dim == 2 ? 3 : 6;
   static constexpr int kElementDofs = 2 * kNodeDofs;
+  using Point = Eigen::Matrix<double, Dim, 1>;
+  using Rotation = Eigen::Matrix<double, Dim, Dim>;
+  using Options = FfrBeamOptionsT<Dim>;
+  using ElementVector = Eigen::Matrix<double, kElementDofs, 1>;
+  using ElementMatrix = Eigen::Matrix<double, kElementDofs, kElementDofs>;
+  /// The rows of an element's nodal coordinates in the body's (node 1, then node 2).
+  using ElementRows = std::array<int, kElementDofs>;
+};
+
+/// Planar beams: ux, uy, psi per node (body frame), BeamElement2d.
+struct PlanarBeam : BeamDimension<2> {
   using Mesh = BeamMesh2d;
   using Element = BeamElement2d;
-  using Point = Vec2;
-  using Rotation = Mat2;
   using Invariants = FfrInvariants;
-  using Options = FfrBeamOptions;
-  using ElementVector = BeamElement2d::Vec6;
-  using ElementMatrix = BeamElement2d::Mat6;
   using SectionForces = Vec2;  ///< axial force, bending moment
-  using ElementRows = std::array<int, kElementDofs>;
   /// Name of a node's coordinate k: u_x, u_y, psi.
   static const char* nodeDofName(int k);
   /// How errors name reference node A or B ("node"; spatial: "node A", "node B").
@@ -85,20 +93,11 @@ struct PlanarBeam {
 };
 
 /// Spatial beams: ux, uy, uz, thx, thy, thz per node (body frame), BeamElement3d.
-struct SpatialBeam {
-  static constexpr int kDim = 3;
-  static constexpr int kNodeDofs = 6;
-  static constexpr int kElementDofs = 2 * kNodeDofs;
+struct SpatialBeam : BeamDimension<3> {
   using Mesh = BeamMesh3d;
   using Element = BeamElement3d;
-  using Point = Vec3;
-  using Rotation = Mat3;
   using Invariants = FfrInvariants3d;
-  using Options = FfrBeamOptions3d;
-  using ElementVector = BeamElement3d::Vec12;
-  using ElementMatrix = BeamElement3d::Mat12;
   using SectionForces = BeamSectionForces3d;
-  using ElementRows = std::array<int, kElementDofs>;
   /// Name of a node's coordinate k: u_x, u_y, u_z, theta_x, theta_y, theta_z.
   static const char* nodeDofName(int k);
   static const char* referenceNodeName(char which) { return which == 'A' ? "node A" : "node B"; }
@@ -140,5 +139,9 @@ struct SpatialBeam {
   /// Body-axis section rotation shape C (twist, -dw_z/dx, dw_y/dx) (3 x 12).
   static Eigen::Matrix<double, 3, kElementDofs> rotationShape(const Element& el, double xi);
 };
+
+static_assert(std::is_same_v<PlanarBeam::ElementVector, BeamElement2d::Vec6> &&
+                  std::is_same_v<SpatialBeam::ElementMatrix, BeamElement3d::Mat12>,
+              "the elements' nodal coordinates are the two nodes' (BeamDimension)");
 
 }  // namespace flexmbd

@@ -73,6 +73,14 @@ ConstraintIndex lookupJoint(const System& sys, const std::string& name, const Ob
   r.fail("unknown joint " + inQuotes(name) + " (known joints: " + (known.empty() ? "none" : join(known)) + ")");
 }
 
+SpringDamperLaw readSpringDamperLaw(const ObjectReader& r, const std::function<double()>& initialLength) {
+  SpringDamperLaw law;
+  law.stiffness = r.nonNegative("stiffness");
+  law.damping = r.nonNegative("damping", 0.0);
+  law.freeLength = r.has("free_length") ? r.nonNegative("free_length") : located(r.where(), initialLength);
+  return law;
+}
+
 }  // namespace scenereaders
 
 namespace {
@@ -267,21 +275,14 @@ void parseForce(const json& j, const std::string& where, System& sys) {
     const std::string name = r.name("name");
     const auto [bi, bj] = lookupBodyPair(sys, r, "a spring");
     const auto points = r.pointPair("points");
-    const double stiffness = r.nonNegative("stiffness");
-    const double damping = r.nonNegative("damping", 0.0);
-    double freeLength = 0.0;
-    if (r.has("free_length")) {
-      freeLength = r.nonNegative("free_length");
-    } else {
-      freeLength = located(r.where(), [&] {
-        const Body& a = sys.body(bi);
-        const Body& b = sys.body(bj);
-        return (b.pointKinematics(b.initialCoordinates(), points[1]).r -
-                a.pointKinematics(a.initialCoordinates(), points[0]).r).norm();
-      });
-    }
+    const scenereaders::SpringDamperLaw law = scenereaders::readSpringDamperLaw(r, [&] {
+      const Body& a = sys.body(bi);
+      const Body& b = sys.body(bj);
+      return (b.pointKinematics(b.initialCoordinates(), points[1]).r -
+              a.pointKinematics(a.initialCoordinates(), points[0]).r).norm();
+    });
     located(r.where(), [&] {
-      return addSpringDamper(sys, name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
+      return addSpringDamper(sys, name, bi, points[0], bj, points[1], law.stiffness, law.damping, law.freeLength);
     });
   } else if (type == "rotational_spring_damper") {
     r.allowOnly(scenekeys::kRotationalSpringDamper, forA);

@@ -452,19 +452,13 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
     const MatX P = r.matrix("points");
     if (P.cols() != 3) r.fail("key \"points\" must be two points [[xi, yi, zi], [xj, yj, zj]]");
     const Vec3 pi = P.row(0).transpose(), pj = P.row(1).transpose();
-    const double stiffness = r.nonNegative("stiffness");
-    const double damping = r.nonNegative("damping", 0.0);
-    double freeLength = 0.0;
-    if (r.has("free_length")) {
-      freeLength = r.nonNegative("free_length");
-    } else {
-      freeLength = located(r.where(), [&] {
-        return (sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj).r -
-                sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi).r).norm();
-      });
-    }
+    const SpringDamperLaw law = readSpringDamperLaw(r, [&] {
+      return (sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj).r -
+              sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi).r).norm();
+    });
     located(r.where(), [&] {
-      return sys.addForce(std::make_unique<SpatialSpringDamper>(name, bi, pi, bj, pj, stiffness, damping, freeLength));
+      return sys.addForce(
+          std::make_unique<SpatialSpringDamper>(name, bi, pi, bj, pj, law.stiffness, law.damping, law.freeLength));
     });
     return;
   }
