@@ -8,28 +8,21 @@
 #include <string>
 #include <vector>
 
-#include "core/types.hpp"
+#include "bodies/ffr_invariants_base.hpp"
 
 namespace flexmbd {
 
-/// A material point of the body where joints and forces attach (a node): undeformed
-/// position u0 (body frame), u = u0 + N q_f, and the small rotation of its cross-section
-/// theta = Ntheta q_f (body axes): the section's axes in the body frame are
-/// (I + skew(theta)) to first order in q_f, as the element's small nodal rotations.
-struct FfrPoint3d {
-  Vec3 position = Vec3::Zero();
-  Mat3X shape;          ///< N, 3 x nf (translation shape matrix)
-  Mat3X rotationShape;  ///< Ntheta, 3 x nf
-};
+/// A spatial attachment point: position u0, shape N (3 x nf), rotation shape Ntheta
+/// (3 x nf, body axes).
+using FfrPoint3d = FfrPointT<3>;
 
 /// With u(P) = u0(P) + N(P) q_f the body-frame position of a material point P, all
-/// integrals over the undeformed body (dV, density rho):
-struct FfrInvariants3d {
-  double mass = 0.0;                        ///< m = int rho dV
-  Vec3 firstMoment = Vec3::Zero();          ///< int rho u0 dV
+/// integrals over the undeformed body (dV, density rho); besides the shared mass, first
+/// moment, S-bar, m_ff = S_xx + S_yy + S_zz, K_ff, D_ff and points
+/// (bodies/ffr_invariants_base.hpp):
+struct FfrInvariants3d : FfrInvariantsBase<3> {
   Mat3 secondMoment = Mat3::Zero();         ///< int rho u0 u0^T dV (the inertia tensor about
                                             ///< the frame origin is tr(.) I - (.))
-  Mat3X sBar;                               ///< S-bar = int rho N dV (3 x nf)
   /// positionShape[k] (3 x nf): row l = int rho u0_k N_l dV (N_l row l of N), k, l in
   /// {x, y, z}: the coupling of the undeformed geometry with the deformation.
   std::array<Mat3X, 3> positionShape;
@@ -46,12 +39,7 @@ struct FfrInvariants3d {
   /// sections' second-order displacement (BeamElement3d::sectionRotationCoupling): the
   /// kinetic energy gains w . (qf^T H_i qf')_i. Empty: none (zero under Euler-Bernoulli).
   std::array<SpMat, 3> hI;
-  SpMat mff;                                ///< m_ff = S_xx + S_yy + S_zz
-  SpMat kff;                                ///< stiffness under the reference conditions
-  SpMat dff;                                ///< damping
-  std::vector<FfrPoint3d> points;           ///< attachment points (nodes)
 
-  int numElastic() const { return static_cast<int>(mff.rows()); }
   /// Sizes; symmetry of m_ff, K_ff, D_ff, S_kk; S_lk = S_kl^T; positive definiteness of
   /// m_ff and K_ff; D_ff positive semi-definite; the second moment symmetric positive
   /// semi-definite with |first moment|^2 <= m tr(second moment); finite entries.
@@ -61,8 +49,12 @@ struct FfrInvariants3d {
   void validateSectionRotation(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
   FfrInvariants3d transformed(const SpMat& P) const;
-  /// The elastic coordinates the point's shape and rotation shape depend on (ascending).
-  static std::vector<int> support(const FfrPoint3d& p);
+
+ private:
+  /// S_lk = S_kl^T (k < l) to 1e-10 max |m_ff|.
+  void validateTransposedPairs(const std::string& owner) const;
+  /// The second moment symmetric positive semi-definite, m tr(J) >= |first moment|^2.
+  void validateSecondMoment(const std::string& owner) const;
 };
 
 }  // namespace flexmbd

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 
 namespace flexmbd {
 
@@ -44,24 +45,57 @@ VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolera
   return cod.solve(G.transpose() * lambda);
 }
 
-MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent) {
+namespace {
+
+/// C = [C_d C_i] split at the r pivot columns d of a full-pivoting LU, and the
+/// eliminated coordinates q_d = X q_i, X = -C_d^{-1} C_i.
+struct NullSpaceSplit {
+  std::vector<int> pivots, free;
+  MatX X;
+};
+
+NullSpaceSplit splitAtPivots(const MatX& C) {
   const int r = static_cast<int>(C.rows()), n = static_cast<int>(C.cols());
   const Eigen::FullPivLU<MatX> lu(C);
-  std::vector<int> pivots(r), free;
-  for (int k = 0; k < r; ++k) pivots[k] = lu.permutationQ().indices()[k];
+  NullSpaceSplit s;
+  s.pivots.resize(r);
+  for (int k = 0; k < r; ++k) s.pivots[k] = lu.permutationQ().indices()[k];
   std::vector<bool> isPivot(n, false);
-  for (int p : pivots) isPivot[p] = true;
+  for (int p : s.pivots) isPivot[p] = true;
   for (int j = 0; j < n; ++j) {
-    if (!isPivot[j]) free.push_back(j);
+    if (!isPivot[j]) s.free.push_back(j);
   }
-  MatX Cd(r, r), Ci(r, free.size());
-  for (int k = 0; k < r; ++k) Cd.col(k) = C.col(pivots[k]);
-  for (size_t k = 0; k < free.size(); ++k) Ci.col(k) = C.col(free[k]);
-  const MatX X = -Cd.fullPivLu().solve(Ci);  // q_d = X q_i
-  MatX B = MatX::Zero(n, free.size());
-  for (size_t k = 0; k < free.size(); ++k) B(free[k], k) = 1.0;
-  for (int k = 0; k < r; ++k) B.row(pivots[k]) = X.row(k);
-  if (independent) *independent = free;
+  MatX Cd(r, r), Ci(r, s.free.size());
+  for (int k = 0; k < r; ++k) Cd.col(k) = C.col(s.pivots[k]);
+  for (size_t k = 0; k < s.free.size(); ++k) Ci.col(k) = C.col(s.free[k]);
+  s.X = -Cd.fullPivLu().solve(Ci);  // q_d = X q_i
+  return s;
+}
+
+}  // namespace
+
+MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent) {
+  const NullSpaceSplit s = splitAtPivots(C);
+  MatX B = MatX::Zero(C.cols(), s.free.size());
+  for (size_t k = 0; k < s.free.size(); ++k) B(s.free[k], k) = 1.0;
+  for (size_t k = 0; k < s.pivots.size(); ++k) B.row(s.pivots[k]) = s.X.row(k);
+  if (independent) *independent = s.free;
+  return B;
+}
+
+SpMat sparseNullSpaceBasis(const MatX& C) {
+  const NullSpaceSplit s = splitAtPivots(C);
+  const MatX& X = s.X;
+  const double drop = 1e-14 * (X.size() > 0 ? X.cwiseAbs().maxCoeff() : 0.0);
+  std::vector<Eigen::Triplet<double>> t;
+  for (size_t k = 0; k < s.free.size(); ++k) t.emplace_back(s.free[k], static_cast<int>(k), 1.0);
+  for (size_t k = 0; k < s.pivots.size(); ++k) {
+    for (int j = 0; j < X.cols(); ++j) {
+      if (std::abs(X(k, j)) > drop) t.emplace_back(s.pivots[k], j, X(k, j));
+    }
+  }
+  SpMat B(C.cols(), static_cast<Eigen::Index>(s.free.size()));
+  B.setFromTriplets(t.begin(), t.end());
   return B;
 }
 

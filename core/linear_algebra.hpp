@@ -35,5 +35,9 @@ VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolera
 /// a full-pivoting LU), q_d = -C_d^{-1} C_i q_i, B = P [-C_d^{-1} C_i; I].
 /// `independent` receives the kept coordinates (the columns of B are unit vectors there).
 MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent = nullptr);
+/// The same basis, sparse, built without the dense n x (n - r) matrix (cost O(r^2 n)):
+/// n - r unit columns and the r eliminated rows, entries below 1e-14 max |C_d^{-1} C_i|
+/// dropped (the beam models' B2, bodies/ffr_beam_model.cpp).
+SpMat sparseNullSpaceBasis(const MatX& C);
 
 }  // namespace flexmbd

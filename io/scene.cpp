@@ -5,7 +5,7 @@
 #include "io/scene.hpp"
 
 #include "io/json_reader.hpp"
-#include "io/beam_model_reader.hpp"
+#include "io/flexible_body_reader.hpp"
 #include "io/scene_keys.hpp"
 #include "io/spatial_scene.hpp"
 
@@ -19,6 +19,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -72,6 +73,14 @@ ConstraintIndex lookupJoint(const System& sys, const std::string& name, const Ob
   r.fail("unknown joint " + inQuotes(name) + " (known joints: " + (known.empty() ? "none" : join(known)) + ")");
 }
 
+SpringDamperLaw readSpringDamperLaw(const ObjectReader& r, const std::function<double()>& initialLength) {
+  SpringDamperLaw law;
+  law.stiffness = r.nonNegative("stiffness");
+  law.damping = r.nonNegative("damping", 0.0);
+  law.freeLength = r.has("free_length") ? r.nonNegative("free_length") : located(r.where(), initialLength);
+  return law;
+}
+
 }  // namespace scenereaders
 
 namespace {
@@ -79,10 +88,6 @@ namespace {
 using scenereaders::lookupBody;
 using scenereaders::lookupBodyPair;
 using scenereaders::lookupJoint;
-
-/// Most elements of one flexible body: its 3 (n + 1) nodal coordinates enter dense
-/// matrices, 72 MB and some 10 s per factorisation at 1,000 elements.
-constexpr long kMaxElements = 1000;
 
 using nlohmann::json;
 using namespace jsonread;
@@ -98,33 +103,19 @@ double initialJointAngle(const System& sys, ConstraintIndex joint) {
          bi.pointKinematics(bi.initialCoordinates(), c.pointI()).phi;
 }
 
-// ----- sections --------------------------------------------------------------------------
+// ----- bodies ----------------------------------------------------------------------------
 
-/// The optional initial elastic state of a flexible body (default zero): keys
-/// "elastic_coordinates" and "elastic_velocities", one number per elastic coordinate.
-struct ElasticState {
-  std::optional<VecX> q, qDot;
-};
-
-ElasticState readElasticState(const ObjectReader& r) {
-  ElasticState s;
-  if (r.has("elastic_coordinates")) s.q = r.vector("elastic_coordinates");
-  if (r.has("elastic_velocities")) s.qDot = r.vector("elastic_velocities");
-  return s;
-}
-
-/// Called inside located(): the message gets the body's location in front.
-void setInitialElasticState(const ElasticState& s, FfrBody2d& body) {
-  const int nf = body.numElastic();
-  auto sized = [&](const std::optional<VecX>& v, const char* key) -> VecX {
-    if (!v) return VecX::Zero(nf);
-    if (v->size() != nf) {
-      throw InputError("key " + inQuotes(key) + " must list " + std::to_string(nf) +
-                       " numbers (one per elastic coordinate of this body), got " + std::to_string(v->size()));
-    }
-    return *v;
-  };
-  body.setInitialElasticState(sized(s.q, "elastic_coordinates"), sized(s.qDot, "elastic_velocities"));
+/// Adds the planar flexible body `make()` with the initial elastic state of keys
+/// "elastic_coordinates" and "elastic_velocities" (default zero; `nf` numbers each).
+template <class MakeBody>
+void addFlexibleBody(const ObjectReader& r, int nf, System& sys, MakeBody make) {
+  const VecX q = scenereaders::readElasticState(r, "elastic_coordinates", nf);
+  const VecX qDot = scenereaders::readElasticState(r, "elastic_velocities", nf);
+  located(r.where(), [&] {
+    std::unique_ptr<FfrBody2d> body = make();
+    body->setInitialElasticState(q, qDot);
+    return sys.addBody(std::move(body));
+  });
 }
 
 FrameState2d parseFrameState(const ObjectReader& r) {
@@ -156,36 +147,14 @@ BeamSection parseSection(const json& j, const std::string& where) {
 void parseFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
   r.allowOnly(scenekeys::kFlexibleBody, " for a flexible body");
   const BeamSection section = parseSection(r.object("section"), r.where() + ": section");
-  BeamMesh2d mesh;
-  if (r.has("beam")) {
-    if (r.has("nodes") || r.has("elements")) r.fail("give either \"beam\" or \"nodes\" and \"elements\", not both");
-    const ObjectReader b(r.object("beam"), r.where() + ": beam");
-    b.allowOnly(scenekeys::kBeam);
-    const double length = b.positive("length");
-    const int n = static_cast<int>(b.integer("elements", 1, 1, kMaxElements));
-    mesh = located(b.where(), [&] { return BeamMesh2d::straight(length, n, section, b.vec2("origin", Vec2::Zero())); });
-  } else {
-    const MatX nodes = r.matrix("nodes");
-    if (nodes.cols() != 2 || nodes.rows() < 2) r.fail("key \"nodes\" must list at least two points [[x, y], ...]");
-    for (int i = 0; i < nodes.rows(); ++i) mesh.nodes.push_back(nodes.row(i).transpose());
-    const json& els = r.required("elements");
-    if (!els.is_array() || els.empty()) r.fail("key \"elements\" must be a non-empty array of node pairs [[i, j], ...]");
-    for (std::size_t e = 0; e < els.size(); ++e) {
-      const std::string label = "elements[" + std::to_string(e) + "]";
-      if (!els[e].is_array() || els[e].size() != 2) r.fail("key " + inQuotes(label) + " must be a node pair [i, j], got " + describe(els[e]));
-      mesh.elements.push_back({r.index(els[e][0], label + "[0]"), r.index(els[e][1], label + "[1]"), section});
-    }
-  }
+  BeamMesh2d mesh = scenereaders::readBeamMesh<BeamMesh2d>(r, {0, 0, section}, scenekeys::kBeam, "");
   FfrBeamOptions options;
   scenereaders::readBeamModelOptions(r, static_cast<int>(mesh.nodes.size()), options);
   const FrameState2d init = parseFrameState(r);
-  const ElasticState elastic = readElasticState(r);
-  located(r.where(), [&] {
-    auto model = std::make_shared<FfrBeamModel>(std::move(mesh), options, "body '" + name + "'");
-    auto body = std::make_unique<FfrBody2d>(name, model, init);
-    setInitialElasticState(elastic, *body);
-    return sys.addBody(std::move(body));
+  const auto model = located(r.where(), [&] {
+    return std::make_shared<const FfrBeamModel>(std::move(mesh), options, "body '" + name + "'");
   });
+  addFlexibleBody(r, model->numElastic(), sys, [&] { return std::make_unique<FfrBody2d>(name, model, init); });
 }
 
 void parseInvariantBody(const ObjectReader& r, const std::string& name, System& sys) {
@@ -198,52 +167,37 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
   inv.polarMoment = iv.positive("polar_moment");
   const MatX mff = iv.matrix("m_ff");
   const int nf = static_cast<int>(mff.rows());
-  const auto sized = [&](MatX m, const char* key, int rows, int cols) {
-    if (m.rows() != rows || m.cols() != cols) {
-      iv.fail("key " + inQuotes(key) + " must be a " + std::to_string(rows) + " x " + std::to_string(cols) +
-              " matrix (" + std::to_string(nf) + " elastic coordinates, from m_ff), got " + std::to_string(m.rows()) +
-              " x " + std::to_string(m.cols()));
-    }
-    return m;
-  };
-  inv.mff = sized(mff, "m_ff", nf, nf).sparseView(1.0, 0.0);
-  inv.sBar = sized(iv.matrix("s_bar"), "s_bar", 2, nf);
-  inv.i1 = sized(iv.vector("i1"), "i1", nf, 1);
-  inv.j0 = sized(iv.vector("j0"), "j0", nf, 1);
-  inv.sTilde = sized(iv.matrix("s_tilde"), "s_tilde", nf, nf).sparseView(1.0, 0.0);
-  inv.kff = sized(iv.matrix("k_ff"), "k_ff", nf, nf).sparseView(1.0, 0.0);
-  inv.dff = (iv.has("d_ff") ? sized(iv.matrix("d_ff"), "d_ff", nf, nf) : MatX::Zero(nf, nf)).sparseView(1.0, 0.0);
+  using scenereaders::readSquareInvariant;
+  using scenereaders::sizedMatrix;
+  inv.mff = readSquareInvariant(iv, "m_ff", nf);
+  inv.sBar = scenereaders::readSizedMatrix(iv, "s_bar", 2, nf, nf);
+  inv.i1 = sizedMatrix(iv, "i1", iv.vector("i1"), nf, 1, nf);
+  inv.j0 = sizedMatrix(iv, "j0", iv.vector("j0"), nf, 1, nf);
+  inv.sTilde = readSquareInvariant(iv, "s_tilde", nf);
+  inv.kff = readSquareInvariant(iv, "k_ff", nf);
+  inv.dff = readSquareInvariant(iv, "d_ff", nf, true);
   const json& pts = iv.array("points");
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const ObjectReader p(pts[k], iv.where() + ": points[" + std::to_string(k) + "]");
     p.allowOnly(scenekeys::kInvariantsPoint);
     FfrPoint fp;
     fp.position = p.vec2("position");
-    fp.shape = p.matrix("shape");
-    fp.rotationShape = p.vector("rotation_shape").transpose();
-    if (fp.shape.rows() != 2 || fp.shape.cols() != nf || fp.rotationShape.size() != nf) {
+    const MatX shape = p.matrix("shape");  // checked before it goes into the 2-row N
+    const VecX rotationShape = p.vector("rotation_shape");
+    if (shape.rows() != 2 || shape.cols() != nf || rotationShape.size() != nf) {
       p.fail("\"shape\" must be 2 x " + std::to_string(nf) + " and \"rotation_shape\" " + std::to_string(nf) + " numbers");
     }
+    fp.shape = shape;
+    fp.rotationShape = rotationShape.transpose();
     inv.points.push_back(fp);
   }
   const FrameState2d init = parseFrameState(r);
-  const ElasticState elastic = readElasticState(r);
-  located(r.where(), [&] {
-    auto body = std::make_unique<FfrBody2d>(name, std::move(inv), init);
-    setInitialElasticState(elastic, *body);
-    return sys.addBody(std::move(body));
-  });
+  addFlexibleBody(r, nf, sys, [&] { return std::make_unique<FfrBody2d>(name, std::move(inv), init); });
 }
 
 void parseBody(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
-  r.peekName();
-  const std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants"});
-  const std::string name = r.name("name");
-  if (name == "ground") {
-    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
-           "in joints, do not define it)");
-  }
+  const auto [type, name] = scenereaders::readBodyTypeAndName(r);
   if (type == "flexible") return parseFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody, " for a rigid body");
@@ -321,21 +275,14 @@ void parseForce(const json& j, const std::string& where, System& sys) {
     const std::string name = r.name("name");
     const auto [bi, bj] = lookupBodyPair(sys, r, "a spring");
     const auto points = r.pointPair("points");
-    const double stiffness = r.nonNegative("stiffness");
-    const double damping = r.nonNegative("damping", 0.0);
-    double freeLength = 0.0;
-    if (r.has("free_length")) {
-      freeLength = r.nonNegative("free_length");
-    } else {
-      freeLength = located(r.where(), [&] {
-        const Body& a = sys.body(bi);
-        const Body& b = sys.body(bj);
-        return (b.pointKinematics(b.initialCoordinates(), points[1]).r -
-                a.pointKinematics(a.initialCoordinates(), points[0]).r).norm();
-      });
-    }
+    const scenereaders::SpringDamperLaw law = scenereaders::readSpringDamperLaw(r, [&] {
+      const Body& a = sys.body(bi);
+      const Body& b = sys.body(bj);
+      return (b.pointKinematics(b.initialCoordinates(), points[1]).r -
+              a.pointKinematics(a.initialCoordinates(), points[0]).r).norm();
+    });
     located(r.where(), [&] {
-      return addSpringDamper(sys, name, bi, points[0], bj, points[1], stiffness, damping, freeLength);
+      return addSpringDamper(sys, name, bi, points[0], bj, points[1], law.stiffness, law.damping, law.freeLength);
     });
   } else if (type == "rotational_spring_damper") {
     r.allowOnly(scenekeys::kRotationalSpringDamper, forA);

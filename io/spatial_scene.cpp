@@ -9,7 +9,7 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "bodies/shape_inertia.hpp"
-#include "io/beam_model_reader.hpp"
+#include "io/flexible_body_reader.hpp"
 #include "builders/planar_builders.hpp"
 #include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
@@ -115,9 +115,6 @@ const SpatialJoint& spatialJoint(const System& sys, ConstraintIndex c, const Obj
   return *joint;
 }
 
-/// Most elements of one spatial flexible body (6 (n + 1) nodal coordinates).
-constexpr long kMaxElements3d = 1000;
-
 /// The frame state of a spatial body: "position", "orientation", "velocity" (world) and
 /// "angular_velocity" (body axes).
 FrameState3d parseFrameState3d(const ObjectReader& r) {
@@ -173,48 +170,11 @@ BeamSection3d parseSection3d(const json& j, const std::string& where) {
   return s;
 }
 
-/// Key `key` as `n` numbers (one per elastic coordinate), or zeros if absent.
-VecX elasticState(const ObjectReader& r, const char* key, int n) {
-  if (!r.has(key)) return VecX::Zero(n);
-  const VecX v = r.vector(key);
-  if (v.size() != n) {
-    r.fail("key " + inQuotes(key) + " must list " + std::to_string(n) +
-           " numbers (one per elastic coordinate of this body), got " + std::to_string(v.size()));
-  }
-  return v;
-}
-
 void parseSpatialFlexibleBody(const ObjectReader& r, const std::string& name, System& sys) {
   r.allowOnly(scenekeys::kFlexibleBody3d, " for a flexible body in a spatial scene");
   const BeamSection3d section = parseSection3d(r.object("section"), r.where() + ": section");
   const Vec3 yHint = vec3(r, "y_axis", Vec3::UnitY());
-  BeamMesh3d mesh;
-  if (r.has("beam")) {
-    if (r.has("nodes") || r.has("elements")) r.fail("give either \"beam\" or \"nodes\" and \"elements\", not both");
-    const ObjectReader b(r.object("beam"), r.where() + ": beam");
-    b.allowOnly(scenekeys::kBeam3d, " for a spatial beam");
-    const double length = b.positive("length");
-    const int n = static_cast<int>(b.integer("elements", 1, 1, kMaxElements3d));
-    const Vec3 origin = vec3(b, "origin", Vec3::Zero());
-    mesh = located(b.where(), [&] { return BeamMesh3d::straight(length, n, section, origin, yHint); });
-  } else {
-    const MatX nodes = r.matrix("nodes");
-    if (nodes.cols() != 3 || nodes.rows() < 2) r.fail("key \"nodes\" must list at least two points [[x, y, z], ...]");
-    for (int i = 0; i < nodes.rows(); ++i) mesh.nodes.push_back(nodes.row(i).transpose());
-    const json& els = r.required("elements");
-    if (!els.is_array() || els.empty()) r.fail("key \"elements\" must be a non-empty array of node pairs [[i, j], ...]");
-    if (static_cast<long>(els.size()) > kMaxElements3d) {
-      r.fail("key \"elements\" lists " + std::to_string(els.size()) + " elements; at most " +
-             std::to_string(kMaxElements3d) + " per body");
-    }
-    for (std::size_t e = 0; e < els.size(); ++e) {
-      const std::string label = "elements[" + std::to_string(e) + "]";
-      if (!els[e].is_array() || els[e].size() != 2) {
-        r.fail("key " + inQuotes(label) + " must be a node pair [i, j], got " + describe(els[e]));
-      }
-      mesh.elements.push_back({r.index(els[e][0], label + "[0]"), r.index(els[e][1], label + "[1]"), section, yHint});
-    }
-  }
+  BeamMesh3d mesh = readBeamMesh<BeamMesh3d>(r, {0, 0, section, yHint}, scenekeys::kBeam3d, " for a spatial beam");
   FfrBeamOptions3d options;
   readBeamModelOptions(r, static_cast<int>(mesh.nodes.size()), options);
   const FrameState3d init = parseFrameState3d(r);
@@ -222,19 +182,9 @@ void parseSpatialFlexibleBody(const ObjectReader& r, const std::string& name, Sy
     return std::make_shared<const FfrBeamModel3d>(std::move(mesh), options, "body '" + name + "'");
   });
   const int nf = model->numElastic();
-  const VecX qf0 = elasticState(r, "elastic_coordinates", nf), qf0dot = elasticState(r, "elastic_velocities", nf);
+  const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
+  const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
   located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody3d>(name, model, init, qf0, qf0dot)); });
-}
-
-/// A matrix key of the invariants with the given size.
-MatX sizedMatrix(const ObjectReader& iv, const char* key, int rows, int cols, int nf) {
-  const MatX m = iv.matrix(key);
-  if (m.rows() != rows || m.cols() != cols) {
-    iv.fail("key " + inQuotes(key) + " must be a " + std::to_string(rows) + " x " + std::to_string(cols) + " matrix (" +
-            std::to_string(nf) + " elastic coordinates, from m_ff), got " + std::to_string(m.rows()) + " x " +
-            std::to_string(m.cols()));
-  }
-  return m;
 }
 
 void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, System& sys) {
@@ -246,15 +196,15 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   inv.firstMoment = iv.vector("first_moment", 3);
   const MatX mff = iv.matrix("m_ff");
   const int nf = static_cast<int>(mff.rows());
-  inv.secondMoment = sizedMatrix(iv, "second_moment", 3, 3, nf);
-  inv.mff = sizedMatrix(iv, "m_ff", nf, nf, nf).sparseView(1.0, 0.0);
-  inv.sBar = sizedMatrix(iv, "s_bar", 3, nf, nf);
+  inv.secondMoment = readSizedMatrix(iv, "second_moment", 3, 3, nf);
+  inv.mff = readSquareInvariant(iv, "m_ff", nf);
+  inv.sBar = readSizedMatrix(iv, "s_bar", 3, nf, nf);
   static const char* const kPositionShape[3] = {"position_shape_x", "position_shape_y", "position_shape_z"};
-  for (int k = 0; k < 3; ++k) inv.positionShape[k] = sizedMatrix(iv, kPositionShape[k], 3, nf, nf);
+  for (int k = 0; k < 3; ++k) inv.positionShape[k] = readSizedMatrix(iv, kPositionShape[k], 3, nf, nf);
   static const char* const kSkl[3][3] = {{"s_xx", "s_xy", "s_xz"}, {nullptr, "s_yy", "s_yz"}, {nullptr, nullptr, "s_zz"}};
   for (int k = 0; k < 3; ++k) {
     for (int l = k; l < 3; ++l) {
-      inv.sKL[k][l] = sizedMatrix(iv, kSkl[k][l], nf, nf, nf).sparseView(1.0, 0.0);
+      inv.sKL[k][l] = readSquareInvariant(iv, kSkl[k][l], nf);
       if (l != k) inv.sKL[l][k] = SpMat(inv.sKL[k][l].transpose());  // S_lk = S_kl^T
     }
   }
@@ -263,28 +213,29 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   for (int k = 0; k < 3; ++k) {
     for (int l = k; l < 3; ++l) {
       if (!iv.has(kRkl[k][l])) continue;
-      inv.rKL[k][l] = sizedMatrix(iv, kRkl[k][l], nf, nf, nf).sparseView(1.0, 0.0);
+      inv.rKL[k][l] = readSquareInvariant(iv, kRkl[k][l], nf);
       if (l != k) inv.rKL[l][k] = inv.rKL[k][l];  // R_lk = R_kl
     }
   }
   static const char* const kH[3] = {"h_x", "h_y", "h_z"};
   for (int i = 0; i < 3; ++i) {
-    if (iv.has(kH[i])) inv.hI[i] = sizedMatrix(iv, kH[i], nf, nf, nf).sparseView(1.0, 0.0);
+    if (iv.has(kH[i])) inv.hI[i] = readSquareInvariant(iv, kH[i], nf);
   }
-  inv.kff = sizedMatrix(iv, "k_ff", nf, nf, nf).sparseView(1.0, 0.0);
-  inv.dff = (iv.has("d_ff") ? sizedMatrix(iv, "d_ff", nf, nf, nf) : MatX::Zero(nf, nf)).sparseView(1.0, 0.0);
+  inv.kff = readSquareInvariant(iv, "k_ff", nf);
+  inv.dff = readSquareInvariant(iv, "d_ff", nf, true);
   const json& pts = iv.array("points");
   for (std::size_t k = 0; k < pts.size(); ++k) {
     const ObjectReader p(pts[k], iv.where() + ": points[" + std::to_string(k) + "]");
     p.allowOnly(scenekeys::kInvariantsPoint3d, " for a point of spatial invariants");
     FfrPoint3d fp;
     fp.position = p.vector("position", 3);
-    fp.shape = sizedMatrix(p, "shape", 3, nf, nf);
-    fp.rotationShape = sizedMatrix(p, "rotation_shape", 3, nf, nf);
+    fp.shape = readSizedMatrix(p, "shape", 3, nf, nf);
+    fp.rotationShape = readSizedMatrix(p, "rotation_shape", 3, nf, nf);
     inv.points.push_back(fp);
   }
   const FrameState3d init = parseFrameState3d(r);
-  const VecX qf0 = elasticState(r, "elastic_coordinates", nf), qf0dot = elasticState(r, "elastic_velocities", nf);
+  const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
+  const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
   located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody3d>(name, std::move(inv), init, qf0, qf0dot)); });
 }
 
@@ -358,13 +309,7 @@ Mat3 parseOrientation(const json& j, const std::string& where) {
 
 void parseSpatialBody(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
-  r.peekName();
-  const std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants"});
-  const std::string name = r.name("name");
-  if (name == "ground") {
-    r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "
-           "in joints, do not define it)");
-  }
+  const auto [type, name] = readBodyTypeAndName(r);
   if (type == "flexible") return parseSpatialFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseSpatialInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");
@@ -514,19 +459,13 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
     const MatX P = r.matrix("points");
     if (P.cols() != 3) r.fail("key \"points\" must be two points [[xi, yi, zi], [xj, yj, zj]]");
     const Vec3 pi = P.row(0).transpose(), pj = P.row(1).transpose();
-    const double stiffness = r.nonNegative("stiffness");
-    const double damping = r.nonNegative("damping", 0.0);
-    double freeLength = 0.0;
-    if (r.has("free_length")) {
-      freeLength = r.nonNegative("free_length");
-    } else {
-      freeLength = located(r.where(), [&] {
-        return (sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj).r -
-                sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi).r).norm();
-      });
-    }
+    const SpringDamperLaw law = readSpringDamperLaw(r, [&] {
+      return (sys.body(bj).frameKinematics(sys.body(bj).initialCoordinates(), pj).r -
+              sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pi).r).norm();
+    });
     located(r.where(), [&] {
-      return sys.addForce(std::make_unique<SpatialSpringDamper>(name, bi, pi, bj, pj, stiffness, damping, freeLength));
+      return sys.addForce(
+          std::make_unique<SpatialSpringDamper>(name, bi, pi, bj, pj, law.stiffness, law.damping, law.freeLength));
     });
     return;
   }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -19,6 +20,13 @@ ConstraintIndex lookupJoint(const System& sys, const std::string& name, const js
 /// The two different bodies of key "bodies" ["I", "J"]; `what` names the element in the
 /// message ("a joint connects two different bodies").
 std::array<BodyIndex, 2> lookupBodyPair(const System& sys, const jsonread::ObjectReader& r, const std::string& what);
+
+/// Keys "stiffness", "damping" (default 0) and "free_length" of a spring-damper, the
+/// free length by default `initialLength()` (the points' distance in the initial positions).
+struct SpringDamperLaw {
+  double stiffness = 0.0, damping = 0.0, freeLength = 0.0;
+};
+SpringDamperLaw readSpringDamperLaw(const jsonread::ObjectReader& r, const std::function<double()>& initialLength);
 
 /// A rotation from an "orientation" object: {"quaternion": [e0, e1, e2, e3]} (normalised),
 /// {"axis": [x, y, z], "angle": a} (radians) or {"matrix": [[...], [...], [...]]} (rows;
