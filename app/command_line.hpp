@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "core/stop_request.hpp"
 #include "integrators/simulation.hpp"
 
 namespace flexmbd::cli {
@@ -49,6 +50,22 @@ inline void stopIfSignalled(double t) {
                          sig);
   }
 }
+
+/// The stop check of the inner loops (core/stop_request.hpp): a signal stops the run
+/// within the step it is computing, the rows up to the last output kept.
+inline void stopIfSignalledInStep(double t) {
+  if (const int sig = gStopSignal) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.10g", t);
+    throw RunInterrupted("interrupted by " + signalName(sig) + " while computing t = " + buf, sig);
+  }
+}
+
+/// While it lives: SIGINT and SIGTERM stop the calling thread's run within its step.
+struct StopOnSignals {
+  StopOnSignals() { installStopHandlers(); }
+  StopPollScope poll{stopIfSignalledInStep};
+};
 
 /// A bad command line (exit status 2).
 struct UsageError : std::runtime_error {

@@ -26,6 +26,7 @@
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
+#include "io/output_lock.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
@@ -217,6 +218,14 @@ int runCommand(const Options& o) {
     printError("--out '" + o.outDir + "' exists and is not a directory");
     return kExitInputError;
   }
+  // One run at a time in DIR, before anything is written there (io/output_lock.hpp).
+  std::optional<OutputLock> lock;
+  try {
+    lock.emplace(outDir);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
 
   // ----- input: scene, overrides, settings (exit 2 on any error) -----
   std::optional<Scene> scene;
@@ -250,19 +259,21 @@ int runCommand(const Options& o) {
                   << std::endl;
       }
     }
-  } catch (const std::exception& e) {
+  } catch (const OutputWriteError& e) {  // a full disk (exit 1, README)
     printError(e.what());
-    return kExitInputError;
+    return kExitSolverFailure;
+  } catch (const std::exception& e) {  // --vtk where DIR/vtk is a file, ...
+    return reportInputError(outDir, e.what());
   }
 
   // ----- the run -----
-  installStopHandlers();
   SimulationSummary summary;
   try {
+    const StopOnSignals stop;  // a signal stops the run within its step
     summary = simulateKeepingFailures(scene->system, scene->solver, [&](const OutputSample& sample) {
       writer->write(sample);
       if (vtk) vtk->write(sample);
-      stopIfSignalled(sample.t);
+      if (sample.t < scene->solver.tEnd) stopIfSignalled(sample.t);  // the last row: the run is complete
     });
   } catch (const InputError& e) {
     // Includes ModelError: the model cannot be set up (assembly, redundant or
@@ -270,6 +281,8 @@ int runCommand(const Options& o) {
     return reportInputError(outDir, o.scenePath + ": " + e.what());
   }
 
+  // The time of the last row written, not of the row whose write failed.
+  if (summary.outputFailed) summary.tReached = writer->rowsWritten() > 0 ? writer->lastTime() : scene->solver.tStart;
   for (const std::string& w : summary.warnings) std::cerr << "flexmbd: warning: " << oneLine(w) << std::endl;
   const std::string kept = writer->rowsWritten() > 0
                                ? "results up to t = " + fmt(writer->lastTime(), kNumberDigits) + " kept in " +

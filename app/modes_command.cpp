@@ -1,7 +1,9 @@
 // flexmbd modes: linearisation and modal analysis from the command line (docs/modes.md).
 #include "app/modes_command.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +23,8 @@
 #include "core/number_text.hpp"
 #include "integrators/linearization.hpp"
 #include "integrators/simulation.hpp"
+#include "io/json_reader.hpp"
+#include "io/output_lock.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
 
@@ -130,15 +134,7 @@ ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
   return o;
 }
 
-std::string readText(const std::string& path) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (!in && !in.eof()) throw InputError("cannot read scene file '" + path + "'");
-  return buf.str();
-}
+std::string readText(const std::string& path) { return jsonread::readSceneFile(path); }
 
 std::string number(double x) {
   char buf[40];
@@ -180,6 +176,11 @@ ReferenceState findReference(const Scene& scene, std::optional<double> at, bool 
   return referenceStateByRun(scene.system, scene.solver, *at, !quiet);
 }
 
+/// The failure to write `file`, with the system's reason.
+std::runtime_error writeFailure(const fs::path& file) {
+  return std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
+}
+
 void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {
   std::ofstream out(file);
   out << "index,frequency_hz,omega_rad_s,damping_ratio,real,imag\n";
@@ -188,7 +189,7 @@ void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {
     out << k + 1 << ',' << number(m.frequencyHz) << ',' << number(m.omega) << ',' << number(m.dampingRatio) << ','
         << number(m.eigenvalue.real()) << ',' << number(m.eigenvalue.imag()) << '\n';
   }
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  if (!out) throw writeFailure(file);
 }
 
 void writeShapesCsv(const fs::path& file, const std::vector<Mode>& modes, const std::vector<std::string>& names) {
@@ -201,7 +202,7 @@ void writeShapesCsv(const fs::path& file, const std::vector<Mode>& modes, const 
     for (const Mode& m : modes) out << ',' << number(m.shape[static_cast<Eigen::Index>(i)].real());
     out << '\n';
   }
-  if (!out) throw std::runtime_error("cannot write " + file.string());
+  if (!out) throw writeFailure(file);
 }
 
 /// Scale of a drawn mode shape: its largest length entry moves kShapeAmplitude of the
@@ -318,6 +319,7 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
               sw.from, sw.to);
   for (int i = 0; i < sw.points; ++i) {
     const double speed = sw.points == 1 ? sw.from : sw.from + (sw.to - sw.from) * i / (sw.points - 1);
+    cli::stopIfSignalledInStep(0.0);  // between the speeds of the sweep
     const Scene scene = parseSceneText(withSpeed(base, sw.name, speed).dump(), o.scenePath);
     const System& sys = scene.system;
     const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo, basisFor(sys, o.solver));
@@ -330,7 +332,7 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
     std::printf(" Hz%s\n", modes.size() > 6 ? " ..." : "");
   }
   csv.close();
-  if (!csv) throw std::runtime_error("cannot write " + (out / "campbell.csv").string());
+  if (!csv) throw writeFailure(out / "campbell.csv");
   std::printf("Campbell diagram: %s\n", (out / "campbell.csv").string().c_str());
   ::setenv("FLEXMBD_PLOT_FROM_CLI", "1", 1);
   return runPythonScript("plot_campbell.py", {(out / "campbell.csv").string(), "--out", (out / "campbell.png").string(),
@@ -353,21 +355,24 @@ int runModesCommand(const std::vector<std::string>& args) {
     return kExitInputError;
   }
   const fs::path out(o.outDir);
+  std::optional<OutputLock> lock;  // one run at a time in DIR; a folder it cannot write is refused here
   try {
     std::error_code ec;
     if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw InputError("--out '" + o.outDir + "' exists and is not a directory");
-    fs::create_directories(out);
+    lock.emplace(out);
   } catch (const std::exception& e) {
     cli::printError(e.what());
     return kExitInputError;
   }
   try {
+    const cli::StopOnSignals stop;  // SIGINT, SIGTERM: as `run` (the simulation of --at within its step)
     if (o.sweep) {
       printBeamFrequencies(scene->system, o.count);
       return runSweep(o, base, out);
     }
     const System& sys = scene->system;
     const ReferenceState ref = findReference(*scene, o.at, o.steady, o.quiet);
+    cli::stopIfSignalledInStep(ref.t);
     const LinearizedSystem lin = linearize(sys, ref);
     const ReducedSystem red = reduce(lin, basisFor(sys, o.solver));
     ModesOptions mo;
@@ -386,10 +391,17 @@ int runModesCommand(const std::vector<std::string>& args) {
     std::printf("results: %s, %s, %s\n", (out / "modes.csv").string().c_str(), (out / "mode_shapes.csv").string().c_str(),
                 (out / "vtk").string().c_str());
     return kExitOk;
+  } catch (const RunInterrupted& e) {
+    cli::printError(std::string("modes: ") + e.what() + " (the modes were not written)");
+    return 128 + e.signal;
   } catch (const InputError& e) {  // ModelError included: no equilibrium, no degree of freedom
     cli::printError(o.scenePath + ": " + e.what());
     return kExitInputError;
   } catch (const std::exception& e) {
+    if (const int sig = cli::gStopSignal) {  // the simulation of --at reports the interrupt as its failure
+      cli::printError("modes: interrupted by " + cli::signalName(sig) + " (the modes were not written)");
+      return 128 + sig;
+    }
     cli::printError(e.what());
     return kExitFailure;
   }

@@ -14,6 +14,7 @@
 // (the script runs itself again with /usr/bin/python3 if its interpreter lacks matplotlib).
 #include "app/plot_command.hpp"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -162,9 +163,14 @@ int runAndWait(const std::vector<std::string>& argv) {
   cargv.push_back(nullptr);
   std::cout.flush();
   std::cerr.flush();
+  // SIGINT and SIGTERM stop the script as they stop a run: flexmbd takes them and ends the
+  // script (SIGTERM), which ignores the terminal's SIGINT (no KeyboardInterrupt traceback).
+  cli::installStopHandlers();
   const pid_t pid = ::fork();
   if (pid < 0) throw std::runtime_error(std::string("plot: cannot start ") + argv[0] + ": " + std::strerror(errno));
   if (pid == 0) {
+    ::signal(SIGINT, SIG_IGN);
+    ::signal(SIGTERM, SIG_DFL);
     ::execvp(cargv[0], cargv.data());
     const std::string msg = "flexmbd: error: plot: cannot run " + argv[0] + ": " + std::strerror(errno) +
                             " (the plots need Python 3 with matplotlib: scripts/setup.sh installs Debian's "
@@ -173,8 +179,18 @@ int runAndWait(const std::vector<std::string>& argv) {
     ::_exit(127);
   }
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
+  bool forwarded = false;
+  for (;;) {
+    if (cli::gStopSignal && !forwarded) {  // also one that came before the wait began
+      ::kill(pid, SIGTERM);
+      forwarded = true;
+    }
+    if (::waitpid(pid, &status, 0) >= 0) break;
     if (errno != EINTR) throw std::runtime_error(std::string("plot: waiting for the plot script: ") + std::strerror(errno));
+  }
+  if (const int sig = cli::gStopSignal) {
+    cli::printError("plot: interrupted by " + cli::signalName(sig) + " (the plot script was stopped; no plot written)");
+    return 128 + sig;
   }
   if (!WIFEXITED(status)) return kExitFailure;
   const int rc = WEXITSTATUS(status);

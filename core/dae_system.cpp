@@ -1,8 +1,10 @@
 #include "core/dae_system.hpp"
 
+
 #include <algorithm>
 #include <cmath>
 
+#include "core/stop_request.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 
@@ -422,6 +424,7 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
 }
 
 void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
+  pollStop(t);  // a SIGINT does not wait for the next output (core/stop_request.hpp)
   if (sys_.velocitiesAreCoordinateRates()) {
     residualImpl<true>(t, y, yp, F, scratch);
   } else {

@@ -1,5 +1,6 @@
 #include "integrators/augmented_lagrangian_integrator.hpp"
 
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -9,6 +10,7 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "core/stop_request.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
@@ -512,6 +514,7 @@ double AugmentedLagrangianSolver::advance(double tout, double tStop) {
   const DaeLayout& L = dae_.layout();
   const long steps0 = integrator_.stats().steps;
   while (integrator_.time() < tout) {
+    pollStop(integrator_.time());  // core/stop_request.hpp
     integrator_.step(tStop);
     if (integrator_.stats().steps - steps0 > maxSteps_) {
       throw SolverError("ali3p: more than max_steps = " + std::to_string(maxSteps_) + " steps before t = " +

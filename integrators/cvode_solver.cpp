@@ -1,5 +1,6 @@
 #include "integrators/cvode_solver.hpp"
 
+
 #include <cvode/cvode.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -14,6 +15,7 @@
 #include <string>
 #include <utility>
 
+#include "core/stop_request.hpp"
 #include "core/errors.hpp"
 
 namespace flexmbd {
@@ -58,6 +60,7 @@ struct CvodeSolver::Impl {
   static int rhs(realtype t, N_Vector y, N_Vector ydot, void* user) {
     auto* self = static_cast<Impl*>(user);
     try {
+      pollStop(t);  // core/stop_request.hpp: thrown, kept pending and rethrown by advance()
       self->ode->rhs(t, N_VGetArrayPointer(y), N_VGetArrayPointer(ydot));
       const double* f = N_VGetArrayPointer(ydot);
       for (sunindextype k = 0; k < N_VGetLength(ydot); ++k) {

@@ -77,6 +77,11 @@ constexpr double kMinRelativeSpan = 1e-9;
 /// Most outputs of a run: 1e8 rows of even a one-body model are 6 GB of results.csv.
 constexpr double kMaxOutputs = 1e8;
 
+bool resolvableTimeSpan(double tStart, double tEnd) {
+  const double span = tEnd - tStart;
+  return span >= kMinTimeSpan && span >= kMinRelativeSpan * std::max(std::fabs(tStart), std::fabs(tEnd));
+}
+
 void SolverSettings::validate() const {
   requireSetting(rtol > 0.0 && std::isfinite(rtol), "rtol", "a positive number", rtol);
   requireSetting(atol > 0.0 && std::isfinite(atol), "atol", "a positive number", atol);
@@ -91,9 +96,7 @@ void SolverSettings::validate() const {
   // A span the integrator can resolve: IDA refuses a stop time within round-off of t_start
   // (IDA_ILL_INPUT for t_end = 1e-300) and needs steps well above round-off of t.
   const double span = tEnd - tStart;
-  requireSetting(span >= kMinTimeSpan && span >= kMinRelativeSpan * std::max(std::fabs(tStart), std::fabs(tEnd)),
-                 "t_end", "t_end - t_start >= 1e-100 and >= 1e-9 max(|t_start|, |t_end|) (a span the integrator "
-                 "can resolve)", tEnd);
+  requireSetting(resolvableTimeSpan(tStart, tEnd), "t_end", kTimeSpanRule, tEnd);
   requireSetting(span / outputStep <= kMaxOutputs, "output_step",
                  "at most 1e8 outputs over t_end - t_start (results.csv would not fit a disk): a larger step",
                  outputStep);

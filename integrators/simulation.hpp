@@ -75,6 +75,12 @@ struct SolverSettings {
   void validate() const;
 };
 
+/// True if t_end - t_start is a span the integrators (IDA, Radau IIA, CVODE) can resolve:
+/// kTimeSpanRule. One rule for every scene format with a time span.
+bool resolvableTimeSpan(double tStart, double tEnd);
+constexpr const char* kTimeSpanRule =
+    "t_end - t_start >= 1e-100 and >= 1e-9 max(|t_start|, |t_end|) (a span the integrator can resolve)";
+
 /// Absolute tolerance of every unknown of the DAE for these settings: per coordinate
 /// class (frame positions, angles, elastic coordinates) and their velocities, the
 /// defaults from the model's scales at its consistent initial state (classTolerances);

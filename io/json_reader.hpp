@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -147,6 +148,59 @@ inline void checkJsonNesting(const std::string& text, const std::string& source)
 /// A name or key in quotes, shortened to kMaxQuoted characters.
 inline std::string inQuotes(const std::string& s) { return "\"" + shorten(s) + "\""; }
 
+// ----- names -----------------------------------------------------------------------------
+
+/// The one rule for every name a scene gives, in every format (bodies, joints, drivers,
+/// forces, outputs; tensegrity nodes, struts, cables, loads; linkage nodes, links, inputs):
+/// names become column names of results.csv and results.h5, VTK array names and Python
+/// keys, and not all of these can quote a comma, quote or newline (docs/scene-format.md).
+constexpr std::size_t kMaxNameLength = 64;
+constexpr const char* kNameRule = "names are 1 to 64 characters, each an ASCII letter, a digit, '_' or '-'";
+
+/// "" if `name` follows the rule; otherwise what breaks it ("has the character ',' at
+/// position 2", "is empty", "is 100000 characters long").
+inline std::string nameProblem(const std::string& name) {
+  if (name.empty()) return "is empty";
+  for (std::size_t k = 0; k < name.size(); ++k) {
+    const unsigned char c = static_cast<unsigned char>(name[k]);
+    if (std::isalnum(c) && c < 128) continue;
+    if (c == '_' || c == '-') continue;
+    char shown[40];
+    if (c >= 32 && c < 127) std::snprintf(shown, sizeof shown, "the character '%c'", c);
+    else if (c < 32 || c == 127) std::snprintf(shown, sizeof shown, "the control character 0x%02X", c);
+    else std::snprintf(shown, sizeof shown, "the non-ASCII byte 0x%02X", c);  // UTF-8
+    return "has " + std::string(shown) + " at position " + std::to_string(k + 1);
+  }
+  if (name.size() > kMaxNameLength) return "is " + std::to_string(name.size()) + " characters long";
+  return "";
+}
+
+/// A name in a message: quoted JSON-style (a newline shows as \n), shortened.
+inline std::string shownName(const std::string& name) {
+  return json(shorten(name)).dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+/// @throws InputError "<where>: key "<key>": the name "a,b" has the character ',' at
+/// position 2 (names are 1 to 64 characters, ...)" if `name` breaks the rule.
+inline void checkName(const std::string& name, const std::string& key, const std::string& where) {
+  const std::string problem = nameProblem(name);
+  if (!problem.empty()) {
+    throw InputError(where + ": key " + inQuotes(key) + ": the name " + shownName(name) + " " + problem + " (" +
+                     kNameRule + ")");
+  }
+}
+
+// ----- scene files -------------------------------------------------------------------------
+
+/// Largest scene file read (64 MiB): the largest models the engine runs are a few MB of
+/// JSON; a bound keeps a wrong path (a log, a disk image) from taking the memory.
+constexpr std::uintmax_t kMaxSceneFileBytes = 64ull << 20;
+
+/// The text of the scene file at `path`: a regular file of at most kMaxSceneFileBytes
+/// (FIFOs, devices such as /dev/zero and directories are refused before any read).
+/// One reader for every scene format and command. @throws InputError naming the path.
+std::string readSceneFile(const std::string& path);
+
 /// nlohmann's message without its "[json.exception.xxx.nnn] " prefix.
 inline std::string plainMessage(const json::exception& e) {
   std::string m = e.what();
@@ -174,7 +228,7 @@ class ObjectReader {
   /// Used as soon as a string name is found, so later messages carry it.
   void peekName() {
     const auto it = j_.find("name");
-    if (it != j_.end() && it->is_string()) where_ += " (" + inQuotes(it->get<std::string>()) + ")";
+    if (it != j_.end() && it->is_string()) where_ += " (" + shownName(it->get<std::string>()) + ")";
   }
 
   /// Rejects keys not in `allowed`; `what` qualifies the list (" for a harmonic law").
@@ -216,8 +270,18 @@ class ObjectReader {
   std::string string(const std::string& key, const std::string& fallback) const {
     return has(key) ? string(key) : fallback;
   }
-  /// A required, non-empty name (of this object or of one it refers to).
+  /// A required name (of this object or of one it refers to) following the name rule
+  /// (checkName).
   std::string name(const std::string& key) const {
+    std::string s = string(key);
+    checkName(s, key, where_);
+    return s;
+  }
+  std::string name(const std::string& key, const std::string& fallback) const {
+    return has(key) ? name(key) : fallback;
+  }
+  /// A required non-empty string that is not a name (a type, a model, a method).
+  std::string nonEmptyString(const std::string& key) const {
     std::string s = string(key);
     if (s.empty()) fail("key " + inQuotes(key) + " must not be empty");
     return s;
@@ -281,6 +345,7 @@ class ObjectReader {
     if (!v.is_array() || v.size() != 2 || !v[0].is_string() || !v[1].is_string()) {
       fail("key " + inQuotes(key) + " must be two body names [\"bodyI\", \"bodyJ\"], got " + describe(v));
     }
+    for (int k = 0; k < 2; ++k) checkName(v[k].get<std::string>(), key + "[" + std::to_string(k) + "]", where_);
     return {v[0].get<std::string>(), v[1].get<std::string>()};
   }
 

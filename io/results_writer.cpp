@@ -286,7 +286,10 @@ void reserveSummary(const std::filesystem::path& dir) {
   text.append(kSummaryReserve > text.size() ? kSummaryReserve - text.size() : 0, ' ');
   const std::filesystem::path target = dir / "summary.json";
   if (const int err = writeWholeFile(target, text)) {
-    throw OutputWriteError("cannot write '" + target.string() + "': " + std::strerror(err));
+    std::error_code ec;
+    std::filesystem::remove(target, ec);  // not an empty summary.json (a full disk)
+    throw OutputWriteError("cannot write '" + target.string() + "': " + std::strerror(err) +
+                           " (nothing was run)");
   }
 }
 

@@ -669,18 +669,6 @@ Scene parseSceneText(const std::string& text, const std::string& source) {
   }
 }
 
-Scene loadScene(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError("cannot read scene file '" + path + "': it is a directory");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot open scene file '" + path + "' for reading");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  if (in.bad()) throw InputError("cannot read scene file '" + path + "'");
-  return parseSceneText(buf.str(), path);
-}
+Scene loadScene(const std::string& path) { return parseSceneText(readSceneFile(path), path); }
 
 }  // namespace flexmbd

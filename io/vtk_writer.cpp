@@ -9,6 +9,7 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "joints/spatial_joint.hpp"
+#include "core/errors.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
 
 namespace flexmbd {
@@ -129,7 +130,13 @@ Eigen::Vector3d in3d(const Vec2& p) { return {p.x(), p.y(), 0.0}; }
 
 VtkCollection::VtkCollection(const std::filesystem::path& dir, std::string prefix)
     : dir_(dir), prefix_(std::move(prefix)) {
-  std::filesystem::create_directories(dir_);
+  std::error_code ec;
+  if (std::filesystem::exists(dir_, ec) && !std::filesystem::is_directory(dir_, ec)) {
+    throw InputError("--vtk: '" + dir_.string() + "' exists and is not a directory (the VTK frames are written "
+                     "into it): remove it or give another --out");
+  }
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw InputError("--vtk: cannot create the folder '" + dir_.string() + "': " + ec.message());
 }
 
 std::filesystem::path VtkCollection::nextFrame() const {

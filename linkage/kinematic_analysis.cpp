@@ -9,6 +9,7 @@
 #include <Eigen/SVD>
 
 #include "core/errors.hpp"
+#include "core/stop_request.hpp"
 #include "core/number_text.hpp"
 
 namespace flexmbd {
@@ -317,6 +318,7 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
 
   for (int k = 1; k <= settings_.steps; ++k) {
     const double alpha = settings_.start + k * h;
+    pollStop(alpha);  // core/stop_request.hpp
     const double da = alpha - prev.alpha;
     VecX X = prev.x + da * prev.xp + 0.5 * da * da * prev.xpp;  // eq. 26
     MatX frozen;

@@ -14,6 +14,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
+#include "io/output_lock.hpp"
 #include "io/results_writer.hpp"
 #include "linkage/kinematic_analysis.hpp"
 #include "linkage/kinematics_scene.hpp"
@@ -97,12 +99,17 @@ class KinematicsWriter {
     }
     out_ << '\n';
     file_.append(out_.str(), s.alpha, "alpha");
+    lastAlpha_ = s.alpha;
   }
+  long rows() const { return file_.rows(); }
+  /// The input of the last row written (NaN if none).
+  double lastAlpha() const { return lastAlpha_; }
 
  private:
   const Linkage2d& linkage_;
   RowFile file_;
   std::vector<double> values_;
+  double lastAlpha_ = NAN;
 };
 
 void writeJson(const fs::path& dir, const nlohmann::json& j) {
@@ -142,6 +149,13 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     printError("--out '" + o.outDir + "' exists and is not a directory");
     return kExitInputError;
   }
+  std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
+  try {
+    lock.emplace(outDir);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
 
   std::optional<KinematicsScene> scene;
   std::optional<KinematicAnalysis> analysis;
@@ -155,7 +169,7 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     analysis.emplace(scene->linkage, scene->settings);  // assembly at alpha = start
   } catch (const InputError& e) {
     const std::string m = e.what();
-    return reportInputError(outDir, m.rfind(o.scenePath, 0) == 0 ? m : o.scenePath + ": " + m);
+    return reportInputError(outDir, m.find(o.scenePath) != std::string::npos ? m : o.scenePath + ": " + m);
   }
 
   std::optional<KinematicsWriter> writer;
@@ -164,25 +178,39 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     removeStale(outDir);
     reserveSummary(outDir);
     writer.emplace(outDir / "kinematics.csv", scene->linkage);
+  } catch (const OutputWriteError& e) {  // a full disk (exit 1, README)
+    printError(e.what());
+    return kExitStopped;
   } catch (const std::exception& e) {
     printError(e.what());
     return kExitInputError;
   }
 
   KinematicSummary summary;
-  int minIt = 0, maxIt = 0;
-  try {
-    summary = analysis->run([&](const KinematicState& s) { writer->write(s); });
-  } catch (const OutputWriteError& e) {  // disk full: the rows written are whole
+  int minIt = 0, maxIt = 0, interruptedBy = 0;
+  // A run stopped by a signal or a full disk: the rows written are whole, the summary
+  // says where they end.
+  auto stoppedAt = [&](const std::string& message) {
     summary.ok = false;
-    summary.message = e.what();
+    summary.message = message;
+    summary.stepsCompleted = static_cast<int>(writer->rows());
+    summary.alphaReached = writer->rows() > 0 ? writer->lastAlpha() : scene->settings.start;
+  };
+  try {
+    const cli::StopOnSignals stop;  // SIGINT, SIGTERM: stop within the step (as `run`)
+    summary = analysis->run([&](const KinematicState& s) { writer->write(s); });
+  } catch (const OutputWriteError& e) {
+    stoppedAt(e.what());
+  } catch (const RunInterrupted& e) {
+    stoppedAt(std::string(e.what()) + " (the rows up to alpha = " + fmt(writer->lastAlpha()) + " are kept)");
+    interruptedBy = e.signal;
   }
   minIt = summary.minIterations;
   maxIt = summary.maxIterations;
 
   const KinematicSettings& st = scene->settings;
   nlohmann::json j;
-  j["status"] = summary.ok ? "ok" : "failed";
+  j["status"] = summary.ok ? "ok" : interruptedBy ? "interrupted" : "failed";
   j["message"] = summary.message;
   j["scene"] = scene->name;
   j["mobility"] = scene->linkage.mobility();
@@ -214,9 +242,13 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     writeJson(outDir, j);
   } catch (const std::exception& e) {
     printError(std::string("cannot write the summary: ") + e.what());
-    return kExitStopped;
+    return interruptedBy ? 128 + interruptedBy : kExitStopped;
   }
   const fs::path csv = outDir / "kinematics.csv";
+  if (interruptedBy) {
+    printError(summary.message + " (" + csv.string() + ")");
+    return 128 + interruptedBy;
+  }
   if (!summary.ok) {
     printError(o.scenePath + ": " + summary.message + " (" + csv.string() + ")");
     return kExitStopped;

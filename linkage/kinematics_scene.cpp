@@ -192,14 +192,7 @@ KinematicsScene parseKinematicsSceneText(const std::string& text, const std::str
 }
 
 KinematicsScene loadKinematicsScene(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError("cannot open scene file '" + path + "': no such file");
-  if (std::filesystem::is_directory(path, ec)) throw InputError("cannot read scene file '" + path + "': it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot open scene file '" + path + "' for reading");
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  return parseKinematicsSceneText(buf.str(), path);
+  return parseKinematicsSceneText(jsonread::readSceneFile(path), path);
 }
 
 }  // namespace flexmbd

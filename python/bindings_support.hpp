@@ -7,14 +7,65 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <chrono>
+#include <csignal>
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/stop_request.hpp"
 #include "core/system.hpp"
+#include "integrators/simulation.hpp"
 
 namespace flexmbd::pybind {
 
 namespace py = pybind11;
+
+/// Ctrl-C during a run (issue 26, D7): while it lives, the run's stop check
+/// (core/stop_request.hpp) gives Python's signal handlers a turn every 0.1 s (the GIL taken
+/// for it); an exception one raises (KeyboardInterrupt) stops the run within its step, and
+/// raiseIfInterrupted() raises it in Python once the run has returned. Made on the thread
+/// of the run, without the GIL.
+class PythonSignalCheck {
+ public:
+  PythonSignalCheck() : scope_(poll) { state() = State{}; }
+  PythonSignalCheck(const PythonSignalCheck&) = delete;
+  PythonSignalCheck& operator=(const PythonSignalCheck&) = delete;
+
+  /// With the GIL: raises the signal handler's exception if the run was stopped by it.
+  static void raiseIfInterrupted() {
+    State& s = state();
+    if (!s.type) return;
+    PyErr_Restore(s.type, s.value, s.traceback);  // the references go to Python's error state
+    s = State{};
+    throw py::error_already_set();
+  }
+
+ private:
+  struct State {
+    unsigned calls = 0;
+    std::chrono::steady_clock::time_point last = std::chrono::steady_clock::now();
+    PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
+  };
+  static State& state() {
+    thread_local State s;
+    return s;
+  }
+  static void poll(double t) {
+    State& s = state();
+    if (s.type) throw RunInterrupted("interrupted in Python at t = " + std::to_string(t), SIGINT);
+    if (++s.calls % 64 != 0) return;  // the clock read at most every 64 residuals
+    const auto now = std::chrono::steady_clock::now();
+    if (now - s.last < std::chrono::milliseconds(100)) return;
+    s.last = now;
+    {
+      py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() == 0) return;  // only the main thread runs handlers
+      PyErr_Fetch(&s.type, &s.value, &s.traceback);
+    }
+    throw RunInterrupted("interrupted by KeyboardInterrupt in Python at t = " + std::to_string(t), SIGINT);
+  }
+  StopPollScope scope_;
+};
 
 inline std::string pyRepr(const py::handle& h) { return py::repr(h).cast<std::string>(); }
 

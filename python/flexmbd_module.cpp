@@ -427,8 +427,10 @@ PYBIND11_MODULE(_flexmbd, m) {
             RunOutput r;
             {
               py::gil_scoped_release release;  // several runs may go on in threads
+              const PythonSignalCheck ctrlC;
               r = runScene(s, progress);
             }
+            PythonSignalCheck::raiseIfInterrupted();
             return py::make_tuple(r.columns, table(r), r.summary, r.ok);
           },
           py::arg("progress") = false);
@@ -441,13 +443,17 @@ PYBIND11_MODULE(_flexmbd, m) {
         std::vector<double> data, row;
         long rows = 0;
         KinematicSummary sum;
-        {
+        try {
           py::gil_scoped_release release;
+          const PythonSignalCheck ctrlC;
           sum = analyzeKinematics(scene.linkage, scene.settings, [&](const KinematicState& st) {
             kinematicsRow(scene.linkage, st, row);
             data.insert(data.end(), row.begin(), row.end());
             ++rows;
           });
+        } catch (const RunInterrupted&) {
+          PythonSignalCheck::raiseIfInterrupted();
+          throw;
         }
         RunOutput r;
         r.columns = std::move(columns);
@@ -496,6 +502,7 @@ PYBIND11_MODULE(_flexmbd, m) {
         TensegrityRunSummary sum;
         {
           py::gil_scoped_release release;
+          const PythonSignalCheck ctrlC;
           const TensegrityObserver observer{[&](const TensegritySample& smp) {
                                               tensegrityRow(*scene.structure, smp, row);
                                               r.data.insert(r.data.end(), row.begin(), row.end());
@@ -514,6 +521,7 @@ PYBIND11_MODULE(_flexmbd, m) {
             sum.tReached = r.rows > 0 ? r.data[(r.rows - 1) * r.columns.size()] : 0.0;
           }
         }
+        PythonSignalCheck::raiseIfInterrupted();
         py::dict summary;
         summary["status"] = sum.ok ? "ok" : "failed";
         summary["message"] = sum.message;

@@ -100,10 +100,12 @@ TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& obse
     for (const auto& e : pending) emit(e);
     pending.clear();
   }
+  const CvodeSolver* solverSeen = nullptr;  // the steps of the samples
   auto sample = [&]() {
     if (!observer.onSample) return;
     TensegritySample smp;
     smp.t = t;
+    smp.steps = solverSeen ? solverSeen->stats().steps : 0;
     smp.x = x;
     smp.v = v;
     smp.cableLength = s_.cableLengths(x);
@@ -121,6 +123,7 @@ TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& obse
 
   try {
     CvodeSolver solver(ode, t, y, o.cvode);
+    solverSeen = &solver;
     const long nOut = std::max(1L, static_cast<long>(std::ceil((o.tEnd - o.tStart) / o.outputStep - 1e-9)));
     for (long k = 1; k <= nOut; ++k) {
       const double tout = k == nOut ? o.tEnd : o.tStart + k * o.outputStep;

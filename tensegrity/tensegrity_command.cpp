@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "io/output_lock.hpp"
 #include "io/results_writer.hpp"
 #include "io/vtk_writer.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
@@ -54,6 +55,7 @@ class TensegrityResults {
     results_.append(row.str(), smp.t);
     ++rows_;
     lastTime_ = smp.t;
+    lastSteps_ = smp.steps;
   }
   void event(const TensegrityEvent& e) {
     std::ostringstream row;
@@ -64,6 +66,8 @@ class TensegrityResults {
   }
   long rows() const { return rows_; }
   double lastTime() const { return lastTime_; }
+  /// Steps taken up to the last row written.
+  long lastSteps() const { return lastSteps_; }
 
  private:
   const TensegrityStructure& s_;
@@ -71,6 +75,7 @@ class TensegrityResults {
   std::vector<double> values_;
   long rows_ = 0;
   double lastTime_ = NAN;
+  long lastSteps_ = 0;
 };
 
 void writeTensegritySummary(const std::filesystem::path& dir, const TensegrityRunSummary& s,
@@ -135,6 +140,13 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     printError("--out '" + o.outDir + "' exists and is not a directory");
     return kExitInputError;
   }
+  std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
+  try {
+    lock.emplace(outDir);
+  } catch (const std::exception& e) {
+    printError(e.what());
+    return kExitInputError;
+  }
   TensegrityScene scene;
   try {
     scene = loadTensegrityScene(o.scenePath);
@@ -154,6 +166,7 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
       if (o.rtol) scene.massless.cvode.rtol = *o.rtol;
       if (o.atol) scene.massless.cvode.atol = *o.atol;
     }
+    checkTensegrityTimes(scene);  // after --t-end
   } catch (const std::exception& e) {
     return reportInputError(outDir, e.what());
   }
@@ -166,9 +179,11 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     reserveSummary(outDir);
     results.emplace(outDir, *scene.structure);
     if (o.vtk) vtk.emplace(outDir / "vtk", *scene.structure, scene.name);
-  } catch (const std::exception& e) {
+  } catch (const OutputWriteError& e) {  // a full disk (exit 1, README)
     printError(e.what());
-    return kExitInputError;
+    return kExitSolverFailure;
+  } catch (const std::exception& e) {  // --vtk where DIR/vtk is a file, ...
+    return reportInputError(outDir, e.what());
   }
   const TensegrityObserver observer{[&](const TensegritySample& s) {
                                       results->sample(s);
@@ -179,8 +194,8 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
   TensegrityRunSummary summary;
   int interruptedBy = 0;
   bool outputFailed = false;
-  cli::installStopHandlers();
   try {
+    const cli::StopOnSignals stop;  // a signal stops the run within its step
     if (scene.method == TensegrityScene::Method::TimeStepping) {
       summary = TensegrityTimeStepper(*scene.structure, scene.timeStepping).run(observer);
     } else {
@@ -192,11 +207,13 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     summary.ok = false;
     summary.message = e.what();
     summary.tReached = results->lastTime();
+    summary.steps = results->lastSteps();
     interruptedBy = e.signal;
   } catch (const OutputWriteError& e) {
     summary.ok = false;
     summary.message = e.what();
     summary.tReached = results->lastTime();
+    summary.steps = results->lastSteps();
     outputFailed = true;
   } catch (const NonFiniteResult& e) {
     if (results->rows() == 0) {  // at the start: the scene's own values overflow (exit 2)
@@ -206,10 +223,12 @@ int runTensegrityCommand(const TensegrityRunOptions& o) {
     summary.ok = false;
     summary.message = std::string(e.what()) + ": the run stops before this output (the rows before it are kept)";
     summary.tReached = results->lastTime();
+    summary.steps = results->lastSteps();
   } catch (const std::exception& e) {
     summary.ok = false;
     summary.message = e.what();
     summary.tReached = results->lastTime();
+    summary.steps = results->lastSteps();
   }
   try {
     writeTensegritySummary(outDir, summary, scene, interruptedBy);

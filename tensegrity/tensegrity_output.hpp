@@ -14,6 +14,7 @@ namespace flexmbd {
 /// State at one output time. Vectors are full (every node coordinate, fixed ones too).
 struct TensegritySample {
   double t = 0.0;
+  long steps = 0;  ///< steps taken up to this sample (the summary's "steps" of a run stopped here)
   VecX x, v;
   VecX cableTension;   ///< method 1: impulse of the last step / dt; method 2: elastic law
   VecX cableImpulse;   ///< method 1: sum of snap impulses since the previous sample; method 2: 0

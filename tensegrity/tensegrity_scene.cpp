@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "integrators/simulation.hpp"
 #include "tensegrity/self_equilibrium.hpp"
 
 namespace flexmbd {
@@ -29,8 +30,10 @@ using namespace jsonread;
 class Reader : public ObjectReader {
  public:
   Reader(const json& j, std::string where) : ObjectReader(j, std::move(where)) { peekName(); }
-  std::string string(const std::string& k) const { return name(k); }
-  std::string string(const std::string& k, const std::string& fallback) const { return has(k) ? name(k) : fallback; }
+  std::string string(const std::string& k) const { return nonEmptyString(k); }
+  std::string string(const std::string& k, const std::string& fallback) const {
+    return has(k) ? nonEmptyString(k) : fallback;
+  }
 };
 
 
@@ -50,19 +53,10 @@ std::pair<int, int> nodePair(const TensegrityStructure& s, const Reader& r) {
 
 }  // namespace
 
-namespace {
-std::string readText(std::ifstream& in) {
-  std::ostringstream buf;
-  buf << in.rdbuf();
-  return buf.str();
-}
-}  // namespace
-
 bool isTensegritySceneFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return false;
-  const std::string text = readText(in);
+  std::string text;
   try {
+    text = readSceneFile(path);
     checkJsonNesting(text, path);
   } catch (const InputError&) {
     return false;  // the scene loader reports it
@@ -74,9 +68,7 @@ bool isTensegritySceneFile(const std::string& path) {
 }
 
 TensegrityScene loadTensegrityScene(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the scene file");
-  const std::string text = readText(in);
+  const std::string text = readSceneFile(path);
   checkJsonNesting(text, path);
   json j;
   try {
@@ -113,7 +105,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   for (std::size_t k = 0; k < nodes.size(); ++k) {
     Reader r(nodes[k], "nodes[" + std::to_string(k) + "]");
     r.allowOnly(scenekeys::kTensegrityNode);
-    const std::string name = r.string("name");
+    const std::string name = r.name("name");
     const VecX x = r.vector("position", d);
     const VecX v = r.has("velocity") ? r.vector("velocity", d) : VecX::Zero(d);
     const double m = r.nonNegative("mass", 0.0);
@@ -138,7 +130,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   for (std::size_t k = 0; k < struts.size(); ++k) {
     Reader r(struts[k], "struts[" + std::to_string(k) + "]");
     r.allowOnly(scenekeys::kStrut);
-    const std::string name = r.string("name");
+    const std::string name = r.name("name");
     const auto n = nodePair(s, r);
     const double ea = r.positive("EA");
     const double l0 = r.has("natural_length") ? r.number("natural_length") : initialLength(n);
@@ -157,7 +149,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   for (std::size_t k = 0; k < cables.size(); ++k) {
     Reader r(cables[k], "cables[" + std::to_string(k) + "]");
     r.allowOnly(scenekeys::kCable);
-    const std::string name = r.string("name");
+    const std::string name = r.name("name");
     const auto n = nodePair(s, r);
     const bool inextensible = r.boolean("inextensible", false);
     if (inextensible && r.has("EA")) r.fail("an inextensible cable takes no \"EA\"");
@@ -170,8 +162,8 @@ TensegrityScene parseTensegrityScene(const json& j) {
   for (std::size_t k = 0; k < loads.size(); ++k) {
     Reader r(loads[k], "loads[" + std::to_string(k) + "]");
     r.allowOnly(scenekeys::kLoad);
-    const std::string name = r.string("name", "load" + std::to_string(k));
-    const int node = lookupNode(s, r.string("node"), r);
+    const std::string name = r.name("name", "load" + std::to_string(k));
+    const int node = lookupNode(s, r.name("node"), r);
     const json& f = r.required("force");
     if (!f.is_array() || static_cast<int>(f.size()) != d) {
       r.fail("key \"force\" must be an array of " + std::to_string(d) + " laws (or null), got " + describe(f));
@@ -187,7 +179,7 @@ TensegrityScene parseTensegrityScene(const json& j) {
   if (top.has("prestress")) {
     Reader r(top.required("prestress"), "prestress");
     r.allowOnly(scenekeys::kPrestress);
-    const std::string cableName = r.string("cable");
+    const std::string cableName = r.name("cable");
     const double tension = r.positive("tension");
     const SelfStressStates st = computeSelfStress(s, s.initialPositions());
     if (st.forceDensities.cols() != 1) {
@@ -244,7 +236,18 @@ TensegrityScene parseTensegrityScene(const json& j) {
   } else {
     sv.fail("unknown method " + inQuotes(method) + " (expected one of: time_stepping, massless_cables)");
   }
+  checkTensegrityTimes(scene);
   return scene;
+}
+
+void checkTensegrityTimes(const TensegrityScene& scene) {
+  const bool stepping = scene.method == TensegrityScene::Method::TimeStepping;
+  const double t0 = stepping ? scene.timeStepping.tStart : scene.massless.tStart;
+  const double t1 = stepping ? scene.timeStepping.tEnd : scene.massless.tEnd;
+  if (!resolvableTimeSpan(t0, t1)) {
+    throw InputError("solver: key \"t_end\" must give " + std::string(kTimeSpanRule) + ", got t_end = " + fmt(t1) +
+                     " with t_start = " + fmt(t0));
+  }
 }
 
 }  // namespace flexmbd

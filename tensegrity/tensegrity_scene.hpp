@@ -29,5 +29,8 @@ bool isTensegritySceneFile(const std::string& path);
 /// @throws InputError (one line, starting with the file and the location).
 TensegrityScene loadTensegrityScene(const std::string& path);
 TensegrityScene parseTensegrityScene(const nlohmann::json& j);
+/// @throws InputError "solver: key "t_end" must ..." if t_end - t_start is not a span the
+/// integrators can resolve (resolvableTimeSpan; --t-end is checked again after it is applied).
+void checkTensegrityTimes(const TensegrityScene& scene);
 
 }  // namespace flexmbd

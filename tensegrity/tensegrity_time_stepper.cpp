@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/stop_request.hpp"
 #include "tensegrity/member_contact_detector.hpp"
 #include "tensegrity/segment_closest_points.hpp"
 
@@ -252,10 +253,12 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
     pending.clear();
   }
 
+  long stepsTaken = 0;
   auto sample = [&]() {
     if (!observer.onSample) return;
     TensegritySample smp;
     smp.t = t;
+    smp.steps = stepsTaken;
     smp.x = x;
     smp.v = v;
     smp.cableLength = s_.cableLengths(x);
@@ -278,6 +281,7 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
 
   try {
     for (long step = 1; step <= nSteps; ++step) {
+      pollStop(t);  // core/stop_request.hpp
       const double dt = step == nSteps ? o.tEnd - t : o.timeStep;
       const double tm = t + 0.5 * dt;
       const VecX xi = x, vi = v;
@@ -443,6 +447,7 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
       lastDt = dt;
       sum.steps = step;
       sum.tReached = t;
+      stepsTaken = step;
       if (step % outEvery == 0 || step == nSteps) sample();
     }
     sum.ok = true;

@@ -4,6 +4,7 @@ models built in Python against scene files, every error type, runs in threads.
 Run by CTest (tests/CMakeLists.txt: PYTHONPATH=build/python, FLEXMBD_CLI, FLEXMBD_SOURCE_DIR).
 """
 import csv
+import json
 import math
 import os
 import subprocess
@@ -305,3 +306,43 @@ def test_tolerance_overrides_scale_every_class_as_the_command_line():
     s.override_tolerances(rtol=1e-8)  # rtol alone: every absolute tolerance by the same factor
     assert s.rtol == 1e-8 and math.isclose(s.atol, 1e-10, rel_tol=1e-12)
     assert math.isclose(s.atol_elastic, 1e-13, rel_tol=1e-12)
+
+
+# ----- issue 26: Ctrl-C during a run, the name rule -------------------------------------
+
+def test_ctrl_c_interrupts_a_run_and_leaves_the_interpreter_usable():
+    """D7: a KeyboardInterrupt (here from SIGALRM's handler) reaches Python within the run,
+    not after it; the interpreter then runs scenes as before."""
+    import signal
+    import time
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    scene = flexmbd.load_scene(os.path.join(SOURCE, "examples", "slider_crank_rigid.json"),
+                               overrides={"solver.t_end": 1e4, "solver.output_step": 1e4})
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.5)
+        t0 = time.monotonic()
+        with pytest.raises(KeyboardInterrupt):
+            scene.run()
+        assert time.monotonic() - t0 < 5.0  # before: the whole run (minutes)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    short = flexmbd.load_scene(os.path.join(SOURCE, "examples", "slider_crank_rigid.json"),
+                               overrides={"solver.t_end": 0.5})
+    assert short.run().summary["status"] == "ok"
+
+
+@pytest.mark.parametrize("name,words", [("a,b", "has the character ',' at position 2"),
+                                        ("rod\nx", "has the control character 0x0A at position 4"),
+                                        ("", "is empty")])
+def test_names_follow_the_one_rule_in_python_scenes(name, words):
+    with open(os.path.join(SOURCE, "examples", "slider_crank_rigid.json"), encoding="utf-8") as f:
+        scene = json.load(f)
+    scene["drivers"][0]["name"] = name
+    with pytest.raises(flexmbd.InputError, match="names are 1 to 64 characters") as e:
+        flexmbd.scene_from_dict(scene)
+    assert words in str(e.value)
