@@ -12,12 +12,8 @@ const char* PlanarBeam::nodeDofName(int k) {
 }
 
 PlanarBeam::Element PlanarBeam::makeElement(const Mesh& mesh, int e, const Options& options, const std::string& who) {
-  if (options.theory != BeamTheory::EulerBernoulli) {
-    throw InputError(who + ": the Rayleigh beam theory is available for spatial bodies only so far; planar "
-                           "elements are Euler-Bernoulli (beam_theory \"euler_bernoulli\")");
-  }
   const auto& el = mesh.elements[e];
-  return Element(mesh.nodes[el.node1], mesh.nodes[el.node2], el.section, who);
+  return Element(mesh.nodes[el.node1], mesh.nodes[el.node2], el.section, who, options.theory);
 }
 
 PlanarBeam::InertiaAssembly::InertiaAssembly(int numNodalDofs) : nd_(numNodalDofs) {
@@ -34,26 +30,39 @@ void PlanarBeam::InertiaAssembly::add(const Element& el, const ElementRows& idx)
   const double l = el.length(), rhoA = el.section().massPerLength();
   nodal_.mass += el.mass();
   nodal_.firstMoment += el.mass() * (XA + R * Vec2(0.5 * l, 0.0));
-  // int rho |X_A + R [x, 0]|^2 dx
-  nodal_.polarMoment += rhoA * (l * XA.squaredNorm() + l * l * XA.dot(R.col(0)) + l * l * l / 3.0);
+  // int rho |X_A + R [x, y]|^2 dV: the centre line's, plus the sections' own rho I l
+  // (Rayleigh, Timoshenko: el.sectionMoment(); zero for Euler-Bernoulli's centre line)
+  nodal_.polarMoment +=
+      rhoA * (l * XA.squaredNorm() + l * l * XA.dot(R.col(0)) + l * l * l / 3.0) + el.sectionMoment();
   const Eigen::Matrix<double, 2, 6> sb = R * el.sBar() * T;  // int rho N dV, N = R S T
-  // int rho N^T u0 = T^T (S-bar^T R^T X_A + int rho x S_x^T dx)
-  const BeamElement2d::Vec6 i1 = T.transpose() * (el.sBar().transpose() * RtX + el.sX().row(0).transpose());
-  // int rho N^T S u0 = T^T (S-bar^T S R^T X_A + int rho x S_y^T dx)
-  const BeamElement2d::Vec6 j0 = T.transpose() * (el.sBar().transpose() * perp(RtX) + el.sX().row(1).transpose());
+  // int rho N^T u0 = T^T (S-bar^T R^T X_A + int rho (x S_x + y S_y)^T dV)
+  const BeamElement2d::Vec6 i1 =
+      T.transpose() * (el.sBar().transpose() * RtX + el.sX().row(0).transpose() + el.sY().row(1).transpose());
+  // int rho N^T S u0 = T^T (S-bar^T S R^T X_A + int rho (x S_y - y S_x)^T dV)
+  const BeamElement2d::Vec6 j0 = T.transpose() * (el.sBar().transpose() * perp(RtX) + el.sX().row(1).transpose() -
+                                                  el.sY().row(0).transpose());
   // S~ = T^T (S_xy - S_xy^T) T
   const BeamElement2d::Mat6 st = T.transpose() * (el.sXY() - el.sXY().transpose()) * T;
+  const bool turnsSections = el.theory() != BeamTheory::EulerBernoulli;
+  const BeamElement2d::Mat6 rr = T.transpose() * el.sectionRotationMoment() * T;  // R = T^T R_el T
   for (int a = 0; a < kElementDofs; ++a) {
     nodal_.sBar.col(idx[a]) += sb.col(a);
     nodal_.i1[idx[a]] += i1[a];
     nodal_.j0[idx[a]] += j0[a];
-    for (int b = 0; b < kElementDofs; ++b) tSTilde_.emplace_back(idx[a], idx[b], st(a, b));
+    for (int b = 0; b < kElementDofs; ++b) {
+      tSTilde_.emplace_back(idx[a], idx[b], st(a, b));
+      if (turnsSections) tR_.emplace_back(idx[a], idx[b], rr(a, b));
+    }
   }
 }
 
 PlanarBeam::Invariants PlanarBeam::InertiaAssembly::finish() {
   nodal_.sTilde.resize(nd_, nd_);
   nodal_.sTilde.setFromTriplets(tSTilde_.begin(), tSTilde_.end());  // duplicates summed
+  if (!tR_.empty()) {
+    nodal_.rff.resize(nd_, nd_);
+    nodal_.rff.setFromTriplets(tR_.begin(), tR_.end());
+  }
   return std::move(nodal_);
 }
 
@@ -81,11 +90,11 @@ MatX PlanarBeam::inertiaLoads(const Invariants& reduced) {
 }
 
 Eigen::Matrix<double, 2, PlanarBeam::kElementDofs> PlanarBeam::bodyShape(const Element& el, double xi) {
-  return rotation(el.angle()) * BeamElement2d::shape(xi, el.length());
+  return rotation(el.angle()) * BeamElement2d::shape(xi, el.length(), el.shear());
 }
 
 Eigen::Matrix<double, 1, PlanarBeam::kElementDofs> PlanarBeam::rotationShape(const Element& el, double xi) {
-  return BeamElement2d::slopeShape(xi, el.length());
+  return BeamElement2d::rotationShape(xi, el.length(), el.shear());  // the section's rotation psi
 }
 
 }  // namespace flexmbd

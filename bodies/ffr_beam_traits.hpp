@@ -71,6 +71,7 @@ struct PlanarBeam : BeamDimension<2> {
     int nd_;
     Invariants nodal_;
     Triplets tSTilde_;
+    Triplets tR_;  // R (Rayleigh and Timoshenko elements only)
   };
 
   /// Conditions C q_n = 0 of the chord frame: node a fixed, node b on the chord a-b.

@@ -47,12 +47,13 @@ double columnDot(const SpMat& S, int k, const X& x) {
 FfrBody2d::FfrBody2d(std::string name, FfrInvariants invariants, const FrameState2d& initial)
     : Body(std::move(name)), ownInvariants_(std::move(invariants)), inv_(ownInvariants_), initial_(initial) {
   inv_.validate("body '" + this->name() + "'");
+  polar_ = inv_.polarQuadratic();
   checkFrame("body '" + this->name() + "'", initial);
 }
 
 FfrBody2d::FfrBody2d(std::string name, std::shared_ptr<const FfrBeamModel> model, const FrameState2d& initial)
     : Body(std::move(name)), model_(std::move(model)), inv_(requireModel(model_, this->name()).invariants()),
-      initial_(initial) {
+      polar_(inv_.polarQuadratic()), initial_(initial) {
   checkFrame("body '" + this->name() + "'", initial);
 }
 
@@ -93,14 +94,15 @@ VecX FfrBody2d::initialVelocities() const {
 namespace {
 
 /// The frame-frame mass block at the rotation A = A(theta) the caller has computed.
+/// `polar`: m_ff + R, the quadratic part of int rho |u0 + u|^2 dV.
 template <class Qf>
-Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const Mat2& A, const Qf& qf) {
-  // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T m_ff qf
+Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const SpMat& polar, const Mat2& A, const Qf& qf) {
+  // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T (m_ff + R) qf
   const Vec2 sas = perp(A * (inv.firstMoment + inv.sBar * qf));
   Eigen::Matrix3d M;
   M << inv.mass, 0.0, sas.x(),  //
       0.0, inv.mass, sas.y(),   //
-      sas.x(), sas.y(), inv.polarMoment + 2.0 * inv.i1.dot(qf) + bilinear(inv.mff, qf, qf);
+      sas.x(), sas.y(), inv.polarMoment + 2.0 * inv.i1.dot(qf) + bilinear(polar, qf, qf);
   return M;
 }
 
@@ -118,7 +120,7 @@ void FfrBody2d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
   const int nf = numElastic();
   const auto qf = q.tail(nf);
   const Mat2 A = rotation(q[2]);
-  M.addBlock(0, 0, frameMassAt(inv_, A, qf));
+  M.addBlock(0, 0, frameMassAt(inv_, polar_, A, qf));
   for (int k = 0; k < nf; ++k) M.addBlock(0, 3 + k, frameElasticMassColumn(A, qf, k));
   for (int j = 0; j < 3; ++j) {
     M.addColumn(3, j, nf, [&](int k) { return frameElasticMassColumn(A, qf, k)[j]; });
@@ -135,7 +137,7 @@ void FfrBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   Eigen::Vector3d mrf;
   mrf.head<2>() = A * (inv_.sBar * af);
   mrf[2] = inv_.j0.dot(af) + bilinear(inv_.sTilde, qf, af);
-  out.head<3>() += frameMassAt(inv_, A, qf) * a.head<3>() + mrf;
+  out.head<3>() += frameMassAt(inv_, polar_, A, qf) * a.head<3>() + mrf;
   // elastic rows: M_fr a_r + m_ff a_f = S-bar^T A^T a_R + (J0 + S~^T qf) a_t + m_ff a_f
   auto of = out.tail(nf);
   of.noalias() += inv_.sBar.transpose() * (A.transpose() * a.head<2>());
@@ -161,7 +163,7 @@ void FfrBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   K.add(2, 2, -As.dot(aR));
   for (int k = 0; k < nf; ++k) {
     K.add(2, 3 + k,
-          aR.dot(SASb(k)) + 2.0 * at * (inv_.i1[k] + columnDot(inv_.mff, k, qf)) - columnDot(inv_.sTilde, k, af));
+          aR.dot(SASb(k)) + 2.0 * at * (inv_.i1[k] + columnDot(polar_, k, qf)) - columnDot(inv_.sTilde, k, af));
   }
   // rows f: S-bar^T A^T a_R + m_ft a_t + m_ff a_f;  d(S~^T qf a_t)/dqf = S~^T a_t = -S~ a_t
   K.addColumn(3, 2, nf, [&](int k) { return SASb(k).dot(aR); });
@@ -176,12 +178,13 @@ void FfrBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
   const Vec2 ASbp = A * (inv_.sBar * p);
   // Quadratic velocity vector Q_v = -int rho (dr/dq)^T (-A u w^2 + 2 S A N p w) dV, with
-  // iu = I1 + m_ff qf = int rho N^T u dV
+  // iu = I1 + (m_ff + R) qf = int rho N^T u dV (+ R qf: half the gradient of the
+  // sections' second-order rotation in the polar moment)
   Q.head<2>() += As * w * w - 2.0 * perp(ASbp) * w;
-  Q[2] += -2.0 * w * (inv_.i1.dot(p) + bilinear(inv_.mff, p, qf));
+  Q[2] += -2.0 * w * (inv_.i1.dot(p) + bilinear(polar_, p, qf));
   auto Qf = Q.tail(nf);
   Qf += (w * w) * inv_.i1;
-  Qf.noalias() += (w * w) * (inv_.mff * qf);
+  Qf.noalias() += (w * w) * (polar_ * qf);
   Qf.noalias() += (2.0 * w) * (inv_.sTilde * p);
   // elastic and damping forces
   if (model_ && model_->geometricStiffening()) {
@@ -202,7 +205,7 @@ void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
   const Vec2 ASbp = A * (inv_.sBar * p);
   auto ASb = [&](int k) -> Vec2 { return A * inv_.sBar.col(k); };
-  auto iu = [&](int k) { return inv_.i1[k] + columnDot(inv_.mff, k, qf); };  // I1 + m_ff qf
+  auto iu = [&](int k) { return inv_.i1[k] + columnDot(polar_, k, qf); };  // I1 + (m_ff + R) qf
   // Q_R = A s w^2 - 2 S A S-bar p w
   dQdq.addBlock(0, 2, Vec2(perp(As) * w * w + 2.0 * ASbp * w));
   dQdv.addBlock(0, 2, Vec2(2.0 * As * w - 2.0 * perp(ASbp)));
@@ -211,13 +214,13 @@ void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
     dQdv.addBlock(0, 3 + k, Vec2(-2.0 * w * perp(ASb(k))));
   }
   // Q_theta = -2 w iu^T p
-  dQdv.add(2, 2, -2.0 * (inv_.i1.dot(p) + bilinear(inv_.mff, p, qf)));
+  dQdv.add(2, 2, -2.0 * (inv_.i1.dot(p) + bilinear(polar_, p, qf)));
   for (int k = 0; k < nf; ++k) {
-    dQdq.add(2, 3 + k, -2.0 * w * columnDot(inv_.mff, k, p));
+    dQdq.add(2, 3 + k, -2.0 * w * columnDot(polar_, k, p));
     dQdv.add(2, 3 + k, -2.0 * w * iu(k));
   }
   // Q_f = w^2 iu + 2 w S~ p - dU/dqf - D p
-  dQdq.addSparse(3, 3, inv_.mff, w * w);
+  dQdq.addSparse(3, 3, polar_, w * w);
   if (model_ && model_->geometricStiffening()) {
     dQdq.addSparse(3, 3, model_->strainEnergyHessian(qf), -1.0);
   } else {

@@ -106,6 +106,7 @@ class FfrBody2d final : public Body {
   FfrInvariants ownInvariants_;                  // given directly; empty with a model
   std::shared_ptr<const FfrBeamModel> model_;    // generating mesh model, or null
   const FfrInvariants& inv_;                     // ownInvariants_ or model_->invariants()
+  SpMat polar_;  // m_ff + R (FfrInvariants::polarQuadratic), the polar moment's quadratic part
   FrameState2d initial_;
   VecX initialQf_, initialQfDot_;
 };

@@ -18,7 +18,9 @@ void FfrInvariants::validate(const std::string& owner) const {
   requireSize(i1.size() == n, owner, "i1", sz);
   requireSize(j0.size() == n, owner, "j0", sz);
   requireSize(sTilde.rows() == n && sTilde.cols() == n, owner, "s_tilde", sz + " x " + sz);
+  requireSize(rff.size() == 0 || (rff.rows() == n && rff.cols() == n), owner, "r", sz + " x " + sz + " or none");
   validateFinite(owner);
+  requireFiniteAll(rff, owner, "r");
   requireFiniteAll(sTilde, owner, "s_tilde");
   requireFiniteAll(i1, owner, "i1");
   requireFiniteAll(j0, owner, "j0");
@@ -26,6 +28,9 @@ void FfrInvariants::validate(const std::string& owner) const {
   // S~ = -S~^T
   if (n > 0 && maxAbs(SpMat(sTilde + SpMat(sTilde.transpose()))) > 1e-10 * (maxAbs(sTilde) + maxAbs(mff))) {
     throw InputError(owner + ": invariant s_tilde is not skew-symmetric; expected S~ = -S~^T");
+  }
+  if (n > 0 && rff.size() != 0 && maxAbs(SpMat(rff - SpMat(rff.transpose()))) > 1e-10 * (maxAbs(rff) + maxAbs(mff))) {
+    throw InputError(owner + ": invariant r is not symmetric; expected R = R^T");
   }
   validateDefiniteness(owner);
   // I0 >= |int rho u0 dV|^2 / m: the polar moment about the centre of mass is not negative
@@ -46,7 +51,10 @@ FfrInvariants FfrInvariants::transformed(const SpMat& P) const {
   r.i1 = P.transpose() * i1;
   r.j0 = P.transpose() * j0;
   r.sTilde = SpMat(P.transpose()) * sTilde * P;
+  if (rff.size() != 0) r.rff = SpMat(P.transpose()) * rff * P;
   return r;
 }
+
+SpMat FfrInvariants::polarQuadratic() const { return rff.size() == 0 ? mff : SpMat(mff + rff); }
 
 }  // namespace flexmbd

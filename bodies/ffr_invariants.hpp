@@ -22,8 +22,15 @@ struct FfrInvariants : FfrInvariantsBase<2> {
   VecX i1;                              ///< I1 = int rho N^T u0 dV
   VecX j0;                              ///< J0 = int rho N^T S u0 dV (S: +90 degree rotation)
   SpMat sTilde;                         ///< S~ = int rho N^T S^T N dV = S_xy - S_yx (skew)
+  /// R (nf x nf, symmetric; optional, empty for none): the sections' second-order
+  /// rotation (Rayleigh and Timoshenko beams, BeamElement2d::sectionRotationMoment):
+  /// int rho |u0 + u|^2 dV = I0 + 2 I1^T q_f + q_f^T (m_ff + R) q_f.
+  SpMat rff;
 
-  /// Sizes, symmetry (m_ff, K_ff, D_ff), skew symmetry (S~), positive definiteness
+  /// m_ff + R: the quadratic part of the polar moment int rho |u0 + u|^2 dV (m_ff
+  /// without R).
+  SpMat polarQuadratic() const;
+  /// Sizes, symmetry (m_ff, K_ff, D_ff, R), skew symmetry (S~), positive definiteness
   /// (m_ff, K_ff), D_ff positive semi-definite, I0 >= |first moment|^2 / m.
   /// @throws InputError naming `owner` and the offending invariant.
   void validate(const std::string& owner) const;

@@ -141,6 +141,13 @@ BeamSection parseSection(const json& j, const std::string& where) {
   s.youngsModulus = r.positive("youngs_modulus");
   s.density = r.positive("density");
   s.damping = r.nonNegative("damping", 0.0);
+  // Timoshenko beams: G and kappa (a rectangle's default kappa: Cowper's, with nu from E and G)
+  if (r.has("shear_modulus")) s.shearModulus = r.positive("shear_modulus");
+  if (r.has("shear_factor")) {
+    s.shearFactor = r.positive("shear_factor");
+  } else if (r.has("width") && s.shearModulus > 0.0) {
+    s.shearFactor = rectangleShearFactor(s.youngsModulus, s.shearModulus);
+  }
   return s;
 }
 
@@ -174,6 +181,7 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
   inv.i1 = sizedMatrix(iv, "i1", iv.vector("i1"), nf, 1, nf);
   inv.j0 = sizedMatrix(iv, "j0", iv.vector("j0"), nf, 1, nf);
   inv.sTilde = readSquareInvariant(iv, "s_tilde", nf);
+  if (iv.has("r")) inv.rff = readSquareInvariant(iv, "r", nf);  // the sections' second-order rotation
   inv.kff = readSquareInvariant(iv, "k_ff", nf);
   inv.dff = readSquareInvariant(iv, "d_ff", nf, true);
   const json& pts = iv.array("points");

@@ -23,17 +23,19 @@ inline const Keys kFlexibleBody = {"name",     "type",     "position",    "angle
                                    "velocity", "angular_velocity",       "section",
                                    "beam",     "nodes",    "elements",   "reference",
                                    "modes",    "geometric_stiffening",   "elastic_coordinates",
-                                   "elastic_velocities", "reduction", "interface_nodes", "inertia_modes"};
+                                   "elastic_velocities", "reduction", "interface_nodes", "inertia_modes",
+                                   "beam_theory"};
 inline const Keys kInvariantsBody = {"name",     "type",       "position",           "angle",
                                      "velocity", "angular_velocity", "invariants", "elastic_coordinates",
                                      "elastic_velocities"};
-inline const Keys kSection = {"area", "inertia", "width", "height", "youngs_modulus", "density", "damping"};
+inline const Keys kSection = {"area",    "inertia", "width",         "height",      "youngs_modulus",
+                              "density", "damping", "shear_modulus", "shear_factor"};
 inline const Keys kBeam = {"length", "elements", "origin"};
 inline const Keys kReferencePinnedPinned = {"type", "nodes"};
 inline const Keys kReferenceClamped = {"type", "node"};
 inline const Keys kReferenceFreeFree = {"type"};
 inline const Keys kInvariants = {"mass", "first_moment", "polar_moment", "s_bar", "i1",    "j0",
-                                 "m_ff", "s_tilde",      "k_ff",         "d_ff",  "points"};
+                                 "m_ff", "s_tilde",      "k_ff",         "d_ff",  "points", "r"};
 inline const Keys kInvariantsPoint = {"position", "shape", "rotation_shape"};
 inline const Keys kJoint = {"name", "type", "bodies", "points"};  ///< revolute, fixed
 inline const Keys kPrismaticJoint = {"name", "type", "bodies", "points", "axis"};

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "bodies/ffr_beam_model.hpp"
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_2d.hpp"
 #include "ffr_test_models.hpp"
 #include "bodies/ffr_invariants.hpp"
@@ -116,6 +117,8 @@ BeamSection softSection(double damping = 0.0) {
   s.youngsModulus = 1e7;
   s.density = 1000.0;
   s.damping = damping;
+  s.shearModulus = 4e6;      // Timoshenko elements only (phi ~ 0.06 on 0.25 m elements)
+  s.shearFactor = 5.0 / 6.0;
   return s;
 }
 
@@ -141,8 +144,9 @@ BeamMesh2d lFrame(int perLeg, const Vec2& offset = Vec2::Zero(), double damping 
 }
 
 FfrBeamOptions options(ReferenceConditions::Type type, int modes = 0, bool stiffening = false, int nodeA = 0,
-                       int nodeB = -1) {
+                       int nodeB = -1, BeamTheory theory = BeamTheory::EulerBernoulli) {
   FfrBeamOptions o;
+  o.theory = theory;
   o.reference.type = type;
   o.reference.nodeA = nodeA;
   o.reference.nodeB = nodeB;
@@ -187,6 +191,16 @@ std::vector<NamedModel> testModels() {
                makeModel(lFrame(3, Vec2(-0.12, 0.25)), options(RC::PinnedPinned, 0, false, 1, 5)), 0.3});
   v.push_back({"offset L frame free_free modal(4), stiffening, damping",
                makeModel(lFrame(2, Vec2(0.2, 0.1), beta), options(RC::FreeFree, 4, true)), 0.3});
+  // Rayleigh and Timoshenko elements (the sections' rotary inertia, shear)
+  v.push_back({"straight clamped nodal Rayleigh, stiffening",
+               makeModel(BeamMesh2d::straight(0.8, 3, softSection(beta), Vec2(0.1, -0.05)),
+                         options(RC::Clamped, 0, true, 0, -1, BeamTheory::Rayleigh)),
+               0.8});
+  v.push_back({"L frame pinned_pinned nodal Timoshenko, damping",
+               makeModel(lFrame(3, Vec2(-0.12, 0.25), beta), options(RC::PinnedPinned, 0, false, 1, 5, BeamTheory::Timoshenko)),
+               0.3});
+  v.push_back({"L frame free_free modal(4) Timoshenko, stiffening",
+               makeModel(lFrame(2, Vec2(0.2, 0.1)), options(RC::FreeFree, 4, true, 0, -1, BeamTheory::Timoshenko)), 0.3});
   return v;
 }
 
@@ -319,6 +333,11 @@ TEST(FfrBeamModel, InvariantsOfBentFramesMatchSlenderRods) {
 /// Quadrature of int rho J^T J dV, J = dr/dq = [I, S A u, A N] (2 x n), over every
 /// element with a Gauss rule of `points` points (the integrand has degree 6 in xi).
 /// Also returns the kinetic energy 1/2 int rho |rdot|^2 for the velocity v.
+/// Rayleigh and Timoshenko elements turn their sections by psi: the section points
+/// y = +-sqrt(I/A) across the axis (weights A/2: int dA = A, int y^2 dA = I, exact for
+/// the quadratics here) move by -y psi along the axis, and the second-order rotation
+/// u2 = -(1/2) psi^2 y n adds int rho 2 u0.u2 = -rho y^2 psi^2 to the polar moment
+/// (m_theta theta and its kinetic energy; BeamElement2d::sectionRotationMoment).
 MatX quadratureMassMatrix(const FfrBeamModel& model, const VecX& q, const VecX& v, int points, double& kinetic) {
   const int nf = model.numElastic(), n = 3 + nf;
   const VecX qf = q.tail(nf), qfdot = v.tail(nf);
@@ -330,18 +349,26 @@ MatX quadratureMassMatrix(const FfrBeamModel& model, const VecX& q, const VecX& 
   for (int e = 0; e < int(model.elements().size()); ++e) {
     const BeamElement2d& el = model.elements()[e];
     const double mu = el.section().massPerLength(), l = el.length();
+    const bool turns = el.theory() != BeamTheory::EulerBernoulli;
+    const double r = turns ? std::sqrt(el.section().inertia / el.section().area) : 0.0;
+    const Vec2 t = rotation(el.angle()).col(0), nrm = perp(t);  // element axis and normal, body frame
     for (size_t g = 0; g < xi.size(); ++g) {
       const FfrPoint p = model.materialPoint(e, xi[g]);
-      const Vec2 u = p.position + p.shape * qf;
-      const Vec2 SAu = perp(A * u);
-      Mat2X J = Mat2X::Zero(2, n);
-      J(0, 0) = J(1, 1) = 1.0;
-      J.col(2) = SAu;
-      J.rightCols(nf) = A * p.shape;
-      const double dm = mu * l * w[g];
-      M += dm * J.transpose() * J;
-      const Vec2 rdot = v.head<2>() + SAu * v[2] + A * (p.shape * qfdot);
-      kinetic += 0.5 * dm * rdot.squaredNorm();
+      for (double y : turns ? std::vector<double>{-r, r} : std::vector<double>{0.0}) {
+        const Mat2X N = p.shape - y * t * p.rotationShape;  // + psi e_z x (y n) = -y psi t
+        const Vec2 u = p.position + y * nrm + N * qf;
+        const Vec2 SAu = perp(A * u);
+        Mat2X J = Mat2X::Zero(2, n);
+        J(0, 0) = J(1, 1) = 1.0;
+        J.col(2) = SAu;
+        J.rightCols(nf) = A * N;
+        const double dm = mu * l * w[g] / (turns ? 2.0 : 1.0);
+        M += dm * J.transpose() * J;
+        const double psi = p.rotationShape.dot(qf), polar2 = -dm * y * y * psi * psi;  // int rho 2 u0.u2
+        M(2, 2) += polar2;
+        const Vec2 rdot = v.head<2>() + SAu * v[2] + A * (N * qfdot);
+        kinetic += 0.5 * dm * rdot.squaredNorm() + 0.5 * polar2 * v[2] * v[2];
+      }
     }
   }
   return M;
@@ -969,13 +996,39 @@ TEST(FfrBody2d, SparseAugmentedMatrixEqualsTheDenseBlocks) {
   EXPECT_LT(A.nonZeros(), (n + m) * (n + m) / 4);  // banded beam blocks: far from dense
 }
 
-// One options template for planar and spatial models: the planar one has the beam theory
-// too, but planar Rayleigh elements are not there yet: a clear InputError naming the body.
-TEST(FfrBeamModel, PlanarRayleighIsAnInputErrorSoFar) {
-  FfrBeamOptions o = options(RC::Clamped);
-  o.theory = BeamTheory::Rayleigh;
-  expectInputError([&] { FfrBeamModel model(BeamMesh2d::straight(1.0, 3, softSection()), o, "body 'rod'"); },
-                   {"body 'rod'", "element 0", "Rayleigh", "spatial bodies only"});
+// Planar Rayleigh and Timoshenko elements are the spatial ones restricted to the x-y
+// plane (BeamElement2d): a planar beam's frequencies equal the spatial beam's in-plane
+// ones (the x-z plane made 100 times stiffer, so the first in-plane modes are the
+// lowest), to the eigensolvers' round-off (1e-9); and Timoshenko is softer than Rayleigh,
+// Rayleigh softer than Euler-Bernoulli.
+TEST(FfrBeamModel, PlanarRayleighAndTimoshenkoAreTheSpatialElementsInThePlane) {
+  const double E = 2.1e11, G = 8.1e10, rho = 7850.0, b = 0.05, h = 0.05, L = 0.5;
+  BeamSection s = rectangularSection(b, h, E, rho);
+  s.shearModulus = G;
+  s.shearFactor = rectangleShearFactor(E, G);
+  BeamSection3d s3 = rectangularSection3d(h, b, E, G, rho);  // Iz = b h^3 / 12 in the x-y plane
+  s3.inertiaY *= 100.0;
+  s3.shearFactorY = s.shearFactor;
+  double previous = 0.0;
+  for (BeamTheory theory : {BeamTheory::EulerBernoulli, BeamTheory::Rayleigh, BeamTheory::Timoshenko}) {
+    const FfrBeamModel planar(BeamMesh2d::straight(L, 6, s), options(RC::Clamped, 0, false, 0, -1, theory), "p");
+    FfrBeamOptions3d o3;
+    o3.theory = theory;
+    const FfrBeamModel3d spatial(BeamMesh3d::straight(L, 6, s3), o3, "s");
+    const VecX wp = planar.naturalFrequencies(), ws = spatial.naturalFrequencies();
+    for (int k = 0; k < 3; ++k) {
+      double best = ws[0];
+      for (double x : ws) best = std::abs(x - wp[k]) < std::abs(best - wp[k]) ? x : best;
+      EXPECT_NEAR(wp[k], best, 1e-9 * wp[k]) << "mode " << k + 1;
+    }
+    if (previous > 0.0) EXPECT_LT(wp[0], (1.0 - 1e-4) * previous);
+    previous = wp[0];
+  }
+  BeamSection noShear = s;
+  noShear.shearFactor = 0.0;
+  expectInputError([&] { FfrBeamModel m(BeamMesh2d::straight(L, 2, noShear),
+                                        options(RC::Clamped, 0, false, 0, -1, BeamTheory::Timoshenko), "body 'rod'"); },
+                   {"body 'rod'", "element 0", "Timoshenko", "shear_factor"});
 }
 
 // The allocation-free strain-energy derivatives the planar model shares with the spatial
