@@ -77,8 +77,11 @@ int TensegrityStructure::addStrut(const std::string& name, int nodeI, int nodeJ,
   if (!(axialStiffness > 0.0) || !std::isfinite(axialStiffness)) {
     throw InputError(who + ": axial stiffness EA must be > 0, got " + num(axialStiffness));
   }
-  if (!(naturalLength >= kMinPositiveMagnitude) || !std::isfinite(naturalLength)) {
-    throw InputError(who + ": natural length must be >= 1e-100, got " + num(naturalLength));
+  if (!(naturalLength > 0.0) || !std::isfinite(naturalLength)) {
+    throw InputError(who + ": natural length must be > 0, got " + num(naturalLength));
+  }
+  if (naturalLength < kMinPositiveMagnitude) {  // core/magnitude_checks.hpp
+    throw InputError(who + ": natural length must be at least 1e-100, got " + num(naturalLength));
   }
   if (!(mass >= 0.0) || !std::isfinite(mass)) throw InputError(who + ": mass must be >= 0, got " + num(mass));
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InputError(who + ": radius must be >= 0, got " + num(radius));
@@ -96,8 +99,11 @@ int TensegrityStructure::addCable(const std::string& name, int nodeI, int nodeJ,
     throw InputError(who + ": axial stiffness EA must be > 0 (or the cable inextensible), got " +
                      num(axialStiffness));
   }
-  if (!(naturalLength >= kMinPositiveMagnitude) || !std::isfinite(naturalLength)) {
-    throw InputError(who + ": natural length must be >= 1e-100, got " + num(naturalLength));
+  if (!(naturalLength > 0.0) || !std::isfinite(naturalLength)) {
+    throw InputError(who + ": natural length must be > 0, got " + num(naturalLength));
+  }
+  if (naturalLength < kMinPositiveMagnitude) {  // core/magnitude_checks.hpp
+    throw InputError(who + ": natural length must be at least 1e-100, got " + num(naturalLength));
   }
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InputError(who + ": radius must be >= 0, got " + num(radius));
   cables_.push_back({name, nodeI, nodeJ, inextensible ? 0.0 : axialStiffness, naturalLength, inextensible, radius});
