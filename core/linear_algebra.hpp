@@ -14,11 +14,22 @@ inline void gather(const std::vector<int>& cols, const double* x, VecX& out) {
   for (std::size_t k = 0; k < cols.size(); ++k) out[k] = x[cols[k]];
 }
 
-/// Indices of the rows of A that are linearly dependent on earlier rows (modified
-/// Gram-Schmidt in row order; a row whose remainder is below rankTolerance times its
+/// Indices of the rows of A that are linearly dependent on earlier rows (orthogonalisation in
+/// row order by a sparse QR of A^T; a row whose remainder is below rankTolerance times its
 /// own norm is dependent). Reports the later of two conflicting rows, so errors can
 /// name the constraint the user added last.
 std::vector<int> dependentRows(const MatX& A, double rankTolerance = 1e-9);
+
+/// Rows up to which singularValueRatio takes the dense SVD (exact, O(m^2 n)): 300 rows
+/// (150 revolute joints) factor in about 0.1 s; the 800-link chain (1,600 rows) took 60 s.
+constexpr Eigen::Index kDenseSingularValueRows = 300;
+/// Power and inverse iterations of singularValueRatio above kDenseSingularValueRows.
+constexpr int kSingularValueIterations = 100;
+
+/// Smallest over largest singular value of A (m x n, m <= n; 1 for m = 0, 0 if rank-deficient):
+/// the dense SVD up to kDenseSingularValueRows rows, above it the square roots of the extreme
+/// eigenvalues of A A^T (sparse Cholesky; inverse and power iteration, to about 1 %).
+double singularValueRatio(const MatX& A);
 
 /// A without the rows listed in `rows` (ascending): the independent rows of a constraint
 /// Jacobian whose dependent rows are released.

@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/ground.hpp"
+#include "core/magnitude_checks.hpp"
 
 namespace flexmbd {
 
@@ -207,7 +208,28 @@ void System::finalize() {
     forceCols_.push_back(globalColumns(f->bodies(), forceUsed_.back(), bodyVelocityOffset_));
     forceQCols_.push_back(globalColumns(f->bodies(), forceUsedQ_.back(), bodyOffset_));
   }
+  checkInertiaSpread();
   finalized_ = true;
+}
+
+void System::checkInertiaSpread() const {
+  std::vector<NamedMagnitude> masses, inertias;
+  for (size_t b = 1; b < bodies_.size(); ++b) {  // 0 is the ground
+    const Body& body = *bodies_[b];
+    const std::string owner = "body '" + body.name() + "'";
+    masses.push_back({owner, body.mass()});
+    // rotational inertias of the rigid frames: the angle rows of the mass matrix's diagonal
+    // (a flexible body's full matrix is not formed here)
+    if (body.numVelocities() != body.numFrameVelocities()) continue;
+    const MatX M = body.massMatrix(body.initialCoordinates());
+    const std::vector<CoordinateKind> kinds = body.velocityKinds();
+    const std::vector<std::string> names = body.velocityNames();
+    for (int k = 0; k < body.numVelocities(); ++k) {
+      if (kinds[k] == CoordinateKind::Angle) inertias.push_back({owner + " (" + names[k] + ")", M(k, k)});
+    }
+  }
+  checkMagnitudeSpread("mass", masses);
+  checkMagnitudeSpread("rotational inertia", inertias);
 }
 
 VecX System::initialCoordinates() const {

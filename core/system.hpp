@@ -108,6 +108,9 @@ class System {
   std::vector<std::string> accelerationNames() const;
 
  private:
+  /// Refuses masses or rigid rotational inertias more than kMaxMagnitudeRatio apart
+  /// (core/magnitude_checks.hpp) when the model is finalized.
+  void checkInertiaSpread() const;
   void requireBuildPhase(const std::string& what) const;
   void requireFinalized(const char* what) const;
   void checkNewName(const std::string& name, const std::string& kind) const;

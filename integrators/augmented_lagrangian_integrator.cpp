@@ -481,8 +481,7 @@ double AugmentedLagrangianIntegrator::constraintConditioning() const {
   if (s.m == 0) return 1.0;
   MatX G;
   evaluateConstraints(s.sys, s.q, s.t, nullptr, &G);
-  const VecX sv = Eigen::JacobiSVD<MatX>(withoutRows(G, s.opt.released)).singularValues();
-  return sv.size() > 0 && sv[0] > 0 ? sv[sv.size() - 1] / sv[0] : 0.0;
+  return singularValueRatio(withoutRows(G, s.opt.released));
 }
 
 namespace {

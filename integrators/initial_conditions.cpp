@@ -3,10 +3,13 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseLU>
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
+#include "core/magnitude_checks.hpp"
+#include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
 
 namespace flexmbd {
@@ -146,22 +149,73 @@ void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2
 
 namespace {
 
+/// The mass matrix's rows named by coordinate where velocities are coordinate rates.
+std::vector<std::string> massRowNames(const System& sys) {
+  return sys.velocitiesAreCoordinateRates() ? sys.coordinateNames() : sys.velocityNames();
+}
+
 /// What was measured of the mass matrix when the augmented system is singular: the
-/// smallest and largest diagonal entries and their coordinates (a mass or inertia tiny
-/// beside the others makes [M G^T; G 0] numerically singular).
+/// smallest and largest diagonal entries, their coordinates and ratio (a mass or inertia
+/// tiny beside the others makes [M G^T; G 0] numerically singular).
 std::string massDiagonalReport(const System& sys, const MatX& M) {
   if (M.rows() == 0) return "";
-  // the mass matrix is in velocity space: named by coordinate where velocities are coordinate rates
-  const std::vector<std::string> names =
-      sys.velocitiesAreCoordinateRates() ? sys.coordinateNames() : sys.velocityNames();
+  const std::vector<std::string> names = massRowNames(sys);
   Eigen::Index lo = 0, hi = 0;
   const VecX d = M.diagonal().cwiseAbs();
   d.minCoeff(&lo);
   d.maxCoeff(&hi);
-  std::ostringstream os;
-  os.precision(3);
-  os << "; mass matrix diagonal from " << d[lo] << " (" << names[lo] << ") to " << d[hi] << " (" << names[hi] << ")";
-  return os.str();
+  std::string out = "; mass matrix diagonal from " + fmt(d[lo], 3) + " (" + names[lo] + ") to " + fmt(d[hi], 3) +
+                    " (" + names[hi] + ")";
+  if (d[lo] > 0.0) out += ", ratio " + fmt(d[hi] / d[lo], 3);
+  // the likely cause only where the measurement points to it (core/magnitude_checks.hpp)
+  if (!(d[hi] <= kMaxMagnitudeRatio * d[lo])) {
+    out += " (more than " + fmt(kMaxMagnitudeRatio) + ": the smaller one is lost in round-off)";
+  }
+  return out;
+}
+
+/// A driver's rate above the largest value a scene may hold (1e100) is an overflow of its law.
+constexpr double kMaxDriverRate = 1e100;
+
+/// The first non-finite entry of the terms of the augmented system, named: a driver's law,
+/// a force, or the mass matrix that overflowed (an overflow, not a singular position). Empty
+/// if all are finite.
+std::string nonFiniteTermReport(const System& sys, double t, const VecX& q, const VecX& v, const MatX& M,
+                                const MatX& G, const VecX& Q, const VecX& rhs) {
+  const std::string at = " at t = " + fmt(t, 6);
+  // a driver's rate beyond the largest input value (1e100) squares to overflow in the
+  // velocity terms of the other joints: the law is the cause, not the joint
+  const VecX rates = velocityConstraintResidual(sys, q, VecX::Zero(v.size()), t);  // -f'(t)
+  for (Eigen::Index r = 0; r < rates.size(); ++r) {
+    if (isDriverEquation(sys, static_cast<int>(r)) && !(std::fabs(rates[r]) <= kMaxDriverRate)) {
+      return sys.describeEquation(static_cast<int>(r)) + ": its law's rate is " + fmt(-rates[r], 3) + at +
+             " (the driver's law overflows: check its values and times)";
+    }
+  }
+  for (Eigen::Index r = 0; r < rhs.size(); ++r) {
+    if (!std::isfinite(rhs[r])) {
+      return sys.describeEquation(static_cast<int>(r)) + ": its acceleration term is " + fmt(rhs[r]) + at +
+             (isDriverEquation(sys, static_cast<int>(r))
+                  ? " (the driver's law or its derivatives overflow: check its values and times)"
+                  : " (the velocities overflow)");
+    }
+  }
+  const std::vector<std::string> names = massRowNames(sys);
+  for (Eigen::Index k = 0; k < Q.size(); ++k) {
+    if (!std::isfinite(Q[k])) {
+      return "the generalized force on " + names[k] + " is " + fmt(Q[k]) + at +
+             " (a force, a speed or a load of the model overflows)";
+    }
+  }
+  for (Eigen::Index k = 0; k < M.rows(); ++k) {
+    if (!M.row(k).allFinite()) return "the mass matrix row of " + names[k] + " is not finite" + at;
+  }
+  for (Eigen::Index r = 0; r < G.rows(); ++r) {
+    if (!G.row(r).allFinite()) {
+      return sys.describeEquation(static_cast<int>(r)) + ": its constraint Jacobian row is not finite" + at;
+    }
+  }
+  return "";
 }
 
 }  // namespace
@@ -189,6 +243,9 @@ void computeAccelerations(const System& sys, double t, const VecX& q, const VecX
     evaluateConstraints(sys, q, t, nullptr, &Gfull);
     const MatX G = withoutRows(Gfull, released);
     const MatX M = massMatrix(sys, q);
+    const std::string overflow =
+        nonFiniteTermReport(sys, t, q, v, M, Gfull, Q, accelerationConstraintRhs(sys, q, v, t));
+    if (!overflow.empty()) throw ModelError("the accelerations cannot be computed: " + overflow);
     const std::vector<int> rows = dependentUnreleasedRows(Gfull, released);
     // At a singular position the accelerations are still unique (M is regular) when the
     // constraint rows agree: a = M^-1 (Q - G^T lambda) with the minimum-norm multipliers of
@@ -314,7 +371,24 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     VecX vr, nu;
     VecX keptVelocities = v0;  // contribution of the coordinates that stay fixed
     for (int c : cols) keptVelocities[c] = 0.0;
-    solveAugmented(Mr, restrictCols(Gi), Mr * v0r, df - Gi * keptVelocities, vr, nu);
+    try {
+      solveAugmented(Mr, restrictCols(Gi), Mr * v0r, df - Gi * keptVelocities, vr, nu);
+    } catch (const ModelError& e) {
+      // what was measured: a non-finite velocity, driver rate or mass, else the mass spread
+      std::string why;
+      const std::vector<std::string> names = massRowNames(sys);
+      for (Eigen::Index k = 0; k < v0.size() && why.empty(); ++k) {
+        if (!std::isfinite(v0[k])) why = "; the given velocity of " + names[k] + " is " + fmt(v0[k]);
+      }
+      for (Eigen::Index r = 0; r < df.size() && why.empty(); ++r) {
+        if (!std::isfinite(df[r])) why = "; the rate of " +
+                    (s.released.empty() ? sys.describeEquation(static_cast<int>(r)) : std::string("a driver")) +
+                    " is " + fmt(df[r]);
+      }
+      if (why.empty() && !(Mr * v0r).allFinite()) why = "; the given velocities times the masses overflow";
+      throw ModelError(std::string("the initial velocities cannot be made consistent: ") + e.what() +
+                       (why.empty() ? massDiagonalReport(sys, M) : why));
+    }
     for (size_t k = 0; k < cols.size(); ++k) s.v[cols[k]] = vr[k];
   }
   // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v.

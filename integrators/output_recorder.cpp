@@ -56,8 +56,10 @@ void OutputRecorder::record(double t, const Eigen::Ref<const VecX>& q, const Eig
     throw NonFiniteResult(std::string("non-finite ") + bad + " at t = " + formatTime(t));
   }
   if (conservative_) {
-    const double E = kineticEnergy(sys_, s.q, s.v) + potentialEnergy(sys_, s.q);
+    const double K = kineticEnergy(sys_, s.q, s.v);
+    const double E = K + potentialEnergy(sys_, s.q);
     if (!std::isfinite(E)) throw NonFiniteResult("non-finite energy at t = " + formatTime(t));
+    r.maxKineticEnergy = std::max(r.maxKineticEnergy, K);
     if (!r.energyStart) r.energyStart = E;
     r.energyEnd = E;
   }

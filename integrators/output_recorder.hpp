@@ -30,6 +30,7 @@ struct RecordedOutputs {
   double maxPositionViolation = 0.0;  ///< max over outputs of max |g(q, t)|
   double maxVelocityViolation = 0.0;  ///< max over outputs of max |G v + g_t|
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
+  double maxKineticEnergy = 0.0;  ///< largest kinetic energy at an output (conservative models)
 
   /// A coordinate output so far exceeds kDivergedSize times the model size.
   bool diverged(double modelSize) const { return hasDiverged(largestCoordinate, modelSize); }

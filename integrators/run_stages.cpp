@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/bdf_stability.hpp"
 #include "integrators/integrator_choice.hpp"
@@ -32,6 +34,14 @@ constexpr double kDefaultMinStepSeconds = 1e-12;
 /// on the 4-element crank with Rayleigh beta 3e-4 s, 24 s; Radau IIA: 844 steps, 15
 /// failures, 0.03 s). Healthy runs stay below 0.1 (the undamped rod: 1.4 %).
 constexpr long kTrapWindow = 2000;
+
+/// A conservative run fails when its energy grows by more than this fraction of the largest
+/// kinetic energy of its outputs: BDF and Radau IIA dissipate (their energy errors are
+/// losses of the order of rtol; the default suite's conservative runs all pass), and energy
+/// created from nothing (an overflowing 1/m) is 100 % of it.
+constexpr double kMaxEnergyGrowthFraction = 0.1;
+/// Round-offs of the energy's magnitude never counted as growth.
+constexpr double kEnergyRoundOffs = 1e3;
 constexpr double kTrapFraction = 0.8;
 
 std::string initialCorrectionWarning(const InitialCorrection& c) {
@@ -382,8 +392,29 @@ SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& ou
                          ", more than 1e-3 of the velocity scale " + formatValue(velocityScale) +
                          ": the results are not accurate (tighten atol and rtol)");
   }
+  if (s.ok && s.energyStart && s.energyEnd) {
+    if (const std::optional<std::string> grown = energyGrowth(*s.energyStart, *s.energyEnd, outputs.maxKineticEnergy)) {
+      // a conservative model gained energy: not a result (the rows are kept)
+      s.ok = false;
+      s.message = *grown;
+      s.failureTime = outputs.tReached;
+    }
+  }
   if (s.ok) s.message = "reached t_end";
   return s;
+}
+
+std::optional<std::string> energyGrowth(double energyStart, double energyEnd, double maxKinetic) {
+  const double growth = energyEnd - energyStart;
+  // round-off of the energy itself: 1e3 eps of its magnitude (potential energies carry an offset)
+  const double floor = kEnergyRoundOffs * std::numeric_limits<double>::epsilon() *
+                       std::max(std::fabs(energyStart), std::fabs(energyEnd));
+  if (!(growth > kMaxEnergyGrowthFraction * maxKinetic + floor)) return std::nullopt;
+  return "the energy grew without input: the model is conservative (no drivers, dampers or non-conservative "
+         "forces) but its energy went from " + fmt(energyStart, 6) + " to " + fmt(energyEnd, 6) + " J, by " +
+         fmt(growth, 3) + ", more than " + fmt(kMaxEnergyGrowthFraction) + " of the largest kinetic energy " +
+         fmt(maxKinetic, 3) + " J: the results are not physical (tighten rtol and atol, check tiny or huge masses "
+         "and stiffnesses)";
 }
 
 }  // namespace flexmbd

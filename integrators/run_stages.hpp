@@ -170,4 +170,9 @@ SimulationSummary summaryAtStart(const RunStart& start, const RecordedOutputs& o
 SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& outputs, const ChosenIntegrator& choice,
                                 const RunState& state, const std::optional<RunFailure>& failure, double span);
 
+/// The failure message of a conservative run whose energy grew from energyStart to
+/// energyEnd by more than kMaxEnergyGrowthFraction of maxKinetic (its largest kinetic
+/// energy at an output); nullopt if it did not.
+std::optional<std::string> energyGrowth(double energyStart, double energyEnd, double maxKinetic);
+
 }  // namespace flexmbd

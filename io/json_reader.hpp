@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
+#include "core/magnitude_checks.hpp"
 #include "core/number_text.hpp"
 #include "core/time_law.hpp"
 #include "core/types.hpp"
@@ -423,14 +424,23 @@ class ObjectReader {
 
   double checkPositive(double x, const std::string& key) const {
     if (!(x > 0.0)) fail("key " + inQuotes(key) + " must be > 0, got " + fmt(x));
+    checkNotTiny(x, key);
     return x;
   }
   double checkNonNegative(double x, const std::string& key) const {
     if (!(x >= 0.0)) fail("key " + inQuotes(key) + " must be >= 0, got " + fmt(x));
+    if (x > 0.0) checkNotTiny(x, key);
     return x;
   }
 
  private:
+  /// A positive magnitude below kMinPositiveMagnitude (core/magnitude_checks.hpp) is refused.
+  void checkNotTiny(double x, const std::string& key) const {
+    if (x < kMinPositiveMagnitude) {
+      fail("key " + inQuotes(key) + " must be at least 1e-100 when it is not 0 (smaller values underflow or give "
+           "infinite reciprocals in the products the engine forms), got " + fmt(x));
+    }
+  }
   double toNumber(const json& v, const std::string& label) const {
     if (!v.is_number()) fail("key " + inQuotes(label) + " must be a number, got " + describe(v));
     const double x = v.get<double>();

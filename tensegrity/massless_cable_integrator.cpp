@@ -52,6 +52,12 @@ class TensegrityOde : public OdeSystem {
   VecX x0_;
 };
 
+/// Most cable switches (taut or slack roots, each a restart of CVODE) within one output
+/// interval: a cable goes taut and slack about once per period of its node's oscillation,
+/// which the output step resolves; 10,000 in one interval is an event storm whose switching
+/// times converge (a 1e-300 node mass: a root every 1,700 steps, no progress in 15 CPU-minutes).
+constexpr long kMaxSwitchesPerOutput = 10000;
+
 }  // namespace
 
 MasslessCableIntegrator::MasslessCableIntegrator(const TensegrityStructure& s, const MasslessCableSettings& o)
@@ -127,6 +133,12 @@ TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& obse
     const long nOut = std::max(1L, static_cast<long>(std::ceil((o.tEnd - o.tStart) / o.outputStep - 1e-9)));
     for (long k = 1; k <= nOut; ++k) {
       const double tout = k == nOut ? o.tEnd : o.tStart + k * o.outputStep;
+      // an event storm (switches ever closer together) ends the run: bounded switches and
+      // steps per output interval (docs/tensegrity.md, "Bounds of a run")
+      const double tInterval = t;
+      const long stepsAtInterval = solver.stats().steps;
+      long switches = 0;
+      std::vector<long> switchesOf(nc, 0);
       while (true) {
         const double tPrev = t;
         const VecX xPrev = x;
@@ -153,6 +165,21 @@ TensegrityRunSummary MasslessCableIntegrator::run(const TensegrityObserver& obse
           e.step = solver.stats().steps;
           e.member = s_.cable(c).name;
           emit(e);
+          ++switches;
+          ++switchesOf[c];
+        }
+        const long intervalSteps = solver.stats().steps - stepsAtInterval;
+        if (switches > kMaxSwitchesPerOutput || intervalSteps > o.cvode.maxSteps) {
+          const int worst = static_cast<int>(std::max_element(switchesOf.begin(), switchesOf.end()) - switchesOf.begin());
+          throw SolverError("event storm: " + std::to_string(switches) + " cable switches (taut/slack) and " +
+                                std::to_string(intervalSteps) + " steps between t = " + num(tInterval) +
+                                " and t = " + num(t) + " without reaching the next output at t = " + num(tout) +
+                                " (at most " + std::to_string(kMaxSwitchesPerOutput) + " switches and max_steps = " +
+                                std::to_string(o.cvode.maxSteps) + " steps per output interval); cable \"" +
+                                s_.cable(worst).name + "\" switched " + std::to_string(switchesOf[worst]) +
+                                " times: the switching times converge (a node mass tiny beside the cable's "
+                                "stiffness, or a cable at its natural length at rest)",
+                            t, solver.stats().lastStepSize);
         }
         // The cable force is only C0 at a switch: restart the multistep method there.
         solver.reinit(t, solver.y());

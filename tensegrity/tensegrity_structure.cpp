@@ -7,6 +7,7 @@
 #include <sstream>
 #include <utility>
 
+#include "core/magnitude_checks.hpp"
 #include "core/errors.hpp"
 #include "tensegrity/cable_element.hpp"
 
@@ -79,6 +80,9 @@ int TensegrityStructure::addStrut(const std::string& name, int nodeI, int nodeJ,
   if (!(naturalLength > 0.0) || !std::isfinite(naturalLength)) {
     throw InputError(who + ": natural length must be > 0, got " + num(naturalLength));
   }
+  if (naturalLength < kMinPositiveMagnitude) {  // core/magnitude_checks.hpp
+    throw InputError(who + ": natural length must be at least 1e-100, got " + num(naturalLength));
+  }
   if (!(mass >= 0.0) || !std::isfinite(mass)) throw InputError(who + ": mass must be >= 0, got " + num(mass));
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InputError(who + ": radius must be >= 0, got " + num(radius));
   struts_.push_back({name, nodeI, nodeJ, axialStiffness, naturalLength, mass, massModel, radius});
@@ -97,6 +101,9 @@ int TensegrityStructure::addCable(const std::string& name, int nodeI, int nodeJ,
   }
   if (!(naturalLength > 0.0) || !std::isfinite(naturalLength)) {
     throw InputError(who + ": natural length must be > 0, got " + num(naturalLength));
+  }
+  if (naturalLength < kMinPositiveMagnitude) {  // core/magnitude_checks.hpp
+    throw InputError(who + ": natural length must be at least 1e-100, got " + num(naturalLength));
   }
   if (!(radius >= 0.0) || !std::isfinite(radius)) throw InputError(who + ": radius must be >= 0, got " + num(radius));
   cables_.push_back({name, nodeI, nodeJ, inextensible ? 0.0 : axialStiffness, naturalLength, inextensible, radius});
@@ -229,6 +236,18 @@ void TensegrityStructure::finalize() {
       }
     }
   }
+  // Masses, stiffnesses and lengths within kMaxMagnitudeRatio of each other (massless nodes aside)
+  std::vector<NamedMagnitude> masses, stiffnesses, lengths;
+  for (int i = 0; i < numNodes(); ++i) masses.push_back({"node " + quoted(nodes_[i].name), massFull_(dim_ * i, dim_ * i)});
+  for (const MemberRef& m : members()) {
+    const std::string who = std::string(m.isStrut ? "strut " : "cable ") + quoted(memberName(m));
+    const double ea = m.isStrut ? struts_[m.index].axialStiffness : cables_[m.index].axialStiffness;
+    stiffnesses.push_back({who, ea});
+    lengths.push_back({who, m.isStrut ? struts_[m.index].naturalLength : cables_[m.index].naturalLength});
+  }
+  checkMagnitudeSpread("mass", masses);
+  checkMagnitudeSpread("axial stiffness EA", stiffnesses);
+  checkMagnitudeSpread("natural length", lengths);
   // Free coordinates; each must carry mass.
   free_.clear();
   freeIndexOf_.assign(n, -1);

@@ -16,6 +16,11 @@
 
 namespace flexmbd {
 
+/// Largest relative energy increase over a step with a snap (an inelastic impulse, which
+/// dissipates): the LCP and the projection leave round-off of 1e-12 (tests/test_tensegrity_snap.cpp);
+/// 1e-6 is far above it and far below energy created from an overflowing 1/m (100 %).
+constexpr double kMaxSnapEnergyGrowth = 1e-6;
+
 std::vector<std::string> tensegrityColumns(const TensegrityStructure& s) {
   const char* axes[3] = {"x", "y", "z"};
   std::vector<std::string> c = {"t"};
@@ -433,6 +438,14 @@ TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observ
         carried[c] = pc > 0.0;
       }
       if (snapped) sum.maxEnergyIncreaseAtSnap = std::max(sum.maxEnergyIncreaseAtSnap, Ef - Ei);
+      if (snapped && Ef - Ei > kMaxSnapEnergyGrowth * std::max(std::fabs(Ei), std::fabs(Ef))) {
+        // a snap is an inelastic impulse: energy from nothing means the model's numbers overflow
+        throw SolverError("the energy grew at a snap between t = " + num(t) + " and t = " + num(tf) + ": from " +
+                              num(Ei) + " to " + num(Ef) + " J (a snap dissipates; more than " +
+                              num(kMaxSnapEnergyGrowth) + " relative growth is not physical: check tiny node "
+                              "masses beside the cables' impulses)",
+                          t, dt);
+      }
       if (contacts) {
         contacts->advance(t, xi, tf, x, pending);
         std::sort(pending.begin(), pending.end(),

@@ -1,0 +1,31 @@
+// Input values that are positive but numerically meaningless next to the rest of the
+// model (issue 26, D2): one bound for the smallest magnitude of any positive scene value
+// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace flexmbd {
+
+/// Smallest positive magnitude of a physical value: the inverse of the largest one read
+/// (1e100, io/json_reader.hpp), so that products and quotients of three values stay
+/// normal doubles (1e-300 to 1e300); a subnormal mass (5e-324) gives 1/m = inf.
+constexpr double kMinPositiveMagnitude = 1e-100;
+
+/// Widest ratio of two values of one kind in one model. The light body's equations carry
+/// round-off of eps times the heavy one's terms (eps = 2.2e-16): at 1e12 that is 2.2e-4
+/// of its own, within a factor 50 of the coarsest rtol accepted (1e-2); a wider spread
+/// leaves the light part's motion as round-off at every tolerance the solver accepts.
+constexpr double kMaxMagnitudeRatio = 1e12;
+
+struct NamedMagnitude {
+  std::string owner;  ///< e.g. "body 'slider'", "node 'm2'"
+  double value;       ///< positive; zeros are skipped (massless nodes)
+};
+
+/// Refuses (InputError) a set of values of one kind (`kind`, e.g. "mass") whose largest is
+/// more than kMaxMagnitudeRatio times its smallest, naming both owners, values and the ratio.
+void checkMagnitudeSpread(const std::string& kind, const std::vector<NamedMagnitude>& values);
+
+}  // namespace flexmbd

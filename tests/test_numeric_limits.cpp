@@ -1,0 +1,168 @@
+// Issue 26 (hardening round two), items 2, 3, 5 and 7: values that are positive but
+// numerically meaningless, messages that say what was measured, runs bounded instead of
+// grinding, the start-up rank test of large models.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <ctime>
+#include <iostream>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <Eigen/Dense>
+#include <nlohmann/json.hpp>
+
+#include "cli_fixture.hpp"
+#include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/magnitude_checks.hpp"
+#include "integrators/run_stages.hpp"
+
+namespace {
+
+using nlohmann::json;
+using flexmbd::MatX;
+using flexmbd::VecX;
+const fs::path kRepro = fs::path(FLEXMBD_SOURCE_DIR) / ".." / "shared" / "findings" / "reliability-repro";
+
+class NumericLimits : public Cli {};
+
+json tensegrityPair(double m2) {
+  return json::parse(R"({"model": "tensegrity", "name": "pair", "dimension": 2,
+    "nodes": [{"name": "m1", "position": [0, 0], "mass": 1.0},
+              {"name": "m2", "position": [1, 0], "velocity": [2, 0], "mass": 1.0}],
+    "cables": [{"name": "c", "nodes": ["m1", "m2"], "natural_length": 1.0, "inextensible": true}],
+    "solver": {"method": "time_stepping", "t_end": 0.01, "time_step": 0.001, "output_step": 0.001}})")
+      .patch(json::parse(R"([{"op": "replace", "path": "/nodes/1/mass", "value": )" + json(m2).dump() + "}]"));
+}
+
+// D2: a subnormal node mass (5e-324: 1/m overflows, kinetic energy 1e-323 -> 2 J) is refused at input.
+TEST_F(NumericLimits, SubnormalMassIsRefusedWithTheKey) {
+  const CliResult r = run("run " + shellQuote(writeScene("t.json", tensegrityPair(5e-324)).string()) + " --out " +
+                          shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("nodes[1]"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("\"mass\" must be at least 1e-100"), std::string::npos) << r.err;
+}
+
+// D2: a node mass 1e-50 beside 1 (a ratio of 1e50) is refused, naming both and the ratio.
+TEST_F(NumericLimits, MassSpreadIsRefusedWithTheRatio) {
+  const CliResult r = run("run " + shellQuote(writeScene("t.json", tensegrityPair(1e-50)).string()) + " --out " +
+                          shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("node \"m2\": mass 1e-50 is 1e+50 times smaller than the mass 1 of node \"m1\""),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("within a ratio of 1e+12"), std::string::npos) << r.err;
+}
+
+// D2 / D8: a body of mass 1e100 beside bodies of mass 1 (R06) is refused at input, named.
+TEST_F(NumericLimits, HeavyBodyBesideLightOnesIsRefusedNamed) {
+  json scene = example();
+  for (json& b : scene["bodies"]) {
+    if (b["name"] == "slider") b["mass"] = 1e100;
+  }
+  const CliResult r = run("run " + shellQuote(writeScene("s.json", scene).string()) + " --out " +
+                          shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("times smaller than the mass 1e+100 of body 'slider'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("[M G^T; G 0] is singular"), std::string::npos) << r.err;
+}
+
+// D2: the spread of masses within the bound is accepted (1e10).
+TEST(MagnitudeSpread, WithinTheBoundIsAccepted) {
+  EXPECT_NO_THROW(flexmbd::checkMagnitudeSpread("mass", {{"a", 1.0}, {"b", 1e10}, {"c", 0.0}}));
+  EXPECT_THROW(flexmbd::checkMagnitudeSpread("mass", {{"a", 1.0}, {"b", 1e13}}), flexmbd::InputError);
+}
+
+// D2: a conservative run whose energy grew fails (by more than 0.1 of its largest kinetic energy).
+TEST(EnergyGrowth, GrowthBeyondTheFractionFails) {
+  EXPECT_FALSE(flexmbd::energyGrowth(-10.0, -10.0 + 1e-6, 1.0));  // an energy error of the integrator
+  EXPECT_FALSE(flexmbd::energyGrowth(5.0, 4.0, 1.0));              // dissipated
+  const auto grown = flexmbd::energyGrowth(1e-323, 2.0, 2.0);     // from nothing (D2, R03)
+  ASSERT_TRUE(grown);
+  EXPECT_NE(grown->find("the energy grew without input"), std::string::npos) << *grown;
+  EXPECT_NE(grown->find("from 9.88131e-324 to 2 J"), std::string::npos) << *grown;
+  EXPECT_FALSE(flexmbd::energyGrowth(1e6, 1e6 * (1.0 + 1e-15), 0.0));  // round-off of a potential offset
+}
+
+// D8: a driver's law that overflows (tabulated times [0, 1e-300], R05) is named, not "singular".
+TEST_F(NumericLimits, OverflowingLawIsNamed) {
+  json scene = example();
+  scene["drivers"][0]["law"] = json::parse(R"({"type": "tabulated", "times": [0, 1e-300], "values": [0, 1]})");
+  const CliResult r = run("run " + shellQuote(writeScene("s.json", scene).string()) + " --out " +
+                          shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("driver '" + scene["drivers"][0]["name"].get<std::string>() + "'"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("overflow"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("is singular"), std::string::npos) << r.err;
+}
+
+// D10: the rank test of a long chain's Jacobian is sparse: a banded 1,601 x 2,400 matrix
+// (the 800-link chain of R09, 60 s CPU with the dense SVD) with one repeated row, in seconds.
+TEST(SparseRank, LongChainJacobianRankIsFast) {
+  const int links = 800, n = 3 * links, m = 2 * links + 1;
+  MatX G = MatX::Zero(m, n);
+  for (int k = 0; k < links; ++k) {  // revolute joints: x and y of link k tied to link k-1
+    G(2 * k, 3 * k) = 1.0;
+    G(2 * k + 1, 3 * k + 1) = 1.0;
+    G(2 * k, 3 * k + 2) = 0.5;
+    if (k > 0) {
+      G(2 * k, 3 * (k - 1)) = -1.0;
+      G(2 * k + 1, 3 * (k - 1) + 1) = -1.0;
+      G(2 * k + 1, 3 * (k - 1) + 2) = 0.5;
+    }
+  }
+  G.row(m - 1) = 2.0 * G.row(7);  // a redundant copy
+  const std::clock_t c0 = std::clock();  // CPU time: the machine may be shared
+  EXPECT_EQ(flexmbd::dependentRows(G), (std::vector<int>{m - 1}));
+  const std::clock_t c1 = std::clock();
+  const double ratio = flexmbd::singularValueRatio(G.topRows(m - 1));
+  const std::clock_t c2 = std::clock();
+  const double rankSeconds = static_cast<double>(c1 - c0) / CLOCKS_PER_SEC;
+  const double ratioSeconds = static_cast<double>(c2 - c1) / CLOCKS_PER_SEC;
+  std::cout << "[ measured ] 1601 x 2400 chain Jacobian: rank " << rankSeconds << " s CPU, singular value ratio "
+            << ratioSeconds << " s CPU\n";
+  EXPECT_GT(ratio, 0.0);
+  EXPECT_LT(rankSeconds + ratioSeconds, 5.0);
+}
+
+// D10: above the dense limit the ratio agrees with the SVD to 1 %.
+TEST(SparseRank, IteratedRatioAgreesWithTheSvd) {
+  const int m = static_cast<int>(flexmbd::kDenseSingularValueRows) + 20, n = m + 30;
+  MatX G = MatX::Zero(m, n);
+  for (int i = 0; i < m; ++i) {
+    G(i, i) = 1.0 + 0.01 * i;
+    G(i, i + 1) = -0.5;
+  }
+  const VecX sv = Eigen::JacobiSVD<MatX>(G).singularValues();
+  EXPECT_NEAR(flexmbd::singularValueRatio(G), sv[sv.size() - 1] / sv[0], 1e-2 * sv[sv.size() - 1] / sv[0]);
+}
+
+// D3 / D4: the reproducers of the findings end promptly with a message and their rows.
+TEST_F(NumericLimits, LockUpAtLooseToleranceEndsPromptly) {
+  const fs::path scene = kRepro / "R07_lockup_rtol_1e-4_crossing_grinds.json";
+  if (!fs::exists(scene)) GTEST_SKIP() << "the findings' reproducers (" << kRepro << ") are not here";
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliResult r = run("run " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / "o").string()));
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("the mechanism does not get past the singular position"), std::string::npos) << r.err;
+  EXPECT_LT(seconds, 30.0);
+  EXPECT_TRUE(fs::exists(dir_ / "o" / "results.csv"));
+}
+
+// D19: `modes` at rest on a spatial scene is no longer refused as planar-only; the spherical
+// pendulum of R15 has a free rotation about the vertical, which the statics names.
+TEST_F(NumericLimits, SpatialModesAtRestAreNotRefusedAsPlanarOnly) {
+  const fs::path scene = kRepro / "R15_spatial_modes_at_rest_refused.json";
+  if (!fs::exists(scene)) GTEST_SKIP() << "the findings' reproducers (" << kRepro << ") are not here";
+  const CliResult r = run("modes " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.err.find("planar models only"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("an unconstrained rigid motion"), std::string::npos) << r.err;
+}
+
+}  // namespace
