@@ -213,11 +213,6 @@ int runCommand(const Options& o) {
     return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet, o.vtk});
   }
   const std::filesystem::path outDir(o.outDir);
-  std::error_code ec;
-  if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec)) {
-    printError("--out '" + o.outDir + "' exists and is not a directory");
-    return kExitInputError;
-  }
   // One run at a time in DIR, before anything is written there (io/output_lock.hpp).
   std::optional<OutputLock> lock;
   try {

@@ -357,8 +357,6 @@ int runModesCommand(const std::vector<std::string>& args) {
   const fs::path out(o.outDir);
   std::optional<OutputLock> lock;  // one run at a time in DIR; a folder it cannot write is refused here
   try {
-    std::error_code ec;
-    if (fs::exists(out, ec) && !fs::is_directory(out, ec)) throw InputError("--out '" + o.outDir + "' exists and is not a directory");
     lock.emplace(out);
   } catch (const std::exception& e) {
     cli::printError(e.what());

@@ -25,6 +25,9 @@ std::string holderOf(int fd) {
 
 OutputLock::OutputLock(const std::filesystem::path& dir, const std::string& option) : path_(dir / kOutputLockName) {
   std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
+    throw InputError(option + " '" + dir.string() + "' exists and is not a directory");
+  }
   std::filesystem::create_directories(dir, ec);
   if (ec) throw InputError("cannot create the output folder " + option + " '" + dir.string() + "': " + ec.message());
   // Open, lock, then check the path still names the file locked: a run ending between

@@ -19,8 +19,9 @@ class OutputLock {
  public:
   /// Creates `dir` (and parents) and takes its lock. `option` names the folder in messages
   /// ("--out").
-  /// @throws InputError (exit 2) if another run holds it (naming its process id and the
-  ///         lock file), or if the folder cannot be created or written (with the reason).
+  /// @throws InputError (exit 2) if `dir` exists and is not a folder, another run holds it
+  ///         (naming its process id and the lock file), or the folder cannot be created
+  ///         or written (with the reason).
   explicit OutputLock(const std::filesystem::path& dir, const std::string& option = "--out");
   ~OutputLock();
   OutputLock(const OutputLock&) = delete;

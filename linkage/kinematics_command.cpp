@@ -144,11 +144,6 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     return kExitInputError;
   }
   const fs::path outDir(o.outDir);
-  std::error_code ec;
-  if (fs::exists(outDir, ec) && !fs::is_directory(outDir, ec)) {
-    printError("--out '" + o.outDir + "' exists and is not a directory");
-    return kExitInputError;
-  }
   std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
   try {
     lock.emplace(outDir);

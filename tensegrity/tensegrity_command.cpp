@@ -135,11 +135,6 @@ bool isTensegrityScene(const std::string& scenePath) { return isTensegritySceneF
 
 int runTensegrityCommand(const TensegrityRunOptions& o) {
   const std::filesystem::path outDir(o.outDir);
-  std::error_code ec;
-  if (std::filesystem::exists(outDir, ec) && !std::filesystem::is_directory(outDir, ec)) {
-    printError("--out '" + o.outDir + "' exists and is not a directory");
-    return kExitInputError;
-  }
   std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
   try {
     lock.emplace(outDir);

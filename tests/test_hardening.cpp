@@ -32,18 +32,6 @@ class Hardening : public Cli {
                (command == "run" ? " --quiet" : "") +
                (extra.empty() ? "" : " " + extra));
   }
-  /// Runs `shell` (a command line where $F is the flexmbd binary) through bash -c.
-  CliResult runShell(const std::string& shell) const {
-    const fs::path out = dir_ / "cli_stdout.txt", err = dir_ / "cli_stderr.txt";
-    const std::string cmd = "F=" + shellQuote(FLEXMBD_CLI) + "; { " + shell + "; } >" + shellQuote(out.string()) +
-                            " 2>" + shellQuote(err.string());
-    const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
-    CliResult r;
-    r.status = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : -1;
-    r.out = readFile(out);
-    r.err = readFile(err);
-    return r;
-  }
   fs::path writeText(const std::string& name, const std::string& text) const {
     const fs::path p = dir_ / name;
     std::ofstream(p, std::ios::binary) << text;

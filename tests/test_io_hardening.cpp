@@ -25,18 +25,6 @@ nlohmann::json exampleScene(const std::string& name) {
 
 class IoHardening : public Cli {
  protected:
-  /// Runs `shell` (a command line where $F is the flexmbd binary) through bash -c.
-  CliResult runShell(const std::string& shell) const {
-    const fs::path out = dir_ / "cli_stdout.txt", err = dir_ / "cli_stderr.txt";
-    const std::string cmd = "F=" + shellQuote(FLEXMBD_CLI) + "; { " + shell + "; } >" + shellQuote(out.string()) +
-                            " 2>" + shellQuote(err.string());
-    const int rc = std::system(("bash -c " + shellQuote(cmd)).c_str());
-    CliResult r;
-    r.status = (rc != -1 && WIFEXITED(rc)) ? WEXITSTATUS(rc) : -1;
-    r.out = readFile(out);
-    r.err = readFile(err);
-    return r;
-  }
   CliResult runScene(const std::string& command, const fs::path& scene, const fs::path& out,
                      const std::string& extra = "") const {
     return run(command + " " + shellQuote(scene.string()) + " --out " + shellQuote(out.string()) +
