@@ -1,9 +1,11 @@
 #include "bodies/shape_inertia.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 
 namespace flexmbd {
 namespace {
@@ -76,11 +78,78 @@ Mat3 shapeInertia(const SolidShape& s, double m) {
   return I.asDiagonal();
 }
 
+namespace {
+
+std::string vectorText(const Vec3& v) { return "[" + fmt(v[0], 7) + ", " + fmt(v[1], 7) + ", " + fmt(v[2], 7) + "]"; }
+
+/// Half the largest extent of the shape about its centre (m): a box's half-diagonal, a
+/// cylinder's sqrt(r^2 + (h/2)^2), a sphere's radius.
+double halfExtent(const SolidShape& s) {
+  switch (s.type) {
+    case SolidShape::Type::Box: return 0.5 * s.size.norm();
+    case SolidShape::Type::Cylinder:
+    case SolidShape::Type::Tube: return std::hypot(s.radius, 0.5 * s.length);
+    case SolidShape::Type::Sphere: return s.radius;
+  }
+  return 0.0;
+}
+
+void checkOrientation(const SolidShape& s) {
+  const Mat3& A = s.orientation;
+  if (!A.allFinite() || !((A.transpose() * A - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-9) || !(A.determinant() > 0.0)) {
+    throw InputError("shape: orientation is not a rotation (expected orthonormal, determinant +1, to 1e-9)");
+  }
+  if (!s.offset.allFinite()) throw InputError("shape: offset must be 3 finite numbers, got " + vectorText(s.offset));
+}
+
+}  // namespace
+
+CompositeInertia compositeInertia(const std::vector<ShapePart>& parts) {
+  if (parts.empty()) throw InputError("shapes: give at least one shape");
+  CompositeInertia c;
+  Mat3 aboutOrigin = Mat3::Zero();
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const ShapePart& p = parts[k];
+    const SolidShape& s = p.shape;
+    try {
+      if ((p.mass > 0.0) == (p.density > 0.0)) throw InputError("shape: give exactly one of mass or density (> 0)");
+      checkOrientation(s);
+      const double m = p.mass > 0.0 ? p.mass : p.density * shapeVolume(s);
+      const Mat3 Ic = s.orientation * shapeInertia(s, m) * s.orientation.transpose();  // I' = A I A^T
+      const Vec3& d = s.offset;
+      // parallel-axis theorem: I_O = I_c + m (|d|^2 E - d d^T) (Meriam & Kraige, Dynamics, eq. 7/10)
+      aboutOrigin += Ic + m * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
+      c.mass += m;
+      c.centreOfMass += m * d;
+    } catch (const InputError& e) {
+      throw InputError(parts.size() == 1 ? std::string(e.what())
+                                         : "shapes[" + std::to_string(k) + "]: " + std::string(e.what()));
+    }
+  }
+  c.centreOfMass /= c.mass;
+  const Vec3& g = c.centreOfMass;
+  c.inertia = aboutOrigin - c.mass * (g.squaredNorm() * Mat3::Identity() - g * g.transpose());  // back to the centre
+  c.inertia = 0.5 * (c.inertia + c.inertia.transpose());
+  return c;
+}
+
+RigidBody3dProperties shapeProperties(const std::vector<ShapePart>& parts) {
+  const CompositeInertia c = compositeInertia(parts);
+  double extent = 0.0;
+  for (const ShapePart& p : parts) extent = std::max(extent, p.shape.offset.norm() + halfExtent(p.shape));
+  if (c.centreOfMass.norm() > kShapeCentreTolerance * extent) {
+    throw InputError("shapes: their centre of mass is at " + vectorText(c.centreOfMass) +
+                     " (body axes), but a body's frame origin is its centre of mass: subtract it from every offset "
+                     "(and from the body's joint points), or add the shape that balances it");
+  }
+  RigidBody3dProperties props;
+  props.mass = c.mass;
+  props.inertia = c.inertia;
+  return props;
+}
+
 RigidBody3dProperties shapeProperties(const SolidShape& s, double mass, double density) {
-  RigidBody3dProperties p;
-  p.mass = mass > 0.0 ? mass : density * shapeVolume(s);
-  p.inertia = shapeInertia(s, p.mass);
-  return p;
+  return shapeProperties(std::vector<ShapePart>{{s, mass, density}});
 }
 
 }  // namespace flexmbd

@@ -80,6 +80,11 @@ BodyIndex addFlexibleBody3d(System& sys, const std::string& name, std::shared_pt
   return sys.addBody(std::make_unique<FfrBody3d>(name, std::move(model), initial, qf0, qf0dot));
 }
 
+BodyIndex addFlexibleBody3d(System& sys, const std::string& name, FfrInvariants3d invariants,
+                            const FrameState3d& initial, const VecX& qf0, const VecX& qf0dot) {
+  return sys.addBody(std::make_unique<FfrBody3d>(name, std::move(invariants), initial, qf0, qf0dot));
+}
+
 SpatialJointType spatialJointTypeFromString(const std::string& type) {
   static const SpatialJointType all[] = {SpatialJointType::Spherical,   SpatialJointType::Revolute,
                                          SpatialJointType::Prismatic,   SpatialJointType::Cylindrical,

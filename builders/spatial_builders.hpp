@@ -46,6 +46,10 @@ BodyIndex addRigidBody3d(System& sys, const std::string& name, const RigidBody3d
 /// @throws InputError naming the body (null model, wrong sizes, bad state).
 BodyIndex addFlexibleBody3d(System& sys, const std::string& name, std::shared_ptr<const FfrBeamModel3d> model,
                             const FrameState3d& initial, const VecX& qf0 = {}, const VecX& qf0dot = {});
+/// A spatial FFR body of given invariants (from another FE tool, or a beam model's
+/// invariants changed): as above. @throws InputError naming the body and the invariant.
+BodyIndex addFlexibleBody3d(System& sys, const std::string& name, FfrInvariants3d invariants,
+                            const FrameState3d& initial, const VecX& qf0 = {}, const VecX& qf0dot = {});
 
 // ----- joints -------------------------------------------------------------------------------
 

@@ -61,10 +61,11 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
 // spatial scenes ("dimension": 3)
 inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "shape", "position",
                                   "orientation", "velocity", "angular_velocity"};
-inline const Keys kShapeBox = {"type", "size", "mass", "density"};
-inline const Keys kShapeSphere = {"type", "radius", "mass", "density"};
-inline const Keys kShapeCylinder = {"type", "radius", "length", "axis", "mass", "density"};
-inline const Keys kShapeTube = {"type", "inner_radius", "outer_radius", "length", "axis", "mass", "density"};
+inline const Keys kShapeBox = {"type", "size", "mass", "density", "offset", "orientation"};
+inline const Keys kShapeSphere = {"type", "radius", "mass", "density", "offset", "orientation"};
+inline const Keys kShapeCylinder = {"type", "radius", "length", "axis", "mass", "density", "offset", "orientation"};
+inline const Keys kShapeTube = {"type",   "inner_radius", "outer_radius", "length", "axis",
+                                "mass",   "density",      "offset",       "orientation"};
 inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "orientation", "velocity",
                                      "angular_velocity",     "section",     "beam",        "nodes",
                                      "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",

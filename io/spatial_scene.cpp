@@ -236,15 +236,17 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   const FrameState3d init = parseFrameState3d(r);
   const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
   const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
-  located(r.where(), [&] { return sys.addBody(std::make_unique<FfrBody3d>(name, std::move(inv), init, qf0, qf0dot)); });
+  located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
 }
 
-/// Key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" | "sphere",
-/// its dimensions, exactly one of "mass" or "density"}, centred on the body frame.
-RigidBody3dProperties parseShape(const json& j, const std::string& where) {
+/// One shape of key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" |
+/// "sphere", its dimensions, exactly one of "mass" or "density", optional "offset" and
+/// "orientation" in body axes}.
+ShapePart parseShapePart(const json& j, const std::string& where) {
   const ObjectReader r(j, where);
   const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
-  SolidShape s;
+  ShapePart part;
+  SolidShape& s = part.shape;
   if (type == "box") {
     r.allowOnly(scenekeys::kShapeBox, " for a box shape");
     s.type = SolidShape::Type::Box;
@@ -268,14 +270,33 @@ RigidBody3dProperties parseShape(const json& j, const std::string& where) {
     s.length = r.positive("length");
     const std::string axis = r.string("axis", "z");
     if (axis != "x" && axis != "y" && axis != "z") {
-      r.fail("key \"axis\" must be \"x\", \"y\" or \"z\" (the body axis along the shape's axis), got " + inQuotes(axis));
+      r.fail("key \"axis\" must be \"x\", \"y\" or \"z\" (the shape axis along its own axis), got " + inQuotes(axis));
     }
     s.axis = axis[0] - 'x';
   }
+  if (r.has("offset")) s.offset = r.vector("offset", 3);
+  if (r.has("orientation")) s.orientation = parseOrientation(r.object("orientation"), r.where() + ".orientation");
   if (r.has("mass") == r.has("density")) r.fail("give exactly one of \"mass\" or \"density\"");
-  const double mass = r.has("mass") ? r.positive("mass") : 0.0;
-  const double density = r.has("density") ? r.positive("density") : 0.0;
-  return located(r.where(), [&] { return shapeProperties(s, mass, density); });
+  part.mass = r.has("mass") ? r.positive("mass") : 0.0;
+  part.density = r.has("density") ? r.positive("density") : 0.0;
+  return part;
+}
+
+/// Key "shape" of a spatial rigid body: one shape, or an array of them whose centre of
+/// mass is the body origin.
+RigidBody3dProperties parseShape(const json& j, const std::string& where) {
+  const auto part = [](const json& v, const std::string& at) {
+    if (!v.is_object()) throw InputError(at + ": must be a shape {\"type\": ...}, got " + describe(v));
+    return parseShapePart(v, at);
+  };
+  std::vector<ShapePart> parts;
+  if (j.is_array()) {
+    if (j.empty()) throw InputError(where + ": an array of shapes must have at least one shape");
+    for (std::size_t k = 0; k < j.size(); ++k) parts.push_back(part(j[k], where + "[" + std::to_string(k) + "]"));
+  } else {
+    parts.push_back(part(j, where));
+  }
+  return located(where, [&] { return shapeProperties(parts); });
 }
 
 }  // namespace
@@ -319,7 +340,7 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys) {
   }
   if (r.has("shape")) {
     if (r.has("mass")) r.fail("key \"mass\" does not go with \"shape\": give the shape's \"mass\" or \"density\"");
-    const RigidBody3dProperties props = parseShape(r.object("shape"), r.where() + ".shape");
+    const RigidBody3dProperties props = parseShape(r.required("shape"), r.where() + ".shape");
     located(r.where(), [&] { return sys.addBody(std::make_unique<RigidBody3d>(name, props, init)); });
     return;
   }

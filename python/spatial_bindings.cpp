@@ -261,16 +261,47 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             return s;
           },
           py::arg("radius"))
-      .def_property_readonly("volume", [](const SolidShape& s) { return shapeVolume(s); });
+      .def_property_readonly("volume", [](const SolidShape& s) { return shapeVolume(s); })
+      .def_readwrite("offset", &SolidShape::offset, "the shape's centre in body axes (m)")
+      .def_readwrite("orientation", &SolidShape::orientation, "the shape's axes in body axes (rotation matrix)")
+      .def(
+          "placed",
+          [](SolidShape s, const py::object& offset, const py::object& orientation) {
+            s.offset = vec3Arg(offset, "SolidShape.placed", "offset");
+            if (!orientation.is_none()) s.orientation = orientationArg(orientation, "SolidShape.placed", "orientation");
+            return s;
+          },
+          py::arg("offset"), py::arg("orientation") = py::none(),
+          "A copy of the shape with its centre at offset and its axes turned by orientation (body axes)");
+  const auto shapePart = [](const SolidShape& s, const py::object& mass, const py::object& density, const char* fn) {
+    if (mass.is_none() == density.is_none()) throw InputError(std::string(fn) + ": give exactly one of mass or density");
+    return mass.is_none() ? ShapePart{s, 0.0, positiveArg(density, fn, "density")}
+                          : ShapePart{s, positiveArg(mass, fn, "mass"), 0.0};
+  };
+  py::class_<ShapePart>(m, "ShapePart")
+      .def(py::init([shapePart](const SolidShape& s, const py::object& mass, const py::object& density) {
+             return shapePart(s, mass, density, "ShapePart");
+           }),
+           py::arg("shape"), py::arg("mass") = py::none(), py::arg("density") = py::none(),
+           "One shape of a body with exactly one of its mass (kg) or density (kg/m^3)")
+      .def_readonly("shape", &ShapePart::shape)
+      .def_readonly("mass", &ShapePart::mass)
+      .def_readonly("density", &ShapePart::density);
+  py::class_<CompositeInertia>(m, "CompositeInertia")
+      .def_readonly("mass", &CompositeInertia::mass)
+      .def_readonly("centre_of_mass", &CompositeInertia::centreOfMass)
+      .def_readonly("inertia", &CompositeInertia::inertia);
+  m.def("composite_inertia", &compositeInertia, py::arg("parts"),
+        "Mass, centre of mass and inertia about it (body axes) of several placed shapes");
   m.def(
       "shape_properties",
-      [](const SolidShape& s, const py::object& mass, const py::object& density) {
-        if (mass.is_none() == density.is_none()) throw InputError("shape_properties: give exactly one of mass or density");
-        return mass.is_none() ? shapeProperties(s, 0.0, positiveArg(density, "shape_properties", "density"))
-                              : shapeProperties(s, positiveArg(mass, "shape_properties", "mass"), 0.0);
+      [shapePart](const SolidShape& s, const py::object& mass, const py::object& density) {
+        return shapeProperties(std::vector<ShapePart>{shapePart(s, mass, density, "shape_properties")});
       },
       py::arg("shape"), py::arg("mass") = py::none(), py::arg("density") = py::none(),
       "RigidBody3dProperties of a body that is the shape: the mass given, or density x volume");
+  m.def("shape_properties", py::overload_cast<const std::vector<ShapePart>&>(&shapeProperties), py::arg("parts"),
+        "RigidBody3dProperties of a body made of several shapes whose centre of mass is the body origin");
   m.def("shape_volume", &shapeVolume, py::arg("shape"));
   m.def(
       "shape_inertia", [](const SolidShape& s, const py::object& mass) { return shapeInertia(s, positiveArg(mass, "shape_inertia", "mass")); },
@@ -427,7 +458,81 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            }),
            py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model")
       .def("natural_frequencies", &FfrBeamModel3d::naturalFrequencies, "rad/s, ascending (frame held fixed)")
-      .def_property_readonly("num_elastic", &FfrBeamModel3d::numElastic);
+      .def_property_readonly("num_elastic", &FfrBeamModel3d::numElastic)
+      .def_property_readonly(
+          "invariants", [](const FfrBeamModel3d& mdl) { return mdl.invariants(); },
+          "A copy of the model's invariants (FfrInvariants3d), to change or to add as a body of its own");
+
+  // ----- given invariants (bodies/ffr_invariants_3d.hpp): NumPy arrays in, sparse inside ----
+  py::class_<FfrPoint3d>(m, "FfrPoint3d")
+      .def(py::init([](const py::object& position, const MatX& shape, const MatX& rotationShape) {
+             FfrPoint3d p;
+             p.position = vec3Arg(position, "FfrPoint3d", "position");
+             p.shape = shape;
+             p.rotationShape = rotationShape;
+             return p;
+           }),
+           py::arg("position"), py::arg("shape"), py::arg("rotation_shape"),
+           "An attachment point: undeformed position u0 (body axes), shape N (3 x nf), rotation shape (3 x nf)")
+      .def_readwrite("position", &FfrPoint3d::position)
+      .def_readwrite("shape", &FfrPoint3d::shape)
+      .def_readwrite("rotation_shape", &FfrPoint3d::rotationShape);
+  const auto sparseField = [](SpMat FfrInvariants3d::*field) {
+    return std::make_pair([field](const FfrInvariants3d& v) { return MatX(v.*field); },
+                          [field](FfrInvariants3d& v, const MatX& x) { v.*field = x.sparseView(); });
+  };
+  const auto [mffGet, mffSet] = sparseField(&FfrInvariantsBase<3>::mff);
+  const auto [kffGet, kffSet] = sparseField(&FfrInvariantsBase<3>::kff);
+  const auto [dffGet, dffSet] = sparseField(&FfrInvariantsBase<3>::dff);
+  using Pairs = std::vector<std::vector<MatX>>;
+  const auto pairsGet = [](const std::array<std::array<SpMat, 3>, 3>& a) {
+    Pairs out(3, std::vector<MatX>(3));
+    for (int k = 0; k < 3; ++k) for (int l = 0; l < 3; ++l) out[k][l] = MatX(a[k][l]);
+    return out;
+  };
+  const auto pairsSet = [](std::array<std::array<SpMat, 3>, 3>& a, const Pairs& x, const char* what) {
+    if (x.size() != 3 || x[0].size() != 3 || x[1].size() != 3 || x[2].size() != 3) {
+      throw InputError(std::string("FfrInvariants3d.") + what + ": expected 3 lists of 3 matrices (k, l in x, y, z)");
+    }
+    for (int k = 0; k < 3; ++k) for (int l = 0; l < 3; ++l) a[k][l] = x[k][l].sparseView();
+  };
+  py::class_<FfrInvariants3d>(m, "FfrInvariants3d",
+                              "The inertia and stiffness invariants of a spatial FFR body (docs/spatial-flexible.md); "
+                              "matrices are NumPy arrays (kept sparse inside); checked when a body is added")
+      .def(py::init<>())
+      .def_readwrite("mass", &FfrInvariants3d::mass)
+      .def_readwrite("first_moment", &FfrInvariants3d::firstMoment)
+      .def_readwrite("s_bar", &FfrInvariants3d::sBar)
+      .def_property("m_ff", mffGet, mffSet)
+      .def_property("k_ff", kffGet, kffSet)
+      .def_property("d_ff", dffGet, dffSet)
+      .def_readwrite("points", &FfrInvariants3d::points)
+      .def_readwrite("second_moment", &FfrInvariants3d::secondMoment)
+      .def_property(
+          "position_shape", [](const FfrInvariants3d& v) { return std::vector<MatX>(v.positionShape.begin(), v.positionShape.end()); },
+          [](FfrInvariants3d& v, const std::vector<MatX>& x) {
+            if (x.size() != 3) throw InputError("FfrInvariants3d.position_shape: expected 3 matrices (x, y, z), 3 x nf each");
+            for (int k = 0; k < 3; ++k) v.positionShape[k] = x[k];
+          })
+      .def_property(
+          "s_kl", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.sKL); },
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.sKL, x, "s_kl"); })
+      .def_property(
+          "r_kl", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.rKL); },
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.rKL, x, "r_kl"); })
+      .def_property(
+          "h_i", [](const FfrInvariants3d& v) { return std::vector<MatX>{MatX(v.hI[0]), MatX(v.hI[1]), MatX(v.hI[2])}; },
+          [](FfrInvariants3d& v, const std::vector<MatX>& x) {
+            if (x.size() != 3) throw InputError("FfrInvariants3d.h_i: expected 3 matrices (x, y, z), nf x nf each");
+            for (int k = 0; k < 3; ++k) v.hI[k] = x[k].sparseView();
+          })
+      .def_property_readonly("num_elastic", [](const FfrInvariants3d& v) { return v.mff.rows(); })
+      .def(
+          "validate", [](const FfrInvariants3d& v, const std::string& owner) {
+            v.validate(owner);
+            v.validateSectionRotation(owner);
+          },
+          py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
 
   // ----- the builders: methods of System ------------------------------------------------------
   system
@@ -448,14 +553,19 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           [](System& s, const std::string& name, const py::object& model, const py::object& init,
              std::optional<VecX> qf, std::optional<VecX> qfDot) {
             constexpr const char* fn = "add_flexible_body_3d";
-            if (!py::isinstance<FfrBeamModel3d>(model)) badArgument(fn, "model", "an FfrBeamModel3d", model);
             if (!init.is_none() && !py::isinstance<FrameState3d>(init)) badArgument(fn, "initial", "a FrameState3d", init);
+            const FrameState3d initial = init.is_none() ? FrameState3d{} : init.cast<FrameState3d>();
+            if (py::isinstance<FfrInvariants3d>(model)) {
+              return addFlexibleBody3d(s, name, model.cast<FfrInvariants3d>(), initial, qf ? *qf : VecX(),
+                                       qfDot ? *qfDot : VecX());
+            }
+            if (!py::isinstance<FfrBeamModel3d>(model)) badArgument(fn, "model", "an FfrBeamModel3d or FfrInvariants3d", model);
             return addFlexibleBody3d(s, name, std::shared_ptr<const FfrBeamModel3d>(model.cast<std::shared_ptr<FfrBeamModel3d>>()),
-                                     init.is_none() ? FrameState3d{} : init.cast<FrameState3d>(), qf ? *qf : VecX(),
-                                     qfDot ? *qfDot : VecX());
+                                     initial, qf ? *qf : VecX(), qfDot ? *qfDot : VecX());
           },
           py::arg("name"), py::arg("model"), py::arg("initial") = py::none(),
-          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none())
+          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none(),
+          "A spatial FFR body of a beam model (FfrBeamModel3d) or of given invariants (FfrInvariants3d)")
       .def(
           "add_spatial_joint",
           [](System& s, const std::string& name, const py::object& type, const py::object& bi, const py::object& fi,

@@ -216,6 +216,78 @@ TEST(Shapes, BoxPendulumSwingsWithThePeriodOfAPhysicalPendulum) {
   EXPECT_NEAR(measured / T, 1.0, 1e-4);
 }
 
+TEST(Shapes, EightSubBoxesMakeTheWholeBoxByTheParallelAxisTheorem) {
+  // A box of edges (a, b, c) cut into eight boxes (a/2, b/2, c/2) at offsets (+-a/4, +-b/4,
+  // +-c/4): the parallel-axis sum is exactly the whole box's inertia (to rounding, 1e-15
+  // relative). Turning every part and its offset by one rotation A turns the sum: A I A^T.
+  const Vec3 e(0.4, 0.3, 0.2);
+  const double rho = 7800.0;
+  SolidShape whole;
+  whole.size = e;
+  const RigidBody3dProperties ref = shapeProperties(whole, 0.0, rho);
+  const Mat3 A = quaternionRotation(quaternionFromAxisAngle(Vec3(1, -2, 0.5), 0.7));
+  std::vector<ShapePart> parts, turned;
+  for (int i = 0; i < 8; ++i) {
+    SolidShape s;
+    s.size = e / 2;
+    s.offset = Vec3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1).cwiseProduct(e / 4);
+    parts.push_back({s, 0.0, rho});
+    s.offset = A * s.offset;
+    s.orientation = A;
+    turned.push_back({s, 0.0, rho});
+  }
+  const RigidBody3dProperties sum = shapeProperties(parts);
+  const double scale = ref.inertia.norm();
+  EXPECT_NEAR(sum.mass, ref.mass, 1e-15 * ref.mass);
+  EXPECT_LE((sum.inertia - ref.inertia).norm(), 1e-15 * scale);
+  const RigidBody3dProperties rot = shapeProperties(turned);
+  EXPECT_LE((rot.inertia - A * ref.inertia * A.transpose()).norm(), 1e-15 * scale);
+}
+
+TEST(Shapes, DumbbellIsTheClosedFormAndAnOffCentreSetIsRefused) {
+  // Two spheres (m_s, r) at +-d on x and a rod (cylinder m_c, radius rc, length 2d) between:
+  // Ixx = 2 (2/5 m_s r^2) + m_c rc^2 / 2, Iyy = Izz = 2 (2/5 m_s r^2 + m_s d^2) + m_c (3 rc^2 + 4 d^2) / 12.
+  const double ms = 1.5, r = 0.05, d = 0.3, mc = 0.4, rc = 0.01;
+  SolidShape ball;
+  ball.type = SolidShape::Type::Sphere;
+  ball.radius = r;
+  SolidShape rod;
+  rod.type = SolidShape::Type::Cylinder;
+  rod.radius = rc;
+  rod.length = 2 * d;
+  rod.orientation = quaternionRotation(quaternionFromAxisAngle(Vec3(0, 1, 0), M_PI / 2));  // its z along body x
+  SolidShape left = ball, right = ball;
+  left.offset = Vec3(-d, 0, 0);
+  right.offset = Vec3(d, 0, 0);
+  const RigidBody3dProperties p = shapeProperties({{left, ms, 0.0}, {right, ms, 0.0}, {rod, mc, 0.0}});
+  const double ixx = 2 * 0.4 * ms * r * r + mc * rc * rc / 2;
+  const double iyy = 2 * (0.4 * ms * r * r + ms * d * d) + mc * (3 * rc * rc + 4 * d * d) / 12;
+  EXPECT_NEAR(p.mass, 2 * ms + mc, 1e-15);
+  EXPECT_NEAR(p.inertia(0, 0), ixx, 1e-15 * iyy);
+  EXPECT_NEAR(p.inertia(1, 1), iyy, 1e-15 * iyy);
+  EXPECT_NEAR(p.inertia(2, 2), iyy, 1e-15 * iyy);
+  EXPECT_NEAR(p.inertia(0, 1), 0.0, 1e-15 * iyy);
+  // without the left ball the centre of mass is at ms d / (ms + mc) on x: refused, and said
+  const CompositeInertia c = compositeInertia({{right, ms, 0.0}, {rod, mc, 0.0}});
+  EXPECT_NEAR(c.centreOfMass.x(), ms * d / (ms + mc), 1e-15);
+  expectInputError([&] { shapeProperties({{right, ms, 0.0}, {rod, mc, 0.0}}); },
+                                  {"centre of mass is at [0.2368421", "subtract it from every offset"});
+  // in a scene: an array of shapes with offsets and an orientation; errors name the shape
+  json j = boxPendulum(1.0, 0.0, 0.01, 0.01);
+  j["bodies"][0]["shape"] = json::parse(R"([
+      {"type": "sphere", "radius": 0.05, "mass": 1.5, "offset": [-0.3, 0, 0]},
+      {"type": "sphere", "radius": 0.05, "mass": 1.5, "offset": [0.3, 0, 0]},
+      {"type": "cylinder", "radius": 0.01, "length": 0.6, "mass": 0.4, "orientation": {"axis": [0, 1, 0], "angle": 1.5707963267948966}}])");
+  Scene scene = parseScene(j);
+  const auto& body = dynamic_cast<const RigidBody3d&>(scene.system.body(scene.system.findBody("box")));
+  EXPECT_NEAR(body.inertia()(0, 0), ixx, 1e-12 * iyy);  // the orientation typed to 17 digits
+  EXPECT_NEAR(body.inertia()(1, 1), iyy, 1e-12 * iyy);
+  j["bodies"][0]["shape"][1]["offset"] = {0.2, 0, 0};
+  expectInputError([&] { parseScene(j); }, {"bodies[0] (\"box\").shape", "centre of mass is at"});
+  j["bodies"][0]["shape"][1] = 3;
+  expectInputError([&] { parseScene(j); }, {"shape[1]", "must be a shape"});
+}
+
 // ----- joint output columns ----------------------------------------------------------
 
 TEST(JointOutputs, DrivenRevoluteReportsTheLawsAngleAndRateOverManyTurns) {

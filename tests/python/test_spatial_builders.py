@@ -233,6 +233,53 @@ def test_timoshenko_option_adds_the_shear_flexibility_of_a_cantilever():
         flexmbd.FfrBeamModel3d(flexmbd.BeamMesh3d.straight(length, 2, general), options)
 
 
+def test_placed_shapes_make_a_dumbbell_of_the_closed_form_inertia():
+    # two spheres (m_s, r) at +-d on body x and a rod (m_c, radius r_c, length 2d) along x:
+    # Ixx = 2 (2/5 m_s r^2) + m_c r_c^2 / 2, Iyy = Izz = 2 (2/5 m_s r^2 + m_s d^2) + m_c (3 r_c^2 + 4 d^2) / 12
+    ms, r, d, mc, rc = 1.5, 0.05, 0.3, 0.4, 0.01
+    ball = flexmbd.SolidShape.sphere(r)
+    rod = flexmbd.SolidShape.cylinder(rc, 2 * d, axis="z").placed((0, 0, 0), orientation=((0, 1, 0), math.pi / 2))
+    parts = [flexmbd.ShapePart(ball.placed((-d, 0, 0)), mass=ms), flexmbd.ShapePart(ball.placed((d, 0, 0)), mass=ms),
+             flexmbd.ShapePart(rod, mass=mc)]
+    props = flexmbd.shape_properties(parts)
+    ixx = 2 * 0.4 * ms * r ** 2 + mc * rc ** 2 / 2
+    iyy = 2 * (0.4 * ms * r ** 2 + ms * d ** 2) + mc * (3 * rc ** 2 + 4 * d ** 2) / 12
+    # exact formulas: rounding only (1e-14 relative)
+    np.testing.assert_allclose(props.inertia, np.diag([ixx, iyy, iyy]), rtol=0, atol=1e-14 * iyy)
+    assert props.mass == pytest.approx(2 * ms + mc, rel=1e-15)
+    # one ball only: the centre of mass moves to m_s d / (m_s + m_c), and such a body is refused
+    c = flexmbd.composite_inertia(parts[1:])
+    assert c.centre_of_mass[0] == pytest.approx(ms * d / (ms + mc), rel=1e-14)
+    with pytest.raises(flexmbd.InputError, match="centre of mass is at"):
+        flexmbd.shape_properties(parts[1:])
+
+
+def test_a_body_of_given_invariants_is_the_body_of_its_beam_model():
+    # The clamped beam as a body of its model and as a body of the model's invariants: the
+    # same equations, so the same modes (1e-10: two eigen-solves of one matrix); k_ff
+    # doubled in the given invariants raises every frequency by sqrt(2) (omega^2 = k/m).
+    section = flexmbd.rectangular_section_3d(0.02, 0.02, youngs_modulus=2.1e11, poisson_ratio=0.3, density=7800.0)
+    model = flexmbd.FfrBeamModel3d(flexmbd.BeamMesh3d.straight(1.0, 6, section),
+                                   flexmbd.FfrBeamOptions3d(reference=flexmbd.Reference3d.CLAMPED, modes=4))
+
+    def clamped(body_model):
+        scene = flexmbd.Scene("cantilever")
+        beam = scene.system.add_flexible_body_3d("beam", body_model)
+        scene.system.add_spatial_joint("clamp", "fixed", "ground", flexmbd.JointFrame(), beam, flexmbd.JointFrame())
+        return [m["omega"] for m in scene.modes(count=3)]
+
+    inv = model.invariants
+    assert isinstance(inv, flexmbd.FfrInvariants3d) and inv.num_elastic == 4 and len(inv.points) == 7
+    assert inv.mass == pytest.approx(7800.0 * 0.02 ** 2 * 1.0, rel=1e-14)
+    reference = clamped(model)
+    assert clamped(inv) == pytest.approx(reference, rel=1e-10)
+    inv.k_ff = 2.0 * inv.k_ff
+    assert clamped(inv) == pytest.approx([math.sqrt(2.0) * w for w in reference], rel=1e-10)
+    inv.m_ff = -inv.m_ff
+    with pytest.raises(flexmbd.InputError, match="m_ff"):
+        flexmbd.Scene("bad").system.add_flexible_body_3d("beam", inv)
+
+
 @pytest.mark.parametrize("call, error, words", [
     (lambda: flexmbd.FrameState3d(position="up"), TypeError, "FrameState3d: position must be 3 numbers"),
     (lambda: flexmbd.FrameState3d(orientation=[[1, 0, 0], [0, 2, 0], [0, 0, 1]]), flexmbd.InputError,
