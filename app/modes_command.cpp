@@ -219,11 +219,12 @@ double shapeScale(const System& sys, const VecX& shape) {
 }
 
 /// DIR/vtk/mode_NN.pvd: one period of each mode shape, q = q_ref (+) c Re(shape e^{i phi}).
-void writeShapesVtk(const fs::path& dir, const System& sys, const ReferenceState& ref, const std::vector<Mode>& modes) {
+void writeShapesVtk(const fs::path& dir, const Scene& scene, const ReferenceState& ref, const std::vector<Mode>& modes) {
+  const System& sys = scene.system;
   for (size_t k = 0; k < modes.size(); ++k) {
     char prefix[32];
     std::snprintf(prefix, sizeof prefix, "mode_%02zu", k + 1);
-    VtkWriter vtk(dir, sys, prefix);
+    VtkWriter vtk(dir, sys, prefix, 4, scene.geometry);
     const double c = shapeScale(sys, modes[k].shape.real());
     for (int f = 0; f < kShapeFrames; ++f) {
       const double phi = 2 * M_PI * f / kShapeFrames;
@@ -379,7 +380,7 @@ int runModesCommand(const std::vector<std::string>& args) {
     const std::vector<Mode> modes = computeModes(red, mo);
     writeModesCsv(out / "modes.csv", modes);
     writeShapesCsv(out / "mode_shapes.csv", modes, lin.velocityNames);
-    writeShapesVtk(out / "vtk", sys, ref, modes);
+    writeShapesVtk(out / "vtk", *scene, ref, modes);
     const double aMax = ref.a.size() ? ref.a.lpNorm<Eigen::Infinity>() : 0.0;
     std::printf("flexmbd: modes of %s about t = %g (%s; max |a| = %.3g): %d velocities, %d independent\n",
                 o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : o.steady ? "steady motion" : "in motion", aMax,

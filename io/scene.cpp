@@ -609,6 +609,11 @@ Scene parseScene(const json& j) {
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::string at = "bodies[" + std::to_string(i) + "]";
     spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys) : parseBody(bodies[i], at, sys);
+    if (bodies[i].contains("geometry")) {  // a rigid body's (the readers refuse the key elsewhere)
+      const BodyIndex b(sys.numBodies() - 1);
+      scene.geometry.push_back({b, scenereaders::parseGeometry(bodies[i]["geometry"],
+                                                               at + " (\"" + sys.body(b).name() + "\").geometry")});
+    }
   }
 
   const json& joints = top.array("joints");

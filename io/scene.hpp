@@ -8,6 +8,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "bodies/body_geometry.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
 
@@ -51,6 +52,7 @@ struct Scene {
   System system;  ///< finalized
   SolverSettings solver;
   std::vector<OutputRequest> outputs;
+  std::vector<BodyGeometry> geometry;  ///< the rigid bodies' "geometry" (viewing only)
 };
 
 /// Reads and parses a scene file. Error messages start with the file path.

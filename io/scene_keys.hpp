@@ -18,7 +18,7 @@ using Keys = std::vector<std::string>;
 inline const Keys kScene = {"name",   "dimension", "gravity", "bodies", "joints",
                             "drivers", "forces",   "outputs", "solver"};
 inline const Keys kRigidBody = {"name",  "type",     "mass", "inertia", "com", "position",
-                                "angle", "velocity", "angular_velocity"};
+                                "angle", "velocity", "angular_velocity", "geometry"};
 inline const Keys kFlexibleBody = {"name",     "type",     "position",    "angle",
                                    "velocity", "angular_velocity",       "section",
                                    "beam",     "nodes",    "elements",   "reference",
@@ -59,13 +59,18 @@ inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",
                              "quasi_static_above", "redundant_constraints"};
 
 // spatial scenes ("dimension": 3)
-inline const Keys kRigidBody3d = {"name",     "type",        "mass",  "inertia", "shape", "position",
-                                  "orientation", "velocity", "angular_velocity"};
+inline const Keys kRigidBody3d = {"name",        "type",     "mass",             "inertia", "shape", "position",
+                                  "orientation", "velocity", "angular_velocity", "geometry"};
 inline const Keys kShapeBox = {"type", "size", "mass", "density", "offset", "orientation"};
 inline const Keys kShapeSphere = {"type", "radius", "mass", "density", "offset", "orientation"};
 inline const Keys kShapeCylinder = {"type", "radius", "length", "axis", "mass", "density", "offset", "orientation"};
 inline const Keys kShapeTube = {"type",   "inner_radius", "outer_radius", "length", "axis",
                                 "mass",   "density",      "offset",       "orientation"};
+// "geometry" of a rigid body (viewing only): the shapes' keys without mass and density
+inline const Keys kGeometryBox = {"type", "size", "offset", "orientation"};
+inline const Keys kGeometrySphere = {"type", "radius", "offset", "orientation"};
+inline const Keys kGeometryCylinder = {"type", "radius", "length", "axis", "offset", "orientation"};
+inline const Keys kGeometryTube = {"type", "inner_radius", "outer_radius", "length", "axis", "offset", "orientation"};
 inline const Keys kFlexibleBody3d = {"name",     "type",      "position",    "orientation", "velocity",
                                      "angular_velocity",     "section",     "beam",        "nodes",
                                      "elements", "y_axis",    "reference",   "modes",       "geometric_stiffening",
@@ -159,6 +164,10 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"shape.sphere", &kShapeSphere},
       {"shape.cylinder", &kShapeCylinder},
       {"shape.tube", &kShapeTube},
+      {"geometry.box", &kGeometryBox},
+      {"geometry.sphere", &kGeometrySphere},
+      {"geometry.cylinder", &kGeometryCylinder},
+      {"geometry.tube", &kGeometryTube},
       {"orientation", &kOrientation},
       {"body.flexible.3d", &kFlexibleBody3d},
       {"body.flexible_invariants.3d", &kInvariantsBody3d},

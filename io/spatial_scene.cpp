@@ -8,6 +8,7 @@
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
+#include "bodies/body_geometry.hpp"
 #include "bodies/shape_inertia.hpp"
 #include "io/flexible_body_reader.hpp"
 #include "builders/planar_builders.hpp"
@@ -239,26 +240,19 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
 }
 
-/// One shape of key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" |
-/// "sphere", its dimensions, exactly one of "mass" or "density", optional "offset" and
-/// "orientation" in body axes}.
-ShapePart parseShapePart(const json& j, const std::string& where) {
-  const ObjectReader r(j, where);
-  const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
-  ShapePart part;
-  SolidShape& s = part.shape;
+/// The type, dimensions, "offset" and "orientation" of a shape (in "shape" and "geometry");
+/// the caller has checked the keys.
+SolidShape readSolidShape(const ObjectReader& r, const std::string& type) {
+  SolidShape s;
   if (type == "box") {
-    r.allowOnly(scenekeys::kShapeBox, " for a box shape");
     s.type = SolidShape::Type::Box;
     s.size = r.vector("size", 3);
     for (int k = 0; k < 3; ++k) r.checkPositive(s.size[k], "size[" + std::to_string(k) + "]");
   } else if (type == "sphere") {
-    r.allowOnly(scenekeys::kShapeSphere, " for a sphere shape");
     s.type = SolidShape::Type::Sphere;
     s.radius = r.positive("radius");
   } else {
     const bool tube = type == "tube";
-    r.allowOnly(tube ? scenekeys::kShapeTube : scenekeys::kShapeCylinder, " for a " + type + " shape");
     s.type = tube ? SolidShape::Type::Tube : SolidShape::Type::Cylinder;
     s.radius = r.positive(tube ? "outer_radius" : "radius");
     if (tube) {
@@ -276,26 +270,51 @@ ShapePart parseShapePart(const json& j, const std::string& where) {
   }
   if (r.has("offset")) s.offset = r.vector("offset", 3);
   if (r.has("orientation")) s.orientation = parseOrientation(r.object("orientation"), r.where() + ".orientation");
+  return s;
+}
+
+const std::array<const char*, 4> kShapeTypes = {"box", "cylinder", "tube", "sphere"};
+
+/// One shape of key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" |
+/// "sphere", its dimensions, exactly one of "mass" or "density", optional "offset" and
+/// "orientation" in body axes}.
+ShapePart parseShapePart(const json& j, const std::string& where) {
+  const ObjectReader r(j, where);
+  const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
+  static const std::array<const scenekeys::Keys*, 4> keys = {&scenekeys::kShapeBox, &scenekeys::kShapeCylinder,
+                                                             &scenekeys::kShapeTube, &scenekeys::kShapeSphere};
+  for (std::size_t k = 0; k < kShapeTypes.size(); ++k) {
+    if (type == kShapeTypes[k]) r.allowOnly(*keys[k], " for a " + type + " shape");
+  }
+  ShapePart part;
+  part.shape = readSolidShape(r, type);
   if (r.has("mass") == r.has("density")) r.fail("give exactly one of \"mass\" or \"density\"");
   part.mass = r.has("mass") ? r.positive("mass") : 0.0;
   part.density = r.has("density") ? r.positive("density") : 0.0;
   return part;
 }
 
+/// An array of shapes or one shape {...}, each object read by `read`.
+template <class T, class Read>
+std::vector<T> readShapeList(const json& j, const std::string& where, Read read) {
+  const auto one = [&](const json& v, const std::string& at) {
+    if (!v.is_object()) throw InputError(at + ": must be a shape {\"type\": ...}, got " + describe(v));
+    return read(v, at);
+  };
+  std::vector<T> out;
+  if (j.is_array()) {
+    if (j.empty()) throw InputError(where + ": an array of shapes must have at least one shape");
+    for (std::size_t k = 0; k < j.size(); ++k) out.push_back(one(j[k], where + "[" + std::to_string(k) + "]"));
+  } else {
+    out.push_back(one(j, where));
+  }
+  return out;
+}
+
 /// Key "shape" of a spatial rigid body: one shape, or an array of them whose centre of
 /// mass is the body origin.
 RigidBody3dProperties parseShape(const json& j, const std::string& where) {
-  const auto part = [](const json& v, const std::string& at) {
-    if (!v.is_object()) throw InputError(at + ": must be a shape {\"type\": ...}, got " + describe(v));
-    return parseShapePart(v, at);
-  };
-  std::vector<ShapePart> parts;
-  if (j.is_array()) {
-    if (j.empty()) throw InputError(where + ": an array of shapes must have at least one shape");
-    for (std::size_t k = 0; k < j.size(); ++k) parts.push_back(part(j[k], where + "[" + std::to_string(k) + "]"));
-  } else {
-    parts.push_back(part(j, where));
-  }
+  const std::vector<ShapePart> parts = readShapeList<ShapePart>(j, where, parseShapePart);
   return located(where, [&] { return shapeProperties(parts); });
 }
 
@@ -326,6 +345,21 @@ Mat3 parseOrientation(const json& j, const std::string& where) {
   const Vec3 axis = r.vector("axis", 3);
   if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
   return quaternionRotation(quaternionFromAxisAngle(axis, r.number("angle")));
+}
+
+std::vector<SolidShape> parseGeometry(const json& j, const std::string& where) {
+  return readShapeList<SolidShape>(j, where, [](const json& v, const std::string& at) {
+    const ObjectReader r(v, at);
+    const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
+    static const std::array<const scenekeys::Keys*, 4> keys = {&scenekeys::kGeometryBox, &scenekeys::kGeometryCylinder,
+                                                               &scenekeys::kGeometryTube, &scenekeys::kGeometrySphere};
+    for (std::size_t k = 0; k < kShapeTypes.size(); ++k) {
+      if (type == kShapeTypes[k]) r.allowOnly(*keys[k], " for a " + type + " in \"geometry\" (viewing only: no mass)");
+    }
+    SolidShape s = readSolidShape(r, type);
+    located(r.where(), [&] { return surfaceMesh(s); });  // the dimensions' checks
+    return s;
+  });
 }
 
 void parseSpatialBody(const json& j, const std::string& where, System& sys) {

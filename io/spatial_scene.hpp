@@ -9,6 +9,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "bodies/shape_inertia.hpp"
 #include "core/system.hpp"
 #include "io/json_reader.hpp"
 
@@ -34,6 +35,9 @@ SpringDamperLaw readSpringDamperLaw(const jsonread::ObjectReader& r, const std::
 Mat3 parseOrientation(const nlohmann::json& j, const std::string& where);
 
 void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys);
+/// Key "geometry" of a rigid body (planar or spatial): one shape or an array of them,
+/// placed in the body frame, for viewing only. @throws InputError starting with `where`.
+std::vector<SolidShape> parseGeometry(const nlohmann::json& j, const std::string& where);
 void parseSpatialJoint(const nlohmann::json& j, const std::string& where, System& sys);
 void parseSpatialDriver(const nlohmann::json& j, const std::string& where, System& sys);
 void parseSpatialForce(const nlohmann::json& j, const std::string& where, System& sys);

@@ -17,13 +17,15 @@ namespace {
 
 constexpr int kVtkLine = 3;      // VTK_LINE
 constexpr int kVtkPolyLine = 4;  // VTK_POLY_LINE
+constexpr int kVtkPolygon = 7;   // VTK_POLYGON
 
-/// One frame: points (3D), cells of one VTK type, named point/cell arrays and the
-/// string arrays of its field data.
+/// One frame: points (3D), cells (of type cellType, or of cellTypes[k] where given),
+/// named point/cell arrays and the string arrays of its field data.
 struct Grid {
   std::vector<Eigen::Vector3d> points;
   std::vector<std::vector<int>> cells;
   int cellType = kVtkPolyLine;
+  std::vector<int> cellTypes;  ///< per cell; cells beyond its size are of cellType
   std::vector<std::pair<std::string, std::vector<double>>> pointScalars, cellScalars;
   std::vector<std::pair<std::string, std::vector<Eigen::Vector3d>>> pointVectors;
   std::vector<std::pair<std::string, std::vector<int>>> cellInts;
@@ -81,7 +83,7 @@ void writeVtu(const std::filesystem::path& path, const Grid& g, double t) {
   long offset = 0;
   for (const auto& l : g.cells) out << (offset += static_cast<long>(l.size())) << " ";
   out << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (size_t k = 0; k < g.cells.size(); ++k) out << g.cellType << " ";
+  for (size_t k = 0; k < g.cells.size(); ++k) out << (k < g.cellTypes.size() ? g.cellTypes[k] : g.cellType) << " ";
   out << "\n</DataArray>\n</Cells>\n";
   if (!g.pointScalars.empty() || !g.pointVectors.empty()) {
     out << "<PointData";
@@ -124,6 +126,33 @@ void writeVtu(const std::filesystem::path& path, const Grid& g, double t) {
 
 Eigen::Vector3d in3d(const Vec2& p) { return {p.x(), p.y(), 0.0}; }
 
+/// Appends a rigid body's geometry surfaces (polygon cells) at state q.
+void addSurfaces(const Body& body, const ConstVecRef& q, const std::vector<SurfaceMesh>& surfaces, Grid& g) {
+  if (surfaces.empty()) return;
+  // the body frame's pose: a spatial body's centre of mass and rotation; a planar body's
+  // points in its plane (z kept: the plane is z = 0, the body turns about z)
+  const auto* r3 = dynamic_cast<const RigidBody3d*>(&body);
+  const Vec3 c = r3 ? body.centreOfMass(q) : Vec3::Zero();
+  const Mat3 A = r3 ? RigidBody3d::rotationOf(q) : Mat3::Identity();
+  const auto world = [&](const Vec3& u) -> Eigen::Vector3d {
+    if (r3) return c + A * u;
+    const Vec2 p = body.pointKinematics(q, u.head<2>(), false).r;
+    return {p.x(), p.y(), u.z()};
+  };
+  g.cellTypes.resize(g.cells.size(), g.cellType);
+  for (const SurfaceMesh& m : surfaces) {
+    const int first = static_cast<int>(g.points.size());
+    for (const Vec3& u : m.points) g.points.push_back(world(u));
+    for (const std::vector<int>& f : m.faces) {
+      std::vector<int> cell(f.size());
+      for (std::size_t k = 0; k < f.size(); ++k) cell[k] = first + f[k];
+      g.cells.push_back(std::move(cell));
+      g.cellTypes.push_back(kVtkPolygon);
+    }
+  }
+}
+
+
 }  // namespace
 
 // ----- the collection -----------------------------------------------------------------------
@@ -162,8 +191,13 @@ void VtkCollection::add(double t) {
 
 // ----- multibody systems ----------------------------------------------------------------------
 
-VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix, int subdivisions)
+VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix, int subdivisions,
+                     const std::vector<BodyGeometry>& geometry)
     : collection_(dir, std::move(prefix)), sys_(sys), subdivisions_(std::max(1, subdivisions)) {
+  surfaces_.resize(sys.numBodies());
+  for (const BodyGeometry& g : geometry) {
+    for (const SolidShape& shape : g.shapes) surfaces_.at(g.body.value).push_back(surfaceMesh(shape));
+  }
   rigidPoints_.resize(sys.numBodies());
   for (int b = 1; b < sys.numBodies(); ++b) {
     const Body& body = sys.body(BodyIndex(b));
@@ -203,7 +237,9 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
     const auto* f3 = dynamic_cast<const FfrBody3d*>(&body);
     const bool spatial = dynamic_cast<const RigidBody3d*>(&body) != nullptr ||
                          (f3 && (f3->model() || !f3->invariants().points.empty()));
-    if (rigidPoints_[b].empty() && !(fb && fb->beamModel()) && !spatial) notDrawn_.push_back(body.name());
+    if (rigidPoints_[b].empty() && !(fb && fb->beamModel()) && !spatial && surfaces_[b].empty()) {
+      notDrawn_.push_back(body.name());
+    }
   }
 }
 
@@ -299,7 +335,11 @@ void VtkWriter::write(const OutputSample& s) {
       }
       g.cells.push_back(line);
     }
+    addSurfaces(body, q, surfaces_[b], g);
     // bodies other than spatial beams carry no section force and moment vectors
+    displacement.resize(g.points.size(), Vec3::Zero());
+    axial.resize(g.points.size(), 0.0);
+    moment.resize(g.points.size(), 0.0);
     sectionForce.resize(g.points.size(), Vec3::Zero());
     sectionMoment.resize(g.points.size(), Vec3::Zero());
     if (static_cast<int>(g.cells.size()) > cellsBefore) {

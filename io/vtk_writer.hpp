@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bodies/body_geometry.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
 #include "tensegrity/tensegrity_output.hpp"
@@ -45,8 +46,9 @@ class VtkCollection {
 class VtkWriter {
  public:
   /// Creates `dir` and starts `dir/<prefix>.pvd`. @throws std::runtime_error.
+  /// `geometry`: shapes drawn as surfaces (polygons) on rigid bodies (Scene::geometry).
   VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix = "bodies",
-            int subdivisions = 4);
+            int subdivisions = 4, const std::vector<BodyGeometry>& geometry = {});
   /// Writes `<prefix>_<k>.vtu` for the sample and rewrites the .pvd collection.
   void write(const OutputSample& sample);
   long filesWritten() const { return collection_.frames(); }
@@ -64,6 +66,7 @@ class VtkWriter {
   // mass, and the length of the axis triad drawn at the centre of mass
   std::vector<std::vector<Vec3>> spatialPoints_;
   double triad_ = 0.1;
+  std::vector<std::vector<SurfaceMesh>> surfaces_;  // per body: its geometry, body axes
 };
 
 /// A tensegrity structure: its nodes as points (point data: velocity) and every member

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -13,11 +14,15 @@
 #include <nlohmann/json.hpp>
 
 #include "bodies/ffr_body_2d.hpp"
+#include "bodies/body_geometry.hpp"
 #include "bodies/ffr_body_3d.hpp"
+#include "bodies/rigid_body_3d.hpp"
+#include "core/rotation_3d.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
 #include "tests/ffr_test_models.hpp"
+#include "tests/test_support.hpp"
 
 using namespace flexmbd;
 namespace fs = std::filesystem;
@@ -167,6 +172,109 @@ TEST(VtkWriter, InvariantsBodyIsDrawnThroughItsAttachmentPoints) {
   }
   EXPECT_GT(largest, 0.0);
   fs::remove_all(dir);
+}
+
+TEST(BodyGeometry, SurfacesAreClosedOutwardAndEncloseThePolyhedronVolume) {
+  // Every directed edge of a closed, consistently oriented surface is matched by its
+  // reverse exactly once; the enclosed volume (1/6) sum p0 . (p1 x p2) over the faces'
+  // fan triangles (divergence theorem) is positive for outward faces and equals the
+  // polyhedron's: a box's a b c; an n-sided prism's n/2 sin(2 pi/n) r^2 h (the cylinder's
+  // and, with ro^2 - ri^2, the tube's); for the sphere of n meridians within 3 % of 4/3 pi
+  // r^3 from below (inscribed). Offsets and rotations do not change a closed volume.
+  const int n = 24;
+  const auto check = [&](const SolidShape& s, double expected, double tol) {
+    const SurfaceMesh m = surfaceMesh(s, n);
+    std::map<std::pair<int, int>, int> edges;
+    double volume = 0.0;
+    for (const auto& f : m.faces) {
+      for (std::size_t k = 0; k < f.size(); ++k) ++edges[{f[k], f[(k + 1) % f.size()]}];
+      for (std::size_t k = 1; k + 1 < f.size(); ++k) {
+        volume += m.points[f[0]].dot(m.points[f[k]].cross(m.points[f[k + 1]])) / 6.0;
+      }
+    }
+    for (const auto& [e, count] : edges) {
+      EXPECT_EQ(count, 1) << "edge " << e.first << "-" << e.second;
+      EXPECT_EQ(edges.count({e.second, e.first}), 1u) << "edge " << e.first << "-" << e.second << " has no twin";
+    }
+    EXPECT_NEAR(volume / expected, 1.0, tol) << static_cast<int>(s.type);
+  };
+  const double prism = n / 2.0 * std::sin(2 * M_PI / n);
+  SolidShape box;
+  box.size = Vec3(0.3, 0.2, 0.1);
+  check(box, 0.006, 1e-14);
+  SolidShape cyl;
+  cyl.type = SolidShape::Type::Cylinder;
+  cyl.radius = 0.05;
+  cyl.length = 0.4;
+  cyl.axis = 0;
+  cyl.offset = Vec3(1.0, -2.0, 0.5);
+  cyl.orientation = quaternionRotation(quaternionFromAxisAngle(Vec3(1, 1, 0), 0.3));
+  check(cyl, prism * 0.0025 * 0.4, 1e-12);  // rounding of the rotated, offset points
+  SolidShape tube = cyl;
+  tube.type = SolidShape::Type::Tube;
+  tube.innerRadius = 0.04;
+  tube.axis = 1;
+  check(tube, prism * (0.0025 - 0.0016) * 0.4, 1e-12);
+  SolidShape sphere;
+  sphere.type = SolidShape::Type::Sphere;
+  sphere.radius = 0.1;
+  const double exact = 4.0 / 3.0 * M_PI * 1e-3;
+  check(sphere, 0.985 * exact, 0.015);
+  // the axis: a cylinder along body y has its points' extent 0.4 along y
+  cyl.axis = 1;
+  cyl.offset = Vec3::Zero();
+  cyl.orientation = Mat3::Identity();
+  double ymax = 0.0;
+  for (const Vec3& p : surfaceMesh(cyl, n).points) ymax = std::max(ymax, p.y());
+  EXPECT_NEAR(ymax, 0.2, 1e-15);
+}
+
+TEST(VtkWriter, GeometryIsDrawnAsPolygonsWhereTheBodyIs) {
+  // A spatial box body turned and moved, with a box "geometry" offset in it: the drawn
+  // corners are R + A (offset + corner) (to the 12 digits the file holds); a planar body
+  // with a cylinder; cells of type VTK_POLYGON (7) after the bodies' lines.
+  nlohmann::json j = nlohmann::json::parse(R"({"dimension": 3, "bodies": [{"name": "b", "type": "rigid",
+      "mass": 1, "inertia": [1, 1, 1], "position": [0.5, -1, 2], "orientation": {"axis": [0, 0, 1], "angle": 0.5},
+      "geometry": [{"type": "box", "size": [0.2, 0.1, 0.1], "offset": [0.1, 0, 0]}]}]})");
+  const Scene sc = parseScene(j);
+  ASSERT_EQ(sc.geometry.size(), 1u);
+  const fs::path dir = fs::temp_directory_path() / ("flexmbd_vtkgeo_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  OutputSample o;
+  o.q = sc.system.initialCoordinates();
+  o.v = sc.system.initialVelocities();
+  {
+    VtkWriter vtk(dir, sc.system, "bodies", 4, sc.geometry);
+    vtk.write(o);
+  }
+  std::string vtu = read(dir / "bodies_000000.vtu");
+  std::vector<int> types = intArray(vtu, "types");
+  ASSERT_EQ(std::count(types.begin(), types.end(), 7), 6);  // the box's faces
+  const std::vector<double> pts = dataArray(vtu, "");
+  const Mat3 A = quaternionRotation(quaternionFromAxisAngle(Vec3(0, 0, 1), 0.5));
+  const Vec3 corner = Vec3(0.5, -1, 2) + A * Vec3(0.1 + 0.1, 0.05, 0.05);  // the last of the 8 corners
+  const std::size_t last = pts.size() - 3;
+  EXPECT_LT((Vec3(pts[last], pts[last + 1], pts[last + 2]) - corner).norm(), 1e-11);
+  EXPECT_EQ(dataArray(vtu, "elastic_displacement").size(), pts.size());  // point data for every point
+  fs::remove_all(dir);
+  // planar: a crank with a cylinder about its pin (axis z): drawn, not "not drawn"
+  nlohmann::json p = nlohmann::json::parse(R"({"bodies": [{"name": "crank", "type": "rigid", "mass": 1,
+      "inertia": 0.1, "geometry": {"type": "cylinder", "radius": 0.02, "length": 0.01}}]})");
+  const Scene ps = parseScene(p);
+  o.q = ps.system.initialCoordinates();
+  o.v = ps.system.initialVelocities();
+  {
+    VtkWriter vtk(dir, ps.system, "bodies", 4, ps.geometry);
+    EXPECT_TRUE(vtk.bodiesNotDrawn().empty());
+    vtk.write(o);
+  }
+  vtu = read(dir / "bodies_000000.vtu");
+  types = intArray(vtu, "types");
+  EXPECT_EQ(std::count(types.begin(), types.end(), 7), 24 + 2);  // side facets and two ends
+  fs::remove_all(dir);
+  // geometry has no mass, and flexible bodies do not take it
+  p["bodies"][0]["geometry"]["mass"] = 1.0;
+  testsupport::expectInputError([&] { parseScene(p); }, {"bodies[0] (\"crank\").geometry", "mass", "viewing only"});
 }
 
 TEST(VtkWriter, SpatialBeamIsDrawnDeformedWithItsSectionForces) {
