@@ -94,7 +94,7 @@ inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames", "world"};
 inline const Keys kJointWorld = {"point", "axis", "x_axis", "orientation"};
 inline const Keys kJointFrame = {"point", "axis", "orientation"};
-inline const Keys kBushing = {"name", "type", "bodies", "frames", "stiffness", "damping"};
+inline const Keys kBushing = {"name", "type", "bodies", "frames", "world", "stiffness", "damping"};
 inline const Keys kSpatialAppliedLoad = {"name",    "type",     "body",     "point",    "force_x",
                                          "force_y", "force_z",  "torque_x", "torque_y", "torque_z"};
 

@@ -466,7 +466,7 @@ void parseSpatialForce(const json& j, const std::string& where, System& sys) {
     r.allowOnly(scenekeys::kBushing, forA);
     const std::string name = r.name("name");
     const auto [bi, bj] = lookupBodyPair(sys, r, "a bushing");
-    const auto [fi, fj] = parseFramePair(r);
+    const auto [fi, fj] = parseJointFrames(r, sys, bi, bj, SpatialJointType::Fixed);  // "frames" or "world"
     std::array<double, 6> k{}, c{};
     const VecX kv = r.vector("stiffness", 6);
     const VecX cv = r.has("damping") ? r.vector("damping", 6) : VecX::Zero(6);

@@ -288,6 +288,37 @@ TEST(Shapes, DumbbellIsTheClosedFormAndAnOffCentreSetIsRefused) {
   expectInputError([&] { parseScene(j); }, {"shape[1]", "must be a shape"});
 }
 
+TEST(WorldJoints, BushingPlacedInTheWorldStartsUndeflectedAndSpringsAlongItsAxis) {
+  // A turned body on a bushing placed by a world frame at its centre with the axis (1, 1, 0):
+  // frame I's z axis is that axis, so a push v0 along it oscillates at w = sqrt(kz / m)
+  // along it, s(t) = (v0 / w) sin(w t), and nothing moves across it (the frames start
+  // aligned, the mount undeflected). rtol 1e-10: 1e-6 of the amplitude, as the other
+  // bushing test (tests/test_spatial_dynamics.cpp).
+  const double m = 2.0, kz = 800.0, v0 = 0.01;
+  const Vec3 e = Vec3(1, 1, 0).normalized(), c(0.3, 0.2, 0.1);
+  json j = json::parse(R"({"dimension": 3,
+    "bodies": [{"name": "b", "type": "rigid", "mass": 2, "inertia": [0.04, 0.045, 0.05],
+                "position": [0.3, 0.2, 0.1], "orientation": {"axis": [1, 2, 3], "angle": 0.7}}],
+    "forces": [{"name": "mount", "type": "bushing", "bodies": ["ground", "b"],
+                "world": {"point": [0.3, 0.2, 0.1], "axis": [1, 1, 0]},
+                "stiffness": [500, 600, 800, 30, 40, 20]}],
+    "solver": {"t_end": 1.0, "output_step": 0.005, "rtol": 1e-10, "atol": 1e-12}})");
+  j["bodies"][0]["velocity"] = {v0 * e.x(), v0 * e.y(), 0.0};
+  Scene scene = parseScene(j);
+  const RunRows r = runScene(scene);
+  const double w = std::sqrt(kz / m);
+  double along = 0.0, across = 0.0;
+  for (std::size_t k = 0; k < r.t.size(); ++k) {
+    const Vec3 d = Vec3(r.q[k].head<3>()) - c;
+    along = std::max(along, std::abs(d.dot(e) - v0 / w * std::sin(w * r.t[k])));
+    across = std::max(across, (d - d.dot(e) * e).norm());
+  }
+  EXPECT_LE(along, 1e-6 * v0 / w);
+  EXPECT_LE(across, 1e-6 * v0 / w);
+  j["forces"][0]["frames"] = json::array({json::object(), json::object()});
+  testsupport::expectInputError([&] { parseScene(j); }, {"forces[0] (\"mount\")", "exactly one of \"frames\""});
+}
+
 // ----- joint output columns ----------------------------------------------------------
 
 TEST(JointOutputs, DrivenRevoluteReportsTheLawsAngleAndRateOverManyTurns) {
