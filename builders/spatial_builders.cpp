@@ -215,6 +215,17 @@ ForceIndex addSpatialBushing(System& sys, const std::string& name, BodyIndex bi,
   return sys.addForce(std::make_unique<SpatialBushing>(name, bi, fi, bj, fj, stiffness, damping));
 }
 
+ForceIndex addSpatialBushingAtWorld(System& sys, const std::string& name, BodyIndex bi, BodyIndex bj,
+                                    const JointFrame& world, const std::array<double, 6>& stiffness,
+                                    const std::array<double, 6>& damping) {
+  const std::string who = "force '" + name + "'";
+  checkSpatialBody(sys, bi, who);
+  checkSpatialBody(sys, bj, who);
+  checkJointFrame(world, who + ": world frame");
+  const auto [fi, fj] = jointFramesFromWorld(sys, bi, bj, world, who);
+  return addSpatialBushing(sys, name, bi, fi, bj, fj, stiffness, damping);
+}
+
 ForceIndex addSpatialAppliedLoad(System& sys, const std::string& name, BodyIndex body, const Vec3& point,
                                  const std::array<TimeLawPtr, 6>& laws) {
   checkSpatialBody(sys, body, "force '" + name + "'");

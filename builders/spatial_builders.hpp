@@ -102,6 +102,11 @@ ForceIndex addSpatialRotationalSpringDamper(System& sys, const std::string& name
 ForceIndex addSpatialBushing(System& sys, const std::string& name, BodyIndex bi, const JointFrame& fi, BodyIndex bj,
                              const JointFrame& fj, const std::array<double, 6>& stiffness,
                              const std::array<double, 6>& damping);
+/// A bushing placed by one frame in world axes, in the initial configuration: both body
+/// frames coincide with it there (jointFramesFromWorld), so it starts undeflected.
+ForceIndex addSpatialBushingAtWorld(System& sys, const std::string& name, BodyIndex bi, BodyIndex bj,
+                                    const JointFrame& world, const std::array<double, 6>& stiffness,
+                                    const std::array<double, 6>& damping);
 /// Force (x, y, z) and torque (x, y, z) laws at a body point, world axes (null: zero; at
 /// least one given).
 ForceIndex addSpatialAppliedLoad(System& sys, const std::string& name, BodyIndex body, const Vec3& point,

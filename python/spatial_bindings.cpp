@@ -661,6 +661,22 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           py::arg("name"), py::arg("body_i"), py::arg("frame_i"), py::arg("body_j"), py::arg("frame_j"),
           py::arg("stiffness"), py::arg("damping") = py::none())
       .def(
+          "add_spatial_bushing_at_world",
+          [](System& s, const std::string& name, const py::object& bi, const py::object& bj, const py::object& world,
+             const py::object& k, const py::object& c) {
+            constexpr const char* fn = "add_spatial_bushing_at_world";
+            if (!py::isinstance<JointFrame>(world)) {
+              badArgument(fn, "world", "a JointFrame in world axes (flexmbd.world_joint_frame(point, axis) or "
+                                       "JointFrame(point, axis=...))", world);
+            }
+            if (k.is_none()) badArgument(fn, "stiffness", "6 numbers (x, y, z, rx, ry, rz)", k);
+            return addSpatialBushingAtWorld(s, name, body(s, bi, fn, "body_i"), body(s, bj, fn, "body_j"),
+                                            world.cast<JointFrame>(), sixArg(k, fn, "stiffness"), sixArg(c, fn, "damping"));
+          },
+          py::arg("name"), py::arg("body_i"), py::arg("body_j"), py::arg("world"), py::arg("stiffness"),
+          py::arg("damping") = py::none(),
+          "A bushing placed by one frame in world axes (initial configuration): it starts undeflected")
+      .def(
           "add_spatial_applied_load",
           [](System& s, const std::string& name, const py::object& b, const py::object& point, const py::object& fx,
              const py::object& fy, const py::object& fz, const py::object& tx, const py::object& ty,

@@ -254,6 +254,34 @@ def test_placed_shapes_make_a_dumbbell_of_the_closed_form_inertia():
         flexmbd.shape_properties(parts[1:])
 
 
+def test_a_bushing_placed_in_the_world_equals_its_scene_form():
+    # the same mount built in Python and read from a scene: the same numbers, bit for bit;
+    # and it starts undeflected (the body at rest stays where it is)
+    scene_json = {"name": "mount", "dimension": 3,
+                  "bodies": [{"name": "b", "type": "rigid", "mass": 2, "inertia": [0.04, 0.045, 0.05],
+                              "position": [0.3, 0.2, 0.1], "orientation": {"axis": [1, 2, 3], "angle": 0.7},
+                              "velocity": [0.005, 0.005, 0]}],
+                  "forces": [{"name": "mount", "type": "bushing", "bodies": ["ground", "b"],
+                              "world": {"point": [0.3, 0.2, 0.1], "axis": [1, 1, 0]},
+                              "stiffness": [500, 600, 800, 30, 40, 20]}],
+                  "solver": {"t_end": 0.2, "output_step": 0.01}}
+    from_file = flexmbd.scene_from_dict(scene_json)
+    built = flexmbd.Scene("mount")
+    sys = built.system
+    b = sys.add_rigid_body_3d("b", flexmbd.RigidBody3dProperties(mass=2, inertia=(0.04, 0.045, 0.05)),
+                              flexmbd.FrameState3d(position=(0.3, 0.2, 0.1), orientation=((1, 2, 3), 0.7),
+                                                   velocity=(0.005, 0.005, 0)))
+    sys.add_spatial_bushing_at_world("mount", "ground", b, flexmbd.world_joint_frame((0.3, 0.2, 0.1), (1, 1, 0)),
+                                     stiffness=(500, 600, 800, 30, 40, 20))
+    built.solver.t_end, built.solver.output_step = 0.2, 0.01
+    a, c = built.run(), from_file.run()
+    assert a.columns == c.columns
+    np.testing.assert_array_equal(a.data, c.data)
+    # the push along (1, 1, 0) stays along it: b.x - 0.3 == b.y - 0.2 (1e-9: rtol 1e-6 of 0.6 mm)
+    np.testing.assert_allclose(a["b.x"] - 0.3, a["b.y"] - 0.2, atol=1e-9)
+    assert np.max(np.abs(a["b.x"] - 0.3)) > 1e-4
+
+
 def test_a_body_of_given_invariants_is_the_body_of_its_beam_model():
     # The clamped beam as a body of its model and as a body of the model's invariants: the
     # same equations, so the same modes (1e-10: two eigen-solves of one matrix); k_ff
