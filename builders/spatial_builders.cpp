@@ -5,6 +5,7 @@
 
 #include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
+#include "core/magnitude_checks.hpp"
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
 #include "joints/spatial_drivers.hpp"
@@ -50,9 +51,9 @@ bool needsAxis(SpatialJointType t) { return t != SpatialJointType::Spherical && 
 }  // namespace
 
 Mat3 rotationFromAxisAngle(const Vec3& axis, double angle) {
-  if (!axis.allFinite() || !(axis.norm() > 0.0)) throw InputError("axis-angle rotation: axis must be a finite non-zero vector");
+  const Vec3 unit = unitDirection(axis, "axis-angle rotation: axis");
   if (!std::isfinite(angle)) throw InputError("axis-angle rotation: angle must be finite");
-  return quaternionRotation(quaternionFromAxisAngle(axis, angle));
+  return quaternionRotation(quaternionFromAxisAngle(unit, angle));
 }
 
 Mat3 rotationFromQuaternion(const Vec4& quaternion) {

@@ -1,10 +1,13 @@
 // Input values that are positive but numerically meaningless next to the rest of the
 // model (issue 26, D2): one bound for the smallest magnitude of any positive scene value
-// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths).
+// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths);
+// the same smallest magnitude for the length of an axis or direction (D22).
 #pragma once
 
 #include <string>
 #include <vector>
+
+#include "core/types.hpp"
 
 namespace flexmbd {
 
@@ -27,5 +30,21 @@ struct NamedMagnitude {
 /// Refuses (InputError) a set of values of one kind (`kind`, e.g. "mass") whose largest is
 /// more than kMaxMagnitudeRatio times its smallest, naming both owners, values and the ratio.
 void checkMagnitudeSpread(const std::string& kind, const std::vector<NamedMagnitude>& values);
+
+/// "" if `v` can be normalised to a direction (an axis): finite, of length at least
+/// kMinPositiveMagnitude (below it, the squared length the normalisation divides by is
+/// subnormal or 0 and the "unit" vector is not of length 1); otherwise what is wrong, to
+/// follow the vector's name: "must be a finite non-zero vector, got [0, 0, 0]", "is too
+/// small to normalise, got [1e-300, 0, 0] (length 1e-300; expected a direction of length
+/// at least 1e-100)". The one rule for every axis and direction of every model and reader.
+std::string directionProblem(const Eigen::Ref<const VecX>& v);
+
+/// `v` / |v| for a 2- or 3-vector `v`.
+/// @throws InputError "<who> <directionProblem(v)>" if it cannot be normalised.
+template <class Vec>
+Vec unitDirection(const Vec& v, const std::string& who);
+
+/// "[1e-300, 0, 0]": a vector in a message, each entry as fmt() prints it.
+std::string vectorText(const Eigen::Ref<const VecX>& v);
 
 }  // namespace flexmbd

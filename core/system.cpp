@@ -109,7 +109,10 @@ ConstraintIndex System::findConstraint(const std::string& name) const {
 }
 
 void System::finalize() {
-  requireBuildPhase("finalize twice");
+  if (finalized_) {
+    throw InputError("finalize: the system is already finalized (finalize() is called once, after everything is "
+                     "added)");
+  }
   // Attachment points resolved once into the bodies' identifiers (nodes of flexible
   // bodies): evaluations then find them without a search.
   auto resolve = [&](const std::vector<Attachment>& attachments, const std::string& user) {

@@ -4,6 +4,13 @@
 
 namespace flexmbd {
 
+void requireLoadableBody(BodyIndex body, const std::string& who) {
+  if (body == kGround) {
+    throw InputError(who + ": a load on the ground does nothing (the ground does not move; expected a body of the "
+                           "model)");
+  }
+}
+
 AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, TimeLawPtr forceX,
                          TimeLawPtr forceY, TimeLawPtr torque)
     : Force(std::move(name), {body}),
@@ -11,6 +18,7 @@ AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, Ti
       forceX_(std::move(forceX)),
       forceY_(std::move(forceY)),
       torque_(std::move(torque)) {
+  requireLoadableBody(body, "force '" + this->name() + "'");
   requireFinite(point.x(), "force '" + this->name() + "': point[0]");
   requireFinite(point.y(), "force '" + this->name() + "': point[1]");
 }

@@ -6,6 +6,11 @@
 
 namespace flexmbd {
 
+/// A load applied to one body (the planar and the spatial applied load): the ground does
+/// not move, so a load on it would be accepted and do nothing.
+/// @throws InputError "<who>: a load on the ground does nothing ..." if `body` is the ground.
+void requireLoadableBody(BodyIndex body, const std::string& who);
+
 /// Q = Jr^T F(t) + Jphi^T tau(t) at the given body point; absent laws count as zero.
 class AppliedLoad final : public Force {
  public:

@@ -1,6 +1,7 @@
 #include "forces/spatial_forces.hpp"
 
 #include "core/errors.hpp"
+#include "forces/applied_load.hpp"
 #include "joints/frame_pair.hpp"
 #include "joints/spatial_drivers.hpp"
 
@@ -11,6 +12,7 @@ namespace flexmbd {
 SpatialAppliedLoad::SpatialAppliedLoad(std::string name, BodyIndex body, const Vec3& point,
                                        std::array<TimeLawPtr, 6> laws)
     : Force(std::move(name), {body}), point_(point), laws_(std::move(laws)) {
+  requireLoadableBody(body, "force '" + this->name() + "'");
   for (int k = 0; k < 3; ++k) requireFinite(point[k], "force '" + this->name() + "': point[" + std::to_string(k) + "]");
   bool any = false;
   for (const auto& l : laws_) any = any || l != nullptr;

@@ -394,6 +394,14 @@ class ObjectReader {
     for (std::size_t k = 0; k < v.size(); ++k) out[k] = toNumber(v[k], key + "[" + std::to_string(k) + "]");
     return out;
   }
+  /// A direction (an axis) of exactly n numbers that can be normalised (directionProblem,
+  /// core/magnitude_checks.hpp), as given (not normalised).
+  VecX direction(const std::string& key, int n) const {
+    VecX v = vector(key, n);
+    const std::string problem = directionProblem(v);
+    if (!problem.empty()) fail("key " + inQuotes(key) + " " + problem);
+    return v;
+  }
   /// A non-negative integer from an arbitrary JSON value (array entries).
   int index(const json& v, const std::string& label) const {
     if (!v.is_number_integer() || v.get<long>() < 0) {

@@ -237,8 +237,7 @@ void parseJoint(const json& j, const std::string& where, System& sys) {
   } else if (type == "fixed") {
     located(r.where(), [&] { return addFixedJoint(sys, name, bi, points[0], bj, points[1]); });
   } else {
-    const Vec2 axis = r.vec2("axis");
-    if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0]");
+    const Vec2 axis = r.direction("axis", 2);
     located(r.where(), [&] { return addPrismaticJoint(sys, name, bi, points[0], bj, points[1], axis); });
   }
 }

@@ -40,8 +40,7 @@ JointFrame parseJointFrame(const json& j, const std::string& where) {
   f.point = vec3(r, "point", Vec3::Zero());
   if (r.has("axis") && r.has("orientation")) r.fail("give either \"axis\" or \"orientation\", not both");
   if (r.has("axis")) {
-    const Vec3 a = r.vector("axis", 3);
-    if (!(a.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
+    const Vec3 a = r.direction("axis", 3);
     f.axes = located(r.where(), [&] { return frameAxesFromZ(a, nullptr, "key \"axis\""); });
   } else if (r.has("orientation")) {
     f.axes = parseOrientation(r.object("orientation"), r.where() + ".orientation");
@@ -85,13 +84,8 @@ JointFrame parseWorldFrame(const json& j, const std::string& where, SpatialJoint
   if (t == SpatialJointType::Universal && !r.has("x_axis")) {
     r.fail("a universal joint needs key \"x_axis\" (the cross's pin on the first body, world axes) with \"axis\"");
   }
-  const Vec3 axis = r.vector("axis", 3);
-  if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
-  Vec3 xHint = Vec3::Zero();
-  if (r.has("x_axis")) {
-    xHint = r.vector("x_axis", 3);
-    if (!(xHint.norm() > 0.0)) r.fail("key \"x_axis\" must be a non-zero vector, got [0, 0, 0]");
-  }
+  const Vec3 axis = r.direction("axis", 3);
+  const Vec3 xHint = r.has("x_axis") ? Vec3(r.direction("x_axis", 3)) : Vec3::Zero();
   return located(r.where(), [&] {
     return worldJointFrame(point, axis, r.has("x_axis") ? &xHint : nullptr, "key \"x_axis\"");
   });
@@ -342,8 +336,7 @@ Mat3 parseOrientation(const json& j, const std::string& where) {
     return A;
   }
   if (!r.has("axis") || !r.has("angle")) r.fail("an axis-angle orientation needs both \"axis\" and \"angle\"");
-  const Vec3 axis = r.vector("axis", 3);
-  if (!(axis.norm() > 0.0)) r.fail("key \"axis\" must be a non-zero vector, got [0, 0, 0]");
+  const Vec3 axis = r.direction("axis", 3);
   return quaternionRotation(quaternionFromAxisAngle(axis, r.number("angle")));
 }
 

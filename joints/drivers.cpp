@@ -1,5 +1,7 @@
 #include "joints/drivers.hpp"
 
+#include "core/magnitude_checks.hpp"
+
 namespace flexmbd {
 
 BodyCoordinateDriver::BodyCoordinateDriver(std::string name, BodyIndex body, int coordinate,
@@ -36,8 +38,7 @@ JointDisplacementDriver::JointDisplacementDriver(std::string name, BodyIndex bod
                                                  const Vec2& pointJ, const Vec2& axis,
                                                  TimeLawPtr law)
     : LawDriver<TwoPointConstraint>(std::move(law), std::move(name), bodyI, pointI, bodyJ, pointJ) {
-  if (!(axis.norm() > 1e-12)) throw InputError("driver '" + this->name() + "': axis must be non-zero");
-  axis_ = axis.normalized();
+  axis_ = unitDirection(axis, "driver '" + this->name() + "': axis");
 }
 
 void JointDisplacementDriver::evaluate(const BodyStates& bodies, bool withHessians,

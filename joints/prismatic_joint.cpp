@@ -1,6 +1,7 @@
 #include "joints/prismatic_joint.hpp"
 
 #include "core/errors.hpp"
+#include "core/magnitude_checks.hpp"
 
 namespace flexmbd {
 
@@ -13,8 +14,7 @@ PrismaticJoint::PrismaticJoint(std::string name, BodyIndex bodyI, const Vec2& po
   requireFinite(axis.x(), who + ": axis[0]");
   requireFinite(axis.y(), who + ": axis[1]");
   requireFinite(referenceAngle, who + ": reference angle");
-  if (axis.norm() < 1e-12) throw InputError(who + ": axis must be a non-zero vector, got [0, 0]");
-  axis_ = axis.normalized();
+  axis_ = unitDirection(axis, who + ": axis");
 }
 
 void PrismaticJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {

@@ -6,6 +6,7 @@
 #include "bodies/rigid_body_3d.hpp"
 #include "core/errors.hpp"
 #include "core/ground.hpp"
+#include "core/magnitude_checks.hpp"
 #include "core/rotation_3d.hpp"
 
 namespace flexmbd {
@@ -24,15 +25,12 @@ BodyPose spatialBodyPose(const Body& body, const ConstVecRef& q, const std::stri
 }
 
 Mat3 frameAxesFromZ(const Vec3& zIn, const Vec3* xHint, const std::string& who) {
-  if (!zIn.allFinite() || !(zIn.norm() > 0.0)) {
-    throw InputError(who + ": axis must be a finite non-zero vector");
-  }
-  const Vec3 z = zIn.normalized();
+  const Vec3 z = unitDirection(zIn, who + ": axis");
   Vec3 x;
   if (xHint) {
-    if (!xHint->allFinite()) throw InputError(who + ": x_axis must be a finite vector");
-    x = *xHint - z.dot(*xHint) * z;  // Gram-Schmidt: the part of the hint normal to z
-    if (!(x.norm() > 1e-9 * xHint->norm())) {
+    const Vec3 hint = unitDirection(*xHint, who + ": x_axis");
+    x = hint - z.dot(hint) * z;  // Gram-Schmidt: the part of the hint normal to z
+    if (!(x.norm() > 1e-9)) {
       throw InputError(who + ": x_axis must not be parallel to axis (expected a direction across the axis)");
     }
     x.normalize();

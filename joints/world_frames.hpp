@@ -31,8 +31,9 @@ BodyPose spatialBodyPose(const Body& body, const ConstVecRef& q, const std::stri
 /// The axes (columns x, y, z, world axes) of a frame with z along `z`: x is `xHint`
 /// made perpendicular to z (Gram-Schmidt), or without a hint the world axis least
 /// aligned with z made perpendicular; y = z x x.
-/// @throws InputError naming `who` if z is zero or not finite, or xHint is not finite
-///         or parallel to z (within 1e-9 of the product of the lengths).
+/// @throws InputError naming `who` if z or xHint cannot be normalised (directionProblem,
+///         core/magnitude_checks.hpp: not finite, zero, or shorter than 1e-100), or xHint
+///         is parallel to z (within 1e-9 of the product of the lengths).
 Mat3 frameAxesFromZ(const Vec3& z, const Vec3* xHint, const std::string& who);
 
 /// A world frame: origin `point`, z axis `axis`, x axis `xHint` (optional; see frameAxesFromZ).

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "core/errors.hpp"
+#include "core/magnitude_checks.hpp"
 #include "core/number_text.hpp"
 
 namespace flexmbd {
@@ -73,15 +74,11 @@ NodeIndex Linkage2d::addFreeNode(const std::string& name, const Vec2& position) 
 
 NodeIndex Linkage2d::addSliderNode(const std::string& name, const Vec2& position, const Vec2& direction) {
   requireFiniteVec(direction, "node " + quoted(name) + ": direction");
-  if (!(direction.norm() > 0.0)) {
-    throw InputError("node " + quoted(name) + ": the slider direction must be a non-zero vector, got [" +
-                     fmt(direction.x()) + ", " + fmt(direction.y()) + "]");
-  }
   Node n;
   n.name = name;
   n.kind = NodeKind::Slider;
   n.position = position;
-  n.direction = direction.normalized();
+  n.direction = unitDirection(direction, "node " + quoted(name) + ": the slider direction");
   return addNode(std::move(n));
 }
 

@@ -95,14 +95,19 @@ inline Vec3 vec3Arg(const py::handle& h, const char* fn, const char* arg) {
   return argumentAs<Vec3>(h, fn, arg, "3 numbers (x, y, z)");
 }
 
-/// A body given as a BodyIndex or by name ("ground" included).
+/// A body of `sys` given as a BodyIndex or by name ("ground" included).
 inline BodyIndex body(const System& sys, const py::handle& b, const char* fn = "body", const char* arg = "body") {
   if (py::isinstance<py::str>(b)) {
     const std::string name = b.cast<std::string>();
     return name == "ground" ? kGround : sys.findBody(name);  // InputError listing the known bodies
   }
   if (!py::isinstance<BodyIndex>(b)) badArgument(fn, arg, "a body name or a BodyIndex", b);
-  return b.cast<BodyIndex>();
+  const BodyIndex i = b.cast<BodyIndex>();
+  if (i.value < 0 || i.value >= sys.numBodies()) {
+    throw InputError(std::string(fn) + ": " + arg + ": no body with index " + std::to_string(i.value) +
+                     " (the system has " + std::to_string(sys.numBodies()) + " bodies, the ground included)");
+  }
+  return i;
 }
 
 /// A joint given as a ConstraintIndex or by name.

@@ -307,7 +307,20 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def_property_readonly("num_velocities", [](const System& s) { return s.numVelocities(); })
       .def("coordinate_names", &System::coordinateNames)
       .def("initial_coordinates", &System::initialCoordinates)
-      .def("coordinate_offset", &System::coordinateOffset, py::arg("body"));
+      .def(
+          "coordinate_offset",
+          [](const System& s, py::object b) {
+            const BodyIndex i = body(s, b, "coordinate_offset");
+            if (i == kGround) {
+              throw InputError("coordinate_offset: the ground has no coordinates (it does not move; expected a body "
+                               "of the model)");
+            }
+            if (!s.isFinalized()) {
+              throw InputError("coordinate_offset: the coordinates are numbered by finalize(): call it first");
+            }
+            return s.coordinateOffset(i);
+          },
+          py::arg("body"), "index of the body's first coordinate in the system's coordinates (after finalize())");
   bindSpatial(m, systemClass);
 
   // ----- solver settings (integrators/simulation.hpp) ------------------------------------
@@ -561,4 +574,9 @@ PYBIND11_MODULE(_flexmbd, m) {
         return std::make_shared<Scene>(parseSceneText(text, source));
       },
       py::arg("text"), py::arg("source") = "<scene>");
+  m.def(
+      "read_scene_file", [](const std::string& path) { return py::bytes(jsonread::readSceneFile(path)); },
+      py::arg("path"),
+      "The bytes of a scene file by the command line's rules (a regular file of at most 64 MiB; InputError "
+      "naming the path otherwise)");
 }

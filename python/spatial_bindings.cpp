@@ -20,6 +20,7 @@
 #include "bodies/rigid_body_3d.hpp"
 #include "bodies/shape_inertia.hpp"
 #include "builders/spatial_builders.hpp"
+#include "core/magnitude_checks.hpp"
 #include "elements/beam_section.hpp"
 #include "joints/world_frames.hpp"
 
@@ -64,11 +65,9 @@ Mat3 orientationArg(const py::handle& h, const char* fn, const char* arg) {
     } catch (const py::cast_error&) {
       badArgument(fn, arg, expected, h);
     }
-    if (!axis.allFinite() || !(axis.norm() > 0.0)) {
-      throw InputError(std::string(fn) + ": " + arg + ": the axis must be a finite non-zero vector");
-    }
+    const Vec3 unit = unitDirection(axis, std::string(fn) + ": " + arg + ": the axis");
     if (!std::isfinite(angle)) throw InputError(std::string(fn) + ": " + arg + ": the angle must be finite");
-    return rotationFromAxisAngle(axis, angle);
+    return rotationFromAxisAngle(unit, angle);
   }
   badArgument(fn, arg, expected, h);
 }

@@ -29,6 +29,12 @@ import re
 import sys
 
 PROG = "plot_results"
+# Text drawn on the figure (--title, each of --labels): one line; matplotlib fails on a
+# 10,000-character title ("raster overflow").
+MAX_TEXT_LENGTH = 300
+# Largest magnitude drawn: matplotlib's autoscaling overflows near 1e308 (an IndexError in
+# its ticker for a column of 1e308); 1e307 and below draw.
+MAX_DRAWABLE = 1e300
 
 
 def fail(message, status=2):
@@ -78,6 +84,19 @@ def check_column(name, header, path):
     hint = f"close matches: {', '.join(near)}" if near else \
         f"it has {len(header)} columns: {', '.join(header[:8])}{', ...' if len(header) > 8 else ''}"
     fail(f"{path} has no column '{name}' ({hint})")
+
+
+def check_text(option, text):
+    if len(text) > MAX_TEXT_LENGTH or "\n" in text:
+        fail(f"{option} must be one line of at most {MAX_TEXT_LENGTH} characters, got {len(text)} characters")
+
+
+def check_drawable(name, path, data):
+    """Exit 2 naming the column if its values are beyond what matplotlib can draw."""
+    largest = max((abs(v) for v in data if math.isfinite(v)), default=0.0)
+    if largest > MAX_DRAWABLE:
+        fail(f"column '{name}' of {path} has values up to {largest:g} in magnitude: matplotlib cannot draw values "
+             f"beyond {MAX_DRAWABLE:g} (leave the column out of --columns / --x)")
 
 
 def values(header, rows, name):
@@ -215,6 +234,13 @@ def main(argv):
         labels = [s.strip() for s in a.labels.split(",")]
         if len(labels) != len(a.dirs):
             fail(f"--labels gives {len(labels)} labels for {len(a.dirs)} directories")
+        for label in labels:
+            check_text("each of --labels", label)
+    if a.title is not None:
+        check_text("--title", a.title)
+    for _, path, header, rows, _ in runs:
+        for c in [xname] + columns:
+            check_drawable(c, path, values(header, rows, c))
     out = a.out or os.path.join(a.dirs[0], "plot.png")
     if not out.lower().endswith(".png"):
         fail(f"--out '{out}' must end in .png")
@@ -275,6 +301,8 @@ def main(argv):
     title = a.title
     if title is None:
         title = ", ".join(a.dirs) if len(a.dirs) > 1 else a.dirs[0]
+        if len(title) > MAX_TEXT_LENGTH:
+            title = title[:MAX_TEXT_LENGTH - 3] + "..."
     fig.suptitle(title, fontsize=11)
     fig.tight_layout()
     try:

@@ -308,7 +308,11 @@ VecX TensegrityStructure::externalForces(double t) const {
   // linear shape functions this is m g / 2 per end node, lumped or consistent).
   VecX G(numCoordinates());
   for (int i = 0; i < numNodes(); ++i) G.segment(dim_ * i, dim_) = gravity_;
-  VecX f = massFull_ * G;
+  return massFull_ * G + loadForces(t);
+}
+
+VecX TensegrityStructure::loadForces(double t) const {
+  VecX f = VecX::Zero(numCoordinates());
   for (const TensegrityLoad& l : loads_) {
     for (int a = 0; a < dim_; ++a) {
       if (l.components[a]) f[dim_ * l.node + a] += l.components[a]->evaluate(t).f;

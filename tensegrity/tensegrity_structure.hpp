@@ -127,6 +127,9 @@ class TensegrityStructure {
 
   /// External nodal forces at time t (gravity M g and loads), full vector.
   VecX externalForces(double t) const;
+  /// The loads' part of externalForces (no gravity): the forces whose work is the input
+  /// of energy that potentialEnergy does not contain.
+  VecX loadForces(double t) const;
   /// Elastic forces of struts and of elastic cables, g(x) = dU/dx (full vector): the
   /// equations of motion read M a = f(t) - g(x) - B_c^T tau (inextensible part).
   VecX internalForces(const VecX& x) const;

@@ -15,6 +15,9 @@
 // iterated (Gauss-Newton) until the relative drift is below the projection tolerance.
 #pragma once
 
+#include <optional>
+#include <string>
+
 #include "tensegrity/lcp_solver.hpp"
 #include "tensegrity/tensegrity_output.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
@@ -62,5 +65,12 @@ class TensegrityTimeStepper {
   const TensegrityStructure& s_;
   TimeSteppingSettings settings_;
 };
+
+/// The energy check of a step with a snap (an inelastic impulse, which dissipates): the
+/// message ending the run if the energy went from energyBefore to energyAfter by more
+/// than loadWork (the loads' work over the step, the only input the potential energy does
+/// not contain) plus 1e-6 of the energy (round-off of the LCP and the projection: 1e-12);
+/// energy from nothing means the model's numbers overflow (R03: 1e-323 J to 2 J).
+std::optional<std::string> snapEnergyGrowth(double energyBefore, double energyAfter, double loadWork);
 
 }  // namespace flexmbd

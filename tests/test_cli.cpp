@@ -720,6 +720,34 @@ TEST_F(Cli, PlotOfAnUnknownColumnExitsWith2NamingCloseMatches) {
   }
 }
 
+// D18: values matplotlib cannot draw (a column of 1e308, R20) and a title too long to draw
+// are exit 2 naming the column or the option, never a matplotlib traceback.
+TEST_F(Cli, PlotOfUndrawableValuesOrAHugeTitleExitsWith2) {
+  if (!haveMatplotlib()) GTEST_SKIP() << "/usr/bin/python3 with matplotlib not found (scripts/setup.sh installs it)";
+  const fs::path out = dir_ / "out";
+  ASSERT_EQ(run("run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) + " --t-end 0.1 --quiet").status,
+            0);
+  CliResult r = run("plot " + shellQuote(out.string()) + " --title " + shellQuote(std::string(100000, 'T')));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err)) << r.err;
+  EXPECT_NE(r.err.find("--title must be one line of at most 300 characters, got 100000"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
+  // every value 1e308 (R20): the column is named
+  const fs::path huge = dir_ / "huge";
+  fs::create_directories(huge);
+  {
+    std::ofstream f(huge / "results.csv");
+    f << "t,slider.x\n1e308,1e308\n1e308,1e308\n";
+  }
+  r = run("plot " + shellQuote(huge.string()) + " --columns slider.x");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err)) << r.err;
+  EXPECT_NE(r.err.find("column 't'"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("matplotlib cannot draw values beyond 1e+300"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("Traceback"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(huge / "plot.png"));
+}
+
 // The scenes of `make demo` run and hold the columns the demo's table and plot read
 // (scripts/demo_report.py, flexmbd plot): the modal one whole (0.03 s), the nodal one
 // over its first 2 ms (its 3 revolutions take 2 s).

@@ -175,7 +175,7 @@ TEST(KinematicsInput, StrictKeysAndTypes) {
   expectError(j, "key \"steps\" must be >= 1, got 0");
   j = sliderCrank();
   j["nodes"][2]["direction"] = {0, 0};
-  expectError(j, "the slider direction must be a non-zero vector");
+  expectError(j, "the slider direction must be a finite non-zero vector, got [0, 0]");
   EXPECT_NE(errorOf(json::parse("[1, 2]")).find("expected an object"), std::string::npos);
   try {
     parseKinematicsSceneText(R"({"name": "a", "name": "b"})", "scene.json");

@@ -13,6 +13,8 @@ arrays with column names. docs/python.md.
 
 import copy
 import json
+import math
+import numbers
 import os
 
 from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
@@ -69,7 +71,7 @@ from . import _flexmbd
 
 __all__ = [
     "Scene", "Results", "SolverFailure", "InputError", "ModelError", "load_scene", "scene_from_dict",
-    "apply_overrides", "run_kinematics", "run_tensegrity",
+    "apply_overrides", "read_scene_file", "run_kinematics", "run_tensegrity",
 ]
 
 
@@ -204,12 +206,48 @@ def apply_overrides(scene_dict, overrides):
 
     ``overrides`` maps keys to values: nested dicts merge into objects
     ({"solver": {"rtol": 1e-6}}), and a dotted path with list indices addresses any key
-    ({"bodies[1].section.youngs_modulus": 1e11, "solver.t_end": 0.1}). A path through a
-    key or index that does not exist raises InputError naming it."""
+    ({"bodies[1].section.youngs_modulus": 1e11, "solver.t_end": 0.1}). A key that is not
+    such a path, a path through a key or index that does not exist, or a value that is not
+    JSON (NaN, infinities, objects other than numbers, strings, booleans, None, lists and
+    dicts) raises InputError naming the key."""
+    if overrides is None:
+        overrides = {}
+    if not isinstance(overrides, dict):
+        raise InputError(f"overrides must be a dict of scene keys and values, got {type(overrides).__name__}")
     result = copy.deepcopy(scene_dict)
-    for key, value in (overrides or {}).items():
-        _set_path(result, key, value)
+    for key, value in overrides.items():
+        if not isinstance(key, str):
+            raise InputError(f"override {key!r}: the key must be a string (a scene key such as 'solver.t_end')")
+        _set_path(result, key, _json_value(key, value, key))
     return result
+
+
+def _json_value(path, value, where):
+    """value as plain JSON data (tuples and NumPy arrays as lists, NumPy numbers as int and
+    float), or InputError "override <path>: ..." naming where in the value it fails."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        x = float(value)
+        if not math.isfinite(x):
+            raise InputError(f"override {path!r}: {where} is {x!r}, not a number a scene accepts (NaN and "
+                             f"infinities are not JSON numbers; expected a finite number)")
+        return x
+    if isinstance(value, dict):
+        out = {}
+        for k, v in value.items():
+            if not isinstance(k, str):
+                raise InputError(f"override {path!r}: {where} has the key {k!r} (expected string keys)")
+            out[k] = _json_value(path, v, f"{where}.{k}")
+        return out
+    if hasattr(value, "tolist") and not isinstance(value, (list, tuple)):  # NumPy arrays
+        value = value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_json_value(path, v, f"{where}[{k}]") for k, v in enumerate(value)]
+    raise InputError(f"override {path!r}: {where} is a {type(value).__name__}, not a scene value (expected a "
+                     f"number, a string, a boolean, None, a list or a dict)")
 
 
 def _merge(target, value):
@@ -224,17 +262,27 @@ def _merge(target, value):
 
 
 def _path_parts(path):
+    """The names and indices of a dotted path "bodies[1].section.area", or InputError."""
+    expected = "expected a scene key such as 'solver.t_end' or 'bodies[1].mass'"
+    if not path:
+        raise InputError(f"override {path!r}: the key is empty ({expected})")
     parts = []
     for piece in path.split("."):
+        if not piece:
+            raise InputError(f"override {path!r}: an empty name between dots ({expected})")
         while "[" in piece:
             name, rest = piece.split("[", 1)
             if name:
                 parts.append(name)
+            if "]" not in rest:
+                raise InputError(f"override {path!r}: '[' without its ']' ({expected})")
             index, piece = rest.split("]", 1)
             try:
                 parts.append(int(index))
             except ValueError:
-                raise InputError(f"override {path!r}: [{index}] is not an index") from None
+                raise InputError(f"override {path!r}: [{index}] is not an index ({expected})") from None
+        if "]" in piece:
+            raise InputError(f"override {path!r}: ']' without its '[' ({expected})")
         if piece:
             parts.append(piece)
     return parts
@@ -270,22 +318,22 @@ def scene_from_dict(scene_dict, overrides=None, source="<scene>"):
     return Scene(_native=_flexmbd.parse_scene_text(text, source))
 
 
+def read_scene_file(path):
+    """The text of a scene file by the command line's rules (a regular file of at most
+    64 MiB, UTF-8): InputError naming the path otherwise."""
+    path = os.fspath(path)
+    data = _flexmbd.read_scene_file(path)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise InputError(f"{path}: not UTF-8 text (byte {e.start + 1}); scene files are UTF-8 JSON") from None
+
+
 def load_scene(path, overrides=None):
     """A Scene from a scene file, with any key overridden (apply_overrides). Errors are
     InputError with the engine's message, starting with the path."""
-    path = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except OSError as e:
-        raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
-    if not overrides:
-        return Scene(_native=_flexmbd.parse_scene_text(text, path))
-    try:
-        scene_dict = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise InputError(f"{path}: not valid JSON: {e}") from None
-    return scene_from_dict(scene_dict, overrides, source=path)
+    text, source = _scene_text(path, overrides)
+    return Scene(_native=_flexmbd.parse_scene_text(text, source))
 
 
 def _scene_text(scene, overrides):
@@ -293,17 +341,30 @@ def _scene_text(scene, overrides):
     if isinstance(scene, dict):
         return json.dumps(apply_overrides(scene, overrides)), "<scene>"
     path = os.fspath(scene)
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except OSError as e:
-        raise InputError(f"cannot open scene file '{path}': {e.strerror}") from None
+    text = read_scene_file(path)
     if overrides:
-        try:
-            text = json.dumps(apply_overrides(json.loads(text), overrides))
-        except json.JSONDecodeError as e:
-            raise InputError(f"{path}: not valid JSON: {e}") from None
+        text = json.dumps(apply_overrides(parse_json(text, path), overrides))
     return text, path
+
+
+def parse_json(text, source):
+    """JSON text parsed as strictly as the engine parses it (no NaN or Infinity, no key
+    twice in an object): InputError "<source>: not valid JSON: ..." otherwise."""
+    def constant(name):
+        raise InputError(f"{source}: not valid JSON: {name} is not a JSON number")
+
+    def pairs(items):
+        out = {}
+        for k, v in items:
+            if k in out:
+                raise InputError(f"{source}: not valid JSON: the key {k!r} appears twice in an object")
+            out[k] = v
+        return out
+
+    try:
+        return json.loads(text, parse_constant=constant, object_pairs_hook=pairs)
+    except json.JSONDecodeError as e:
+        raise InputError(f"{source}: not valid JSON: {e}") from None
 
 
 def run_tensegrity(scene, overrides=None):

@@ -24,13 +24,39 @@ import time
 
 import numpy as np
 
-from . import InputError, scene_from_dict
+from . import InputError, parse_json, read_scene_file, scene_from_dict
 
 FIXED_COLUMNS = ["point", "status", "message", "t_reached", "wall_seconds"]
 STUDY_KEYS = {"name", "scene", "overrides", "axes", "combine", "samples", "outputs", "plot"}
 AXIS_KEYS = {"name", "key", "values", "range", "count", "spacing"}
 OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions"}
 PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
+PLOT_FILE_TYPES = (".png", ".svg", ".pdf")
+MAX_TITLE_LENGTH = 300  # a title is one line over the figure; matplotlib fails on 100 kB ("raster overflow")
+
+# The engine's one rule for names (checkName, io/json_reader.hpp): axis and output names
+# become column names of study.csv and the plot's file name a file in --out.
+NAME_RULE = "names are 1 to 64 characters, each an ASCII letter, a digit, '_' or '-'"
+
+
+def _name_problem(name):
+    """"" if name follows NAME_RULE, else what breaks it (as the engine says it)."""
+    if not isinstance(name, str):
+        return f"is not a string ({json.dumps(name)[:60]})"
+    if not name:
+        return "is empty"
+    for k, c in enumerate(name):
+        if not (c.isascii() and (c.isalnum() or c in "_-")):
+            return f"has the character {c!r} at position {k + 1}"
+    if len(name) > 64:
+        return f"is {len(name)} characters long"
+    return ""
+
+
+def _check_name(name, key, where):
+    problem = _name_problem(name)
+    if problem:
+        _fail(where, f"key {key!r}: the name {json.dumps(name)[:60]} {problem} ({NAME_RULE})")
 
 
 def _fail(where, message):
@@ -56,14 +82,13 @@ class Study:
         base = os.path.dirname(os.path.abspath(path)) if path != "<study>" else os.getcwd()
         self.path = path
         self.name = spec.get("name", os.path.splitext(os.path.basename(path))[0])
+        if not isinstance(spec["scene"], str) or not spec["scene"]:
+            _fail(where, 'key "scene" must be the path of a scene file')
         self.scene_path = os.path.join(base, spec["scene"])
-        try:
-            with open(self.scene_path, encoding="utf-8") as f:
-                self.scene = json.load(f)
-        except OSError as e:
-            _fail(where, f'key "scene": cannot open {self.scene_path!r}: {e.strerror}')
-        except json.JSONDecodeError as e:
-            _fail(where, f'key "scene": {self.scene_path!r} is not valid JSON: {e}')
+        try:  # the command line's rules: a regular file of at most 64 MiB, strict JSON
+            self.scene = parse_json(read_scene_file(self.scene_path), self.scene_path)
+        except InputError as e:
+            _fail(where, f'key "scene": {e}')
         self.overrides = spec.get("overrides", {})
         if not isinstance(self.overrides, dict):
             _fail(where, 'key "overrides" must be an object of scene keys')
@@ -72,12 +97,48 @@ class Study:
         self.outputs = spec.get("outputs", {"summary": ["steps", "cpu_seconds"]})
         _allow_only(self.outputs, OUTPUT_KEYS, where + ": outputs")
         self.output_names = output_names(self.outputs)
+        for i, a in enumerate(self.outputs.get("at", []) if isinstance(self.outputs.get("at"), list) else []):
+            if isinstance(a, dict) and "name" in a:
+                _check_name(a["name"], "name", f"{where}: outputs.at[{i}]")
         self.plot = spec.get("plot")
         if self.plot is not None:
-            _allow_only(self.plot, PLOT_KEYS, where + ": plot")
-            for k in ("x", "y"):
-                if k not in self.plot:
-                    _fail(where + ": plot", f"key {k!r} is required")
+            self._check_plot(where + ": plot")
+
+    def _check_plot(self, where):
+        """The plot spec checked against the study's columns before any point runs."""
+        spec = self.plot
+        _allow_only(spec, PLOT_KEYS, where)
+        for k in ("x", "y"):
+            if k not in spec:
+                _fail(where, f"key {k!r} is required")
+        ys = spec["y"] if isinstance(spec["y"], list) else [spec["y"]]
+        if not ys:
+            _fail(where, 'key "y" must be a column name or a non-empty list of column names, got []')
+        text_axes = {a["name"] for a in self.axes if not _numeric(a)}
+        columns = self.columns
+        for key, c in [("x", spec["x"])] + [("y", y) for y in ys] + ([("group", spec["group"])] if "group" in spec else []):
+            if not isinstance(c, str) or c not in columns:
+                _fail(where, f"key {key!r}: no column {json.dumps(c)[:60]} in the study (columns: {', '.join(columns)})")
+            if key != "group" and c in text_axes:
+                _fail(where, f"key {key!r}: the axis {c!r} has values that are not numbers (expected a numeric "
+                             f"column; an axis of strings can be the plot's \"group\")")
+        if "title" in spec:
+            title = spec["title"]
+            if not isinstance(title, str):
+                _fail(where, f'key "title" must be a string, got {json.dumps(title)[:60]}')
+            if len(title) > MAX_TITLE_LENGTH or "\n" in title:
+                _fail(where, f'key "title" must be one line of at most {MAX_TITLE_LENGTH} characters, got '
+                             f'{len(title)} characters')
+        for k in ("log_x", "log_y"):
+            if k in spec and not isinstance(spec[k], bool):
+                _fail(where, f"key {k!r} must be true or false, got {json.dumps(spec[k])[:60]}")
+        if "file" in spec:
+            f = spec["file"]
+            stem, ext = os.path.splitext(f) if isinstance(f, str) else (f, "")
+            if ext not in PLOT_FILE_TYPES:
+                _fail(where, f'key "file" must be a file name ending in {", ".join(PLOT_FILE_TYPES)}, got '
+                             f'{json.dumps(f)[:60]}')
+            _check_name(stem, "file", where)
 
     @staticmethod
     def _parse_axes(spec, where):
@@ -91,9 +152,13 @@ class Study:
             _allow_only(a, AXIS_KEYS, w)
             if "key" not in a:
                 _fail(w, 'key "key" is required (the scene key to override, e.g. "drivers[0].law.speed")')
-            name = a.get("name", a["key"])
+            if not isinstance(a["key"], str):
+                _fail(w, f'key "key" must be a scene key path such as "drivers[0].law.speed", got {json.dumps(a["key"])[:60]}')
+            # default: the key's last name ("speed" of "drivers[0].law.speed")
+            name = a.get("name", a["key"].split("[")[0] if "." not in a["key"] else a["key"].rsplit(".", 1)[1])
+            _check_name(name, "name" if "name" in a else "key", w)
             if name in names:
-                _fail(w, f"duplicate axis name {name!r}")
+                _fail(w, f"duplicate axis name {name!r} (give each axis its own \"name\")")
             names.add(name)
             if "values" in a:
                 values = a["values"]
@@ -166,15 +231,24 @@ class Study:
         return ["point"] + [a["name"] for a in self.axes] + FIXED_COLUMNS[1:] + self.output_names
 
 
-def load_study(path):
+def _numeric(axis):
+    """True if every value of the axis is a number (a range always is)."""
+    values = axis["values"] if axis["values"] is not None else axis["range"]
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+
+
+def _number(text):
+    """A study.csv cell as a float (NaN where it is empty or not a number)."""
     try:
-        with open(path, encoding="utf-8") as f:
-            spec = json.load(f)
-    except OSError as e:
-        raise InputError(f"cannot open study file '{path}': {e.strerror}") from None
-    except json.JSONDecodeError as e:
-        raise InputError(f"{path}: not valid JSON: {e}") from None
-    return Study(spec, path)
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def load_study(path):
+    """The study file at path (read by the scene files' rules: a regular file of at most
+    64 MiB, strict JSON), parsed and checked: InputError naming the key otherwise."""
+    return Study(parse_json(read_scene_file(path), path), path)
 
 
 def output_names(outputs):
@@ -375,18 +449,23 @@ def plot(study, out_dir):
     spec = study.plot
     columns, rows = read_table(os.path.join(out_dir, "study.csv"))
     ys = spec["y"] if isinstance(spec["y"], list) else [spec["y"]]
-    for c in [spec["x"], *ys] + ([spec["group"]] if "group" in spec else []):
-        if c not in columns:
-            raise InputError(f"{study.path}: plot: no column {c!r} in study.csv (columns: {', '.join(columns)})")
+    if columns != study.columns:  # checked with the study: only another file in its place differs
+        raise InputError(f"{study.path}: plot: study.csv holds other columns than the study's")
     col = {c: k for k, c in enumerate(columns)}
     ok = [r for r in rows if r[col["status"]] == "ok"]
-    groups = sorted({r[col[spec["group"]]] for r in ok}, key=float) if "group" in spec else [None]
+    if "group" in spec:  # numbers in numeric order, other values (an axis of strings) as categories
+        values = {r[col[spec["group"]]] for r in ok}
+        numeric = all(not math.isnan(_number(v)) for v in values)
+        groups = sorted(values, key=_number if numeric else str)
+    else:
+        numeric, groups = True, [None]
     fig, axes = plt.subplots(len(ys), 1, figsize=(8, 3.2 * len(ys)), sharex=True, squeeze=False)
     for ax, y in zip(axes[:, 0], ys):
         for g in groups:
-            sel = sorted((r for r in ok if g is None or r[col[spec["group"]]] == g), key=lambda r: float(r[col[spec["x"]]]))
-            ax.plot([float(r[col[spec["x"]]]) for r in sel], [float(r[col[y]]) for r in sel], marker="o", ms=3,
-                    label=None if g is None else f"{spec['group']} = {float(g):g}")
+            sel = sorted((r for r in ok if g is None or r[col[spec["group"]]] == g), key=lambda r: _number(r[col[spec["x"]]]))
+            label = None if g is None else f"{spec['group']} = {_number(g):g}" if numeric else f"{spec['group']} = {g}"
+            ax.plot([_number(r[col[spec["x"]]]) for r in sel], [_number(r[col[y]]) for r in sel], marker="o", ms=3,
+                    label=label)
         ax.set_ylabel(y)
         ax.grid(True, alpha=0.3)
         if spec.get("log_x"):
@@ -396,7 +475,8 @@ def plot(study, out_dir):
         if groups != [None]:
             ax.legend(fontsize=8)
     axes[-1, 0].set_xlabel(spec["x"])
-    fig.suptitle(spec.get("title", study.name))
+    title = spec.get("title", study.name)
+    fig.suptitle(title if len(title) <= MAX_TITLE_LENGTH else title[:MAX_TITLE_LENGTH - 3] + "...")
     fig.tight_layout()
     out = os.path.join(out_dir, spec.get("file", "study.png"))
     fig.savefig(out, dpi=120)

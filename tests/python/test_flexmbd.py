@@ -346,3 +346,58 @@ def test_names_follow_the_one_rule_in_python_scenes(name, words):
     with pytest.raises(flexmbd.InputError, match="names are 1 to 64 characters") as e:
         flexmbd.scene_from_dict(scene)
     assert words in str(e.value)
+
+
+@pytest.mark.parametrize("overrides,words", [
+    ({"": 1}, "override '': the key is empty (expected a scene key such as 'solver.t_end'"),
+    ({"bodies[": 1}, "override 'bodies[': '[' without its ']'"),
+    ({"solver..t_end": 1}, "override 'solver..t_end': an empty name between dots"),
+    ({"bodies[x].mass": 1}, "override 'bodies[x].mass': [x] is not an index"),
+    ({1: 1}, "override 1: the key must be a string"),
+    ({"solver.t_end": float("nan")}, "override 'solver.t_end': solver.t_end is nan, not a number a scene accepts"),
+    ({"solver": {"t_end": math.inf}}, "override 'solver': solver.t_end is inf, not a number a scene accepts"),
+    ({"solver.t_end": object()}, "is a object, not a scene value"),
+])
+def test_bad_overrides_are_input_errors_naming_the_key(overrides, words):
+    # D20: before, IndexError, a raw ValueError or "<scene file>: invalid JSON at byte 1103"
+    with pytest.raises(flexmbd.InputError) as e:
+        flexmbd.load_scene(example("slider_crank_rigid.json"), overrides=overrides)
+    assert words in str(e.value)
+    assert "invalid JSON" not in str(e.value)
+
+
+def test_override_values_from_numpy_are_scene_values():
+    scene = flexmbd.load_scene(example("slider_crank_rigid.json"),
+                               overrides={"solver.t_end": np.float64(0.1), "solver.max_steps": np.int64(100000),
+                                          "gravity": np.array([0.0, -9.81])})
+    assert scene.run().summary["status"] == "ok"
+
+
+def test_scene_files_from_python_follow_the_command_lines_file_rules(tmp_path):
+    # D20 / D17: load_scene reads by readSceneFile's rules (regular file, at most 64 MiB)
+    with pytest.raises(flexmbd.InputError, match="a character device"):
+        flexmbd.load_scene("/dev/zero")
+    with pytest.raises(flexmbd.InputError, match="it is a directory"):
+        flexmbd.load_scene(tmp_path, overrides={"solver.t_end": 1.0})
+    nan_file = tmp_path / "nan.json"
+    nan_file.write_text('{"name": "x", "gravity": [NaN, 0]}')
+    with pytest.raises(flexmbd.InputError, match="NaN is not a JSON number"):
+        flexmbd.load_scene(nan_file, overrides={"solver.t_end": 1.0})
+
+
+def test_system_misuse_is_an_input_error_that_says_what_to_do():
+    # D20: the ground has no coordinates; a load on it does nothing; finalize once
+    scene = flexmbd.Scene("x")
+    with pytest.raises(flexmbd.InputError, match="coordinate_offset: the ground has no coordinates"):
+        scene.system.coordinate_offset(flexmbd.GROUND)
+    bar = scene.system.add_rigid_body("bar", flexmbd.RigidBodyProperties(mass=1, inertia=0.1, com=(0.5, 0)))
+    with pytest.raises(flexmbd.InputError, match="call it first"):
+        scene.system.coordinate_offset(bar)
+    with pytest.raises(flexmbd.InputError, match="force 'push': a load on the ground does nothing"):
+        scene.system.add_applied_load("push", flexmbd.GROUND, (0, 0), flexmbd.constant_law(1.0))
+    with pytest.raises(flexmbd.InputError, match="force 'push3': a load on the ground does nothing"):
+        scene.system.add_spatial_applied_load("push3", "ground", (0, 0, 0), force_x=flexmbd.constant_law(1.0))
+    scene.system.finalize()
+    assert scene.system.coordinate_offset(bar) == 0
+    with pytest.raises(flexmbd.InputError, match="finalize: the system is already finalized"):
+        scene.system.finalize()

@@ -93,3 +93,75 @@ def test_study_input_errors_name_the_key(tmp_path):
     (tmp_path / "other" / "study.csv").write_text("a,b\n")
     with pytest.raises(InputError, match="another study"):
         st.run_study(study, str(tmp_path / "other"), workers=0, progress=False)
+
+
+def write_spec(tmp_path, axes, plot=None, name="study.json"):
+    spec = {
+        "scene": os.path.join(SOURCE, "examples", "slider_crank_elastic_demo_modal.json"),
+        "overrides": {"solver": {"t_end": 0.005}},
+        "axes": axes,
+        "outputs": {"summary": ["steps"], "max_abs": ["mid.uy"]},
+    }
+    if plot is not None:
+        spec["plot"] = plot
+    path = tmp_path / name
+    path.write_text(json.dumps(spec))
+    return str(path)
+
+
+@pytest.mark.parametrize("plot,words", [
+    ({"x": "speed", "y": []}, 'plot: key "y" must be a column name or a non-empty list'),
+    ({"x": "speed", "y": "max_abs(mid.uy)", "title": "T" * 100000}, 'plot: key "title" must be one line of at most 300'),
+    ({"x": "sped", "y": "max_abs(mid.uy)"}, "plot: key 'x': no column \"sped\" in the study"),
+    ({"x": "speed", "y": "max_abs(mid.uy)", "group": "nope"}, "plot: key 'group': no column \"nope\""),
+    ({"x": "integ", "y": "max_abs(mid.uy)"}, "plot: key 'x': the axis 'integ' has values that are not numbers"),
+    ({"x": "speed", "y": "max_abs(mid.uy)", "file": "../up.png"}, "plot: key 'file': the name \"../up\" has the character '.'"),
+    ({"x": "speed", "y": "max_abs(mid.uy)", "file": "plot.exe"}, 'plot: key "file" must be a file name ending in .png'),
+])
+def test_the_plot_spec_is_checked_before_the_study_runs(tmp_path, capsys, plot, words):
+    # D17: before, a traceback after every point had run
+    axes = [{"name": "integ", "key": "solver.integrator", "values": ["ida", "radau5"]},
+            {"key": "drivers[0].law.speed", "values": [100.0, 150.0]}]
+    path = write_spec(tmp_path, axes, plot)
+    assert st.main([path, "--out", str(tmp_path / "out"), "--workers", "0", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert words in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert not (tmp_path / "out" / "study.csv").exists()  # refused before any point ran
+
+
+def test_a_group_axis_of_strings_groups_the_plot_by_category(tmp_path, capsys):
+    # D17, R11: an axis of integrator names as the plot's group
+    axes = [{"name": "integ", "key": "solver.integrator", "values": ["ida", "radau5"]},
+            {"key": "drivers[0].law.speed", "values": [100.0, 150.0]}]  # named "speed" by default
+    path = write_spec(tmp_path, axes, {"x": "speed", "y": ["max_abs(mid.uy)"], "group": "integ", "file": "by_integrator.png"})
+    assert st.main([path, "--out", str(tmp_path / "out"), "--workers", "0", "--quiet"]) == 0
+    png = (tmp_path / "out" / "by_integrator.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    header, rows = table(tmp_path / "out")
+    assert header[:3] == ["point", "integ", "speed"]
+    assert {r[1] for r in rows} == {"ida", "radau5"} and {r[3] for r in rows} == {"ok"}
+
+
+@pytest.mark.parametrize("axis,words", [
+    ({"name": "a,b", "key": "solver.rtol", "values": [1e-6]}, "axes[0]: key 'name': the name \"a,b\" has the character ','"),
+    ({"name": "x" * 65, "key": "solver.rtol", "values": [1e-6]}, "is 65 characters long"),
+    ({"key": "solver.rtol[0]", "values": [1e-6]}, "axes[0]: key 'key': the name \"rtol[0]\" has the character '['"),
+])
+def test_axis_names_follow_the_one_name_rule(tmp_path, axis, words):
+    with pytest.raises(InputError, match="names are 1 to 64 characters") as e:
+        st.load_study(write_spec(tmp_path, [axis]))
+    assert words in str(e.value)
+
+
+def test_study_and_scene_files_follow_the_scene_file_rules(tmp_path):
+    with pytest.raises(InputError, match="a character device"):
+        st.load_study("/dev/zero")
+    spec = json.loads(open(write_spec(tmp_path, AXES)).read())
+    spec["scene"] = "/dev/zero"
+    (tmp_path / "s.json").write_text(json.dumps(spec))
+    with pytest.raises(InputError, match='key "scene": cannot read scene file \'/dev/zero\': it is a character device'):
+        st.load_study(str(tmp_path / "s.json"))
+    (tmp_path / "nan.json").write_text('{"scene": "x.json", "axes": [{"key": "solver.rtol", "values": [NaN]}]}')
+    with pytest.raises(InputError, match="NaN is not a JSON number"):
+        st.load_study(str(tmp_path / "nan.json"))
