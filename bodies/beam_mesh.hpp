@@ -9,6 +9,12 @@
 
 namespace flexmbd {
 
+/// Most elements of one beam body (scenes, C++ and Python alike): every node of a nodal
+/// body keeps a dense block of shapes as wide as the body's coordinates, so memory grows
+/// with the square of the mesh (0.9 GB at 1,000 spatial elements; docs/stability.md,
+/// "Sizes").
+constexpr long kMaxElements = 1000;
+
 /// Nodes (body frame, undeformed) and two-node beam elements.
 struct BeamMesh2d {
   struct Element {

@@ -10,16 +10,35 @@
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
+#include "core/memory_budget.hpp"
 
 namespace flexmbd {
 
 template <class Traits>
 FfrBeamModelT<Traits>::FfrBeamModelT(Mesh mesh, const Options& options, const std::string& owner)
     : mesh_(std::move(mesh)), options_(options) {
+  if (static_cast<long>(mesh_.elements.size()) > kMaxElements) {
+    throw InputError(owner + ": " + std::to_string(mesh_.elements.size()) + " elements, more than the " +
+                     std::to_string(kMaxElements) + " a beam body may have (docs/stability.md, \"Sizes\")");
+  }
+  requireMemory(memoryEstimate(), owner, "this beam model and a run of it");
   buildElements(owner);
   const Invariants nodal = nodalInvariants();
   const SpMat B2 = sparseNullSpaceBasis(referenceConditions(nodal, owner));  // unit columns where it can
   setBasis(reduced(B2, nodal, owner), nodal, owner);
+}
+
+template <class Traits>
+double FfrBeamModelT<Traits>::memoryEstimate() const {
+  // Without a reduction every node keeps a dense kNodeDofs x nf block of shapes (its point
+  // in the invariants), nf ~ N = kNodeDofs x nodes: 8 N^2 bytes; the run's Jacobian
+  // factors and the output's accelerations take about 2.5 times as much again (measured on
+  // 100 to 1,000 spatial elements: docs/stability.md, "Sizes"). A modal reduction solves
+  // a dense eigenproblem of K and M over N: about six N x N matrices at once.
+  const double N = static_cast<double>(mesh_.nodes.size()) * kNodeDofs;
+  const bool modal = !options_.modeSet.empty() || options_.modes > 0 ||
+                     options_.reduction == ModalReduction::CraigBampton;
+  return modal ? 6.0 * 8.0 * N * N : 3.5 * 8.0 * N * N;
 }
 
 template <class Traits>

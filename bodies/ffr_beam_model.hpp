@@ -93,6 +93,8 @@ class FfrBeamModelT {
   // ----- construction stages ----------------------------------------------------------
   /// The elements of the mesh (topology checked).
   void buildElements(const std::string& owner);
+  /// The bytes this model and a run of it take, about (requireMemory before building).
+  double memoryEstimate() const;
   /// The nodal invariants (kNodeDofs coordinates per node): the dimension's inertia
   /// shape integrals, m_ff, K_ff, D_ff summed from the elements.
   Invariants nodalInvariants() const;

@@ -54,19 +54,26 @@ const FfrBeamModel3d& requireModel(const std::shared_ptr<const FfrBeamModel3d>& 
 
 FfrBody3d::FfrBody3d(std::string name, std::shared_ptr<const FfrBeamModel3d> model, const FrameState3d& initial,
                      VecX qf0, VecX qf0dot)
-    : FfrBody3d(name, requireModel(model, name).invariants(), initial, std::move(qf0), std::move(qf0dot)) {
-  model_ = std::move(model);
+    : Body(std::move(name)), model_(std::move(model)), inv_(requireModel(model_, this->name()).invariants()),
+      initial_(initial), qf0_(std::move(qf0)), qf0dot_(std::move(qf0dot)) {
+  setUp();  // the model's invariants, shared, not copied (their point shapes are nf wide per node)
 }
 
 FfrBody3d::FfrBody3d(std::string name, FfrInvariants3d invariants, const FrameState3d& initial, VecX qf0,
                      VecX qf0dot)
-    : Body(std::move(name)), inv_(std::move(invariants)), initial_(initial), qf0_(std::move(qf0)),
-      qf0dot_(std::move(qf0dot)) {
+    : Body(std::move(name)), ownInvariants_(std::move(invariants)), inv_(ownInvariants_), initial_(initial),
+      qf0_(std::move(qf0)), qf0dot_(std::move(qf0dot)) {
+  const int nf = ownInvariants_.numElastic();
+  if (ownInvariants_.dff.size() == 0) ownInvariants_.dff.resize(nf, nf);  // undamped
+  setUp();
+}
+
+void FfrBody3d::setUp() {
   const std::string who = "body '" + this->name() + "'";
   nf_ = inv_.numElastic();
-  if (inv_.dff.size() == 0) inv_.dff.resize(nf_, nf_);  // undamped
   inv_.validate(who);
   // initial state
+  const FrameState3d& initial = initial_;
   for (int k = 0; k < 3; ++k) {
     requireFinite(initial.position[k], who + ": position[" + std::to_string(k) + "]");
     requireFinite(initial.velocity[k], who + ": velocity[" + std::to_string(k) + "]");

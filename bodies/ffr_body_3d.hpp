@@ -146,8 +146,13 @@ class FfrBody3d final : public Body {
   /// Column k of Y(q_f) = int rho u~ N dV.
   Vec3 skewShapeColumn(const ConstVecRef& qf, int k) const;
 
+  /// The checks of the invariants and the initial state, and the constants derived from
+  /// them (after inv_ is bound).
+  void setUp();
+
   std::shared_ptr<const FfrBeamModel3d> model_;  // generating mesh model, or null
-  FfrInvariants3d inv_;
+  FfrInvariants3d ownInvariants_;                // given directly; empty with a model
+  const FfrInvariants3d& inv_;                   // ownInvariants_ or model_->invariants()
   int nf_ = 0;
   FrameState3d initial_;
   VecX qf0_, qf0dot_;

@@ -94,9 +94,15 @@ void FfrInvariantsBase<Dim>::transformInto(const SpMat& P, FfrInvariantsBase& r)
   r.firstMoment = firstMoment;
   r.sBar = sBar * P;
   const SpMat Pt = P.transpose();
-  r.mff = Pt * mff * P;
-  r.kff = Pt * kff * P;
-  r.dff = Pt * dff * P;
+  // P^T A P of a symmetric A is symmetric; its round-off is not (a dense modal P over a
+  // stiff mesh: k_ff's entries ~1e10 against omega^2 ~1e4), so the symmetric part is kept
+  const auto congruent = [&](const SpMat& A) {
+    const SpMat C = Pt * A * P;
+    return SpMat(0.5 * (C + SpMat(C.transpose())));
+  };
+  r.mff = congruent(mff);
+  r.kff = congruent(kff);
+  r.dff = congruent(dff);
   r.points.clear();
   for (const Point& p : points) r.points.push_back({p.position, p.shape * P, p.rotationShape * P});
 }

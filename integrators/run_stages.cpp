@@ -241,6 +241,19 @@ void handOverToRadau(const RunContext& ctx, RunState& state, const OutputSample&
   state.restart(ctx.dae, last.t, y, yp, ctx.options);
 }
 
+void requireStepBudget(const RunContext& ctx, const RunState& state, double t) {
+  const long steps = state.totalSteps();
+  if (steps <= ctx.settings.maxTotalSteps) return;
+  const double mean = (t - ctx.outputs.t0) / static_cast<double>(steps);
+  throw StepBudgetExceeded("the run took " + std::to_string(steps) + " steps by t = " + formatTime(t) +
+                               ", more than max_total_steps (" + std::to_string(ctx.settings.maxTotalSteps) +
+                               "): its steps average " + fmt(mean, 3) + " s, " + fmt(mean / ctx.settings.outputStep, 3) +
+                               " of the output step (a model far stiffer than its outputs need, a tiny max_step, or "
+                               "a motion out of control; raise max_total_steps for a longer run: docs/stability.md, "
+                               "section 8)",
+                           t);
+}
+
 void integrateToNextOutput(const RunContext& ctx, RunState& state, OutputRecorder& recorder,
                            ProgressReporter& progress) {
   const DaeLayout& L = ctx.dae.layout();
@@ -248,6 +261,7 @@ void integrateToNextOutput(const RunContext& ctx, RunState& state, OutputRecorde
   const double t = state.integrator->advance(ctx.outputs.time(k), ctx.outputs.tEnd);
   recorder.record(t, state.integrator->y().segment(L.q, L.nq), state.integrator->y().segment(L.v, L.nv));
   progress.update(t, state.totalSteps());
+  requireStepBudget(ctx, state, t);
   const IntegratorStats now = state.integrator->stats();
   state.regularStep = now.lastStepSize;
   // IDA rejecting nearly every step (the order-1 trap of heavily damped elastic modes,
@@ -293,6 +307,8 @@ RunFailure diagnoseFailure(const std::exception_ptr& error, const FailureContext
   try {
     std::rethrow_exception(error);
   } catch (const CrossingFailure& e) {
+    return {e.what(), e.time()};
+  } catch (const StepBudgetExceeded& e) {
     return {e.what(), e.time()};
   } catch (const SolverError& e) {
     return {withDiagnosis(e.what(), ctx, e.time()), e.time()};

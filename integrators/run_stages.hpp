@@ -9,6 +9,7 @@
 
 #include <exception>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -117,7 +118,21 @@ void handOverToRadau(const RunContext& ctx, RunState& state, const OutputSample&
 /// Stage "integrate to the next output": the running integrator to output
 /// state.nextOutput, which is recorded; then the hand-over decision on its window of
 /// steps. @pre state.integrator is set, state.nextOutput <= ctx.outputs.count.
-/// @throws SolverError if the integrator fails; what the output throws passes through.
+/// The run took more steps than SolverSettings::maxTotalSteps (not a SolverError: no
+/// crossing is tried); reported with the time reached, rows kept, exit 1.
+struct StepBudgetExceeded : std::runtime_error {
+  StepBudgetExceeded(const std::string& message, double time) : std::runtime_error(message), time_(time) {}
+  double time() const { return time_; }
+
+ private:
+  double time_;
+};
+
+/// @throws StepBudgetExceeded when the run's steps exceed settings.maxTotalSteps.
+void requireStepBudget(const RunContext& ctx, const RunState& state, double t);
+
+/// @throws SolverError if the integrator fails, StepBudgetExceeded; what the output
+/// throws passes through.
 void integrateToNextOutput(const RunContext& ctx, RunState& state, OutputRecorder& recorder,
                            ProgressReporter& progress);
 

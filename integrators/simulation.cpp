@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/number_text.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/integrator_choice.hpp"
 #include "integrators/modal_participation.hpp"
@@ -113,6 +114,13 @@ void SolverSettings::validate() const {
   requireSetting(maxOrder >= 1 && maxOrder <= 5, "max_order", "an integer from 1 to 5",
                  static_cast<double>(maxOrder));
   requireSetting(maxSteps > 0, "max_steps", "a positive integer", static_cast<double>(maxSteps));
+  requireSetting(maxTotalSteps > 0, "max_total_steps", "a positive integer", static_cast<double>(maxTotalSteps));
+  if (maxStepSize > 0.0) {
+    requireSetting(span / maxStepSize <= static_cast<double>(maxTotalSteps), "max_step",
+                   "a step that covers t_end - t_start in at most max_total_steps (" + fmt(static_cast<double>(maxTotalSteps)) +
+                       ") steps, not " + fmt(span / maxStepSize, 3) + ": a larger max_step, or 0 (no limit)",
+                   maxStepSize);
+  }
   if (quasiStaticAbove) {
     requireSetting(*quasiStaticAbove > 0.0 && std::isfinite(*quasiStaticAbove), "quasi_static_above",
                    "a positive circular frequency (rad/s)", *quasiStaticAbove);

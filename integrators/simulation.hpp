@@ -58,6 +58,7 @@ struct SolverSettings {
   /// shrinks the step without bound). Unset: 1e-12 (t_end - t_start), at most 1e-12 s.
   std::optional<double> minStepSize;
   long maxSteps = 1000000;        ///< per output interval
+  long maxTotalSteps = 10000000;  ///< of the whole run (1e7: 2 to 15 CPU-minutes of small models)
   /// Highest BDF order (1..5). Orders 1 and 2 are A-stable: undamped high-frequency
   /// modes cannot force small steps for stability (docs/formulations.md).
   int maxOrder = 5;

@@ -129,12 +129,25 @@ void chooseStartingMultipliers(StaticProblem& P, const std::vector<int>& release
   P.setState(x);
 }
 
+/// Most unknowns (velocities and multipliers) of the dense Newton solve: 3,000 is a 72 MB
+/// matrix and some 10 s per factorisation.
+constexpr int kDenseStaticLimit = 3000;
+
 }  // namespace
 
 StaticEquilibrium solveStaticEquilibrium(const System& sys, double t, const VecX& q0,
                                          const StaticEquilibriumOptions& options) {
   StaticProblem P(sys, t, q0, options.released);
   const int nv = P.nv(), m = P.m();
+  if (nv + m > kDenseStaticLimit) {
+    // the Newton solve is dense (FullPivLU): n^3 time, 8 n^2 bytes per matrix; measured on
+    // the 1,000-element spatial beam (n = 6,012): 293 s CPU, 2.3 GB, and its condition
+    // (EA/l against the bending terms, ~1e13) read as singular
+    throw InputError("static equilibrium: " + std::to_string(nv + m) + " unknowns (velocities and multipliers), more "
+                     "than the " + std::to_string(kDenseStaticLimit) +
+                     " its dense Newton solve takes (minutes and GBs beyond): a modal reduction of the "
+                     "flexible bodies (\"modes\"), or modes about a state of a run (--at)");
+  }
   chooseStartingMultipliers(P, options.released);
   VecX r0;
   P.residual(r0);  // the unbalanced load at the start

@@ -15,10 +15,6 @@
 
 namespace flexmbd::scenereaders {
 
-/// Most elements of one flexible body: its 3 or 6 (n + 1) nodal coordinates enter dense
-/// matrices, 72 MB and some 10 s per factorisation at 1,000 planar elements.
-constexpr long kMaxElements = 1000;
-
 /// The "type" (one of rigid, flexible, flexible_invariants) and "name" of a body object,
 /// the name "ground" refused (reserved for the fixed ground body).
 std::pair<std::string, std::string> readBodyTypeAndName(jsonread::ObjectReader& r);

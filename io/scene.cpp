@@ -378,6 +378,7 @@ SolverSettings parseSolver(const json& j) {
   s.maxStepSize = r.number("max_step", s.maxStepSize);
   if (r.has("min_step")) s.minStepSize = r.number("min_step", 0.0);
   s.maxSteps = r.integer("max_steps", s.maxSteps, 1);
+  s.maxTotalSteps = r.integer("max_total_steps", s.maxTotalSteps, 1);
   s.maxOrder = static_cast<int>(r.integer("max_order", s.maxOrder, 1));
   s.initialStepSize = r.number("initial_step", s.initialStepSize);
   s.finiteDifferenceJacobian = r.boolean("fd_jacobian", s.finiteDifferenceJacobian);

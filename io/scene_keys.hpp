@@ -54,7 +54,7 @@ inline const Keys kEnergyOutput = {"type"};
 inline const Keys kPointOutput = {"type", "name", "body", "point"};  ///< point, deflection
 inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",       "atol_angle",
                              "atol_elastic", "atol_velocity", "t_start",  "t_end",      "output_step",
-                             "max_step",     "min_step",      "max_steps", "max_order", "initial_step",
+                             "max_step",     "min_step",      "max_steps", "max_total_steps", "max_order", "initial_step",
                              "linear_solver", "fd_jacobian", "cross_singular", "elastic_start",
                              "quasi_static_above", "redundant_constraints"};
 

@@ -58,7 +58,10 @@ Options parseOptions(const std::vector<std::string>& args) {
       o.corrector = value;
     } else if (name == "--steps") {
       const double x = cli::parseNumberOption(name, value);
-      if (x != std::floor(x) || x < 1 || x > 1e8) throw UsageError("option --steps expects an integer >= 1, got '" + value + "'");
+      if (x != std::floor(x) || x < 1 || x > static_cast<double>(kMaxKinematicSteps)) {
+        throw UsageError("option --steps expects an integer from 1 to " + std::to_string(kMaxKinematicSteps) + ", got '" +
+                         value + "'");
+      }
       o.steps = static_cast<long>(x);
     } else {
       o.tolerance = cli::parsePositiveOption(name, value);

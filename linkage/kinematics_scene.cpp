@@ -23,9 +23,6 @@
 namespace flexmbd {
 namespace {
 
-/// Most input steps: the bound of the --steps option (a 1e8-row kinematics.csv is GBs).
-constexpr long kMaxKinematicSteps = 100000000;
-
 using nlohmann::json;
 
 using namespace jsonread;

@@ -15,6 +15,10 @@ namespace flexmbd {
 
 /// A linkage ready to analyse. Linkage2d is referred to by KinematicAnalysis, so keep
 /// the scene alive while analysing it.
+/// Most steps of an analysis (scene "steps" and --steps): 1e7 rows of kinematics.csv are
+/// about a GB, some 50 s CPU at 5 us per step.
+constexpr long kMaxKinematicSteps = 10000000;
+
 struct KinematicsScene {
   std::string name;
   Linkage2d linkage;  ///< finalized

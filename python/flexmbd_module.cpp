@@ -345,6 +345,7 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def_readwrite("output_step", &SolverSettings::outputStep)
       .def_readwrite("max_step", &SolverSettings::maxStepSize)
       .def_readwrite("max_steps", &SolverSettings::maxSteps)
+      .def_readwrite("max_total_steps", &SolverSettings::maxTotalSteps)
       .def_readwrite("max_order", &SolverSettings::maxOrder)
       .def_readwrite("initial_step", &SolverSettings::initialStepSize)
       .def_readwrite("fd_jacobian", &SolverSettings::finiteDifferenceJacobian)

@@ -18,9 +18,11 @@
 #include "core/linear_algebra.hpp"
 #include "core/magnitude_checks.hpp"
 #include "integrators/run_stages.hpp"
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "joints/world_frames.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
 #include "tensegrity/tensegrity_time_stepper.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -256,3 +258,78 @@ TEST_F(NumericLimits, SpatialModesAtRestAreNotRefusedAsPlanarOnly) {
 }
 
 }  // namespace
+
+// D11: a model whose memory estimate exceeds what the machine has available is refused at
+// input, before the allocation, with the estimate (the budget lowered to 50 MB by
+// FLEXMBD_MEMORY_LIMIT_MB; 400 spatial elements: 3.5 x 8 N^2 bytes, N = 6 x 401 = 2,406,
+// about 162 MB); and the element cap holds for every way of building a beam model.
+TEST_F(NumericLimits, ModelAboveTheMemoryAvailableIsRefusedWithItsEstimate) {
+  json scene = json::parse(R"({"dimension": 3, "bodies": [{"name": "rod", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "poisson_ratio": 0.3, "density": 7800},
+      "beam": {"length": 1.0, "elements": 400}, "reference": {"type": "clamped"}}],
+      "solver": {"t_end": 1e-6}})");
+  const std::string path = shellQuote(writeScene("big.json", scene).string());
+  const CliResult r = runShell("FLEXMBD_MEMORY_LIMIT_MB=50 \"$F\" run " + path + " --out " + shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  for (const char* words : {"bodies[0] (\"rod\")", "needs about 162 MB of memory", "more than the 52 MB",
+                            "available", "docs/stability.md"}) {
+    EXPECT_NE(r.err.find(words), std::string::npos) << words << " in " << r.err;
+  }
+  scene["bodies"][0]["beam"]["elements"] = 1001;
+  const CliResult cap = run("run " + shellQuote(writeScene("cap.json", scene).string()) + " --out " +
+                            shellQuote((dir_ / "o2").string()));
+  EXPECT_EQ(cap.status, 2);
+  EXPECT_NE(cap.err.find("1000"), std::string::npos) << cap.err;
+  flexmbd::BeamSection3d s;
+  flexmbd::testsupport::expectInputError(
+      [&] { flexmbd::FfrBeamModel3d(flexmbd::BeamMesh3d::straight(1.0, 1001, s), {}, "body 'rod'"); },
+      {"body 'rod': 1001 elements, more than the 1000 a beam body may have"});
+}
+
+// Item 5: a run's steps are bounded (max_total_steps): a max_step that needs more steps than
+// that over t_end - t_start is refused at input (exit 2, the count named); a run past the
+// budget ends as failed with its rows, the mean step and its fraction of the output step.
+TEST_F(NumericLimits, StepBudgetEndsARunAndRefusesATinyMaxStep) {
+  json scene = example();
+  scene["solver"]["max_step"] = 1e-9;  // 6.3e9 steps over the rigid crank's 2 pi s
+  const CliResult tiny = run("run " + shellQuote(writeScene("tiny.json", scene).string()) + " --out " +
+                             shellQuote((dir_ / "o1").string()));
+  EXPECT_EQ(tiny.status, 2) << tiny.err;
+  EXPECT_TRUE(IsOneErrorLine(tiny.err));
+  for (const char* words : {"solver.max_step", "at most max_total_steps (1e+07)", "not 6.28e+09", "a larger max_step"}) {
+    EXPECT_NE(tiny.err.find(words), std::string::npos) << words << " in " << tiny.err;
+  }
+  scene["solver"].erase("max_step");
+  scene["solver"]["max_total_steps"] = 300;
+  const fs::path out = dir_ / "o2";
+  const CliResult over = run("run " + shellQuote(writeScene("over.json", scene).string()) + " --out " +
+                             shellQuote(out.string()));
+  EXPECT_EQ(over.status, 1) << over.err;
+  for (const char* words : {"steps by t = ", "more than max_total_steps (300)", "of the output step",
+                            "raise max_total_steps"}) {
+    EXPECT_NE(over.err.find(words), std::string::npos) << words << " in " << over.err;
+  }
+  const json summary = json::parse(readFile(out / "summary.json"));
+  EXPECT_EQ(summary.at("status"), "failed");
+  EXPECT_GT(summary.at("t_reached").get<double>(), 0.0);  // rows up to the failure kept
+  EXPECT_LT(summary.at("t_reached").get<double>(), scene["solver"]["t_end"].get<double>());
+}
+
+// D11 / item 8: modes at rest of a model beyond the dense static solve (more than 3,000
+// unknowns: the 600-element spatial beam has 3,612) are refused at once with the way out,
+// not after minutes and GBs (the 1,000-element beam: 293 s, 2.3 GB, then "singular").
+TEST_F(NumericLimits, ModesAtRestOfAHugeModelAreRefusedWithTheWayOut) {
+  json scene = json::parse(R"({"dimension": 3, "gravity": [0, 0, -9.81], "bodies": [{"name": "rod", "type": "flexible",
+      "section": {"width": 0.01, "height": 0.01, "youngs_modulus": 2e11, "poisson_ratio": 0.3, "density": 7800},
+      "beam": {"length": 1.0, "elements": 600}, "reference": {"type": "clamped"}}],
+      "joints": [{"name": "clamp", "type": "fixed", "bodies": ["ground", "rod"], "frames": [{"point": [0, 0, 0]}, {"point": [0, 0, 0]}]}],
+      "solver": {"t_end": 1e-3}})");
+  const CliResult r = run("modes " + shellQuote(writeScene("huge.json", scene).string()) + " --out " +
+                          shellQuote((dir_ / "o").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(IsOneErrorLine(r.err));
+  for (const char* words : {"static equilibrium: 3612 unknowns", "more than the 3000", "\"modes\"", "--at"}) {
+    EXPECT_NE(r.err.find(words), std::string::npos) << words << " in " << r.err;
+  }
+}
