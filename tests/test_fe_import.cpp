@@ -23,6 +23,7 @@
 #include <string>
 
 #include "bodies/fe_body_model.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
 #include "core/system.hpp"
@@ -539,4 +540,31 @@ TEST_F(AnsysFiles, MalformedTables) {
   f = files();
   write("elements.txt", "Elementnummer\tElementtyp\tKnoten\n1\tShell181\t1\t2\t3\t4\n");
   expectMentions(errorOf([&] { readAnsysFe(f); }), {"line 2", "'Shell181'", "expected Tet4"});
+}
+
+TEST(FeImport, FreeFreeModesWithAnIndefiniteMass) {
+  // Stored solid masses need not be positive definite (CalculiX's C3D20R: issue 27). A
+  // pencil built from its modes: V invertible, K = V^-T diag(kappa) V^-1, M = V^-T diag(mu)
+  // V^-1, so K v_i = lambda_i M v_i with lambda_i = kappa_i / mu_i. Six rigid modes
+  // (kappa = 0, mu > 0), elastic ones with mu > 0, and three with mu < 0 and large kappa
+  // (M indefinite; K - sigma M stays positive definite for small sigma < 0).
+  const int n = 24;
+  Random rnd(7);
+  MatX V = MatX::Identity(n, n) + 0.3 * MatX(rnd.vector(n * n, -1.0, 1.0).reshaped(n, n));
+  VecX kappa(n), mu(n);
+  for (int i = 0; i < n; ++i) {
+    mu[i] = i >= n - 3 ? -rnd.uniform(0.5, 1.0) : rnd.uniform(0.5, 2.0);
+    kappa[i] = i < 6 ? 0.0 : (i >= n - 3 ? 1e6 : 100.0 * (i - 5) * (i - 5) * mu[i]);  // lambda_i = 100 (i - 5)^2
+  }
+  const MatX Vinv = V.inverse();
+  const MatX K = Vinv.transpose() * kappa.asDiagonal() * Vinv, M = Vinv.transpose() * mu.asDiagonal() * Vinv;
+  const Eigen::SelfAdjointEigenSolver<MatX> es(M);
+  ASSERT_LT(es.eigenvalues().minCoeff(), 0.0);  // M indefinite indeed
+  VecX omega;
+  const MatX phi = freeFreeModes(SpMat(K.sparseView()), SpMat(M.sparseView()), V.leftCols(6), 4, "pencil", &omega);
+  // the exact lambda_i = 100 (i - 5)^2, i = 6..9: 100, 400, 900, 1600; the symmetric
+  // Lanczos to 1e-13 and the pencil's condition (|V| |V^-1| ~ 10): 1e-9
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(omega[i] * omega[i] / (100.0 * (i + 1) * (i + 1)), 1.0, 1e-9) << i;
+  EXPECT_LT((phi.transpose() * M * phi - MatX::Identity(4, 4)).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((phi.transpose() * M * V.leftCols(6)).cwiseAbs().maxCoeff(), 1e-9);  // mean axes
 }
