@@ -27,14 +27,14 @@ struct FeDof {
 };
 
 struct FeBodyData {
-  std::string source;                       ///< the files read, for messages
-  std::vector<int> nodeIds;                 ///< the FE code's node numbers
-  std::vector<Vec3> coordinates;            ///< undeformed positions, same order
+  std::string source;             ///< the files read, for messages
+  std::vector<int> nodeIds;       ///< the FE code's node numbers
+  std::vector<Vec3> coordinates;  ///< undeformed positions, same order
   std::vector<FeElement> elements;
   std::map<std::string, std::vector<int>> nodeSets;  ///< node indices, by set name
-  std::vector<FeDof> dofs;                  ///< one per row of mass and stiffness
-  SpMat mass;                               ///< symmetric, both triangles stored
-  SpMat stiffness;                          ///< symmetric, both triangles stored
+  std::vector<FeDof> dofs;                           ///< one per row of mass and stiffness
+  SpMat mass;                                        ///< symmetric, both triangles stored
+  SpMat stiffness;                                   ///< symmetric, both triangles stored
 
   int numNodes() const { return static_cast<int>(nodeIds.size()); }
   int numDofs() const { return static_cast<int>(dofs.size()); }

@@ -64,8 +64,8 @@ SpMat nodeMass(const FeBodyData& d, const std::string& owner) {
   const double scale = maxAbsOf(d.mass);
   const double diff = maxAbsOf(SpMat(d.mass - rebuilt));
   if (diff > kStructureTolerance * scale) {
-    throw InputError(owner + ": the mass matrix of " + d.source + " differs by " + fmt(diff, 3) +
-                     " (largest entry " + fmt(scale, 3) +
+    throw InputError(owner + ": the mass matrix of " + d.source + " differs by " + fmt(diff, 3) + " (largest entry " +
+                     fmt(scale, 3) +
                      ") from a solid element mass; expected M(a k, b l) = delta_kl m_ab (no coupling between "
                      "directions, the same in x, y, z)");
   }
@@ -106,8 +106,9 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   const MatX R = rigidBodyModes(d);
   const double kr = (d.stiffness * R).cwiseAbs().maxCoeff() / (maxAbsOf(d.stiffness) * R.cwiseAbs().maxCoeff());
   if (kr > kRigidTolerance) {
-    throw InputError(owner_ + ": the stiffness of " + d.source + " does not vanish on the rigid motions of the nodes (" +
-                     fmt(kr, 3) + " of |K| |r|, expected <= 1e-8): the coordinates or the DOF map are not those of "
+    throw InputError(owner_ + ": the stiffness of " + d.source +
+                     " does not vanish on the rigid motions of the nodes (" + fmt(kr, 3) +
+                     " of |K| |r|, expected <= 1e-8): the coordinates or the DOF map are not those of "
                      "the matrices, or the export holds supports");
   }
 

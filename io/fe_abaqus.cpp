@@ -80,12 +80,16 @@ class InpReader {
       const std::string t = trimmed(line);
       if (t.empty() || t.rfind("**", 0) == 0) continue;
       if (t[0] == '*') {
-        if (!pendingFields.empty()) f_.failAt(pendingLine, "element " + pendingFields[0] + " has too few nodes; expected " + std::to_string(elementNodes_));
+        if (!pendingFields.empty())
+          f_.failAt(pendingLine,
+                    "element " + pendingFields[0] + " has too few nodes; expected " + std::to_string(elementNodes_));
         startSection(parseKeyword(t));
         continue;
       }
       switch (section_) {
-        case Section::Node: readNode(t); break;
+        case Section::Node:
+          readNode(t);
+          break;
         case Section::Element: {
           const std::vector<std::string> f = splitFields(t, ",");
           if (pendingFields.empty()) pendingLine = f_.lineNumber();
@@ -96,11 +100,16 @@ class InpReader {
           }
           break;
         }
-        case Section::Nset: readSetLine(t); break;
-        case Section::None: break;  // data of a keyword not read
+        case Section::Nset:
+          readSetLine(t);
+          break;
+        case Section::None:
+          break;  // data of a keyword not read
       }
     }
-    if (!pendingFields.empty()) f_.failAt(pendingLine, "element " + pendingFields[0] + " has too few nodes; expected " + std::to_string(elementNodes_));
+    if (!pendingFields.empty())
+      f_.failAt(pendingLine,
+                "element " + pendingFields[0] + " has too few nodes; expected " + std::to_string(elementNodes_));
     return finish();
   }
 
@@ -118,9 +127,10 @@ class InpReader {
       elementType_ = it->second;
       elementNodes_ = elementNodeCount(elementType_);
       if (elementNodes_ < 0) {
-        f_.fail("element type '" + elementType_ +
-                "' is not a solid element read here; expected C3D4, C3D6, C3D8, C3D10, C3D15 or C3D20 (suffixes R, I, H, "
-                "M, T allowed)");
+        f_.fail(
+            "element type '" + elementType_ +
+            "' is not a solid element read here; expected C3D4, C3D6, C3D8, C3D10, C3D15 or C3D20 (suffixes R, I, H, "
+            "M, T allowed)");
       }
     } else if (k.name == "NSET") {
       section_ = Section::Nset;
@@ -144,7 +154,8 @@ class InpReader {
               std::to_string(nodeLine_.at(label)) + "); expected unique labels (one instance)");
     }
     Vec3 x;
-    for (int k = 0; k < 3; ++k) x[k] = realField(f_, f[k + 1], std::string("coordinate ") + "xyz"[k] + " of node " + f[0]);
+    for (int k = 0; k < 3; ++k)
+      x[k] = realField(f_, f[k + 1], std::string("coordinate ") + "xyz"[k] + " of node " + f[0]);
     nodes_.emplace_back(label, x);
     if (!setName_.empty()) sets_[setName_].push_back({label, f_.lineNumber()});
   }
@@ -161,7 +172,8 @@ class InpReader {
       f_.failAt(line, "element " + f[0] + " is defined twice (first on line " +
                           std::to_string(elementLine_.at(e.element.id)) + "); expected unique labels");
     }
-    for (size_t i = 1; i < f.size(); ++i) e.labels.push_back({integerField(f_, f[i], "node " + std::to_string(i) + " of element " + f[0]), line});
+    for (size_t i = 1; i < f.size(); ++i)
+      e.labels.push_back({integerField(f_, f[i], "node " + std::to_string(i) + " of element " + f[0]), line});
     elements_.push_back(std::move(e));
   }
 
@@ -169,10 +181,14 @@ class InpReader {
     const std::vector<std::string> f = splitFields(t, ",");
     std::vector<PendingLabel>& set = sets_[setName_];
     if (generate_) {
-      if (f.size() < 2 || f.size() > 3) f_.fail("a generate line of set " + setName_ + " has " + std::to_string(f.size()) + " fields; expected 'first, last[, step]'");
+      if (f.size() < 2 || f.size() > 3)
+        f_.fail("a generate line of set " + setName_ + " has " + std::to_string(f.size()) +
+                " fields; expected 'first, last[, step]'");
       const long a = integerField(f_, f[0], "the first node"), b = integerField(f_, f[1], "the last node");
       const long s = f.size() == 3 ? integerField(f_, f[2], "the step") : 1;
-      if (s < 1 || b < a) f_.fail("set " + setName_ + " generates from " + f[0] + " to " + f[1] + " by " + std::to_string(s) + "; expected first <= last and a positive step");
+      if (s < 1 || b < a)
+        f_.fail("set " + setName_ + " generates from " + f[0] + " to " + f[1] + " by " + std::to_string(s) +
+                "; expected first <= last and a positive step");
       for (long l = a; l <= b; l += s) set.push_back({l, f_.lineNumber()});
       return;
     }
@@ -194,11 +210,13 @@ class InpReader {
     if (d.nodeIds.empty()) throw InputError(f_.path() + ": no *Node data; expected the body's nodes");
     const auto resolve = [&](const PendingLabel& p, const std::string& user) {
       const auto it = index.find(p.label);
-      if (it == index.end()) f_.failAt(p.line, user + " names node " + std::to_string(p.label) + ", which no *Node line defines");
+      if (it == index.end())
+        f_.failAt(p.line, user + " names node " + std::to_string(p.label) + ", which no *Node line defines");
       return it->second;
     };
     for (PendingElement& e : elements_) {
-      for (const PendingLabel& p : e.labels) e.element.nodes.push_back(resolve(p, "element " + std::to_string(e.element.id)));
+      for (const PendingLabel& p : e.labels)
+        e.element.nodes.push_back(resolve(p, "element " + std::to_string(e.element.id)));
       d.elements.push_back(std::move(e.element));
     }
     for (const auto& s : sets_) {
@@ -235,12 +253,15 @@ SpMat readMtx(const std::string& path, int n) {
     for (const std::string& s : fields) {
       if (!s.empty()) nonEmpty.push_back(s);
     }
-    if (nonEmpty.size() != 3) f.fail("the line has " + std::to_string(nonEmpty.size()) + " fields; expected 'row column value'");
+    if (nonEmpty.size() != 3)
+      f.fail("the line has " + std::to_string(nonEmpty.size()) + " fields; expected 'row column value'");
     const long r = integerField(f, nonEmpty[0], "the row"), c = integerField(f, nonEmpty[1], "the column");
     if (r < 1 || c < 1 || r > n || c > n) {
-      f.fail("entry (" + nonEmpty[0] + ", " + nonEmpty[1] + ") is outside the " + std::to_string(n) + " DOF of the nodes (3 per node); expected row and column from 1 to " + std::to_string(n));
+      f.fail("entry (" + nonEmpty[0] + ", " + nonEmpty[1] + ") is outside the " + std::to_string(n) +
+             " DOF of the nodes (3 per node); expected row and column from 1 to " + std::to_string(n));
     }
-    entries.push_back({static_cast<int>(r - 1), static_cast<int>(c - 1), realField(f, nonEmpty[2], "the value"), f.lineNumber()});
+    entries.push_back(
+        {static_cast<int>(r - 1), static_cast<int>(c - 1), realField(f, nonEmpty[2], "the value"), f.lineNumber()});
   }
   if (entries.empty()) throw InputError(path + ": no matrix entries; expected lines 'row column value'");
   return assembleSymmetric(entries, n, SymmetricStorage::Both, path);

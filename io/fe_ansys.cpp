@@ -78,7 +78,8 @@ std::vector<int> readDofMap(const std::string& path, const FeBodyData& d, const 
     if (static_cast<long>(map.size()) == n) f.fail("more than the " + size[0] + " entries of the size line");
     const long id = integerField(f, w[0], "the node number");
     const auto found = index.find(static_cast<int>(id));
-    if (found == index.end()) f.fail("node " + w[0] + " is not in the nodal coordinates; expected the nodes of the mesh");
+    if (found == index.end())
+      f.fail("node " + w[0] + " is not in the nodal coordinates; expected the nodes of the mesh");
     const int a = found->second;
     if (firstLine[a] > 0) {
       f.fail("node " + w[0] + " is mapped twice (first on line " + std::to_string(firstLine[a]) +
@@ -97,8 +98,10 @@ SpMat readMatrixMarket(const std::string& path, int n) {
   TextFile f(path);
   std::string symmetry;
   const std::vector<std::string> size = readMatrixMarketHeader(f, "coordinate", "real", symmetry);
-  if (size.size() != 3) f.fail("the size line has " + std::to_string(size.size()) + " fields; expected 'rows columns entries'");
-  const long rows = integerField(f, size[0], "the number of rows"), cols = integerField(f, size[1], "the number of columns");
+  if (size.size() != 3)
+    f.fail("the size line has " + std::to_string(size.size()) + " fields; expected 'rows columns entries'");
+  const long rows = integerField(f, size[0], "the number of rows"),
+             cols = integerField(f, size[1], "the number of columns");
   const long nnz = integerField(f, size[2], "the number of entries");
   if (rows != n || cols != n) {
     f.fail("the matrix is " + size[0] + " x " + size[1] + "; expected " + std::to_string(n) + " x " +
@@ -112,12 +115,15 @@ SpMat readMatrixMarket(const std::string& path, int n) {
     if (w.size() != 3) f.fail("the line has " + std::to_string(w.size()) + " fields; expected 'row column value'");
     if (static_cast<long>(entries.size()) == nnz) f.fail("more than the " + size[2] + " entries of the size line");
     const long r = integerField(f, w[0], "the row"), c = integerField(f, w[1], "the column");
-    entries.push_back({static_cast<int>(r - 1), static_cast<int>(c - 1), realField(f, w[2], "the value"), f.lineNumber()});
+    entries.push_back(
+        {static_cast<int>(r - 1), static_cast<int>(c - 1), realField(f, w[2], "the value"), f.lineNumber()});
   }
   if (static_cast<long>(entries.size()) != nnz) {
-    f.fail("the file ends after " + std::to_string(entries.size()) + " of the " + size[2] + " entries of its size line");
+    f.fail("the file ends after " + std::to_string(entries.size()) + " of the " + size[2] +
+           " entries of its size line");
   }
-  return assembleSymmetric(entries, n, symmetry == "symmetric" ? SymmetricStorage::Lower : SymmetricStorage::Both, path);
+  return assembleSymmetric(entries, n, symmetry == "symmetric" ? SymmetricStorage::Lower : SymmetricStorage::Both,
+                           path);
 }
 
 }  // namespace
@@ -132,10 +138,12 @@ FeBodyData readAnsysFe(const AnsysFeFiles& files) {
       if (w.size() != 4) f.fail("the line has " + std::to_string(w.size()) + " fields; expected 'node x y z'");
       const int id = static_cast<int>(integerField(f, w[0], "the node number"));
       if (!firstLine.emplace(id, f.lineNumber()).second) {
-        f.fail("node " + w[0] + " is given twice (first on line " + std::to_string(firstLine[id]) + "); expected each node once");
+        f.fail("node " + w[0] + " is given twice (first on line " + std::to_string(firstLine[id]) +
+               "); expected each node once");
       }
       Vec3 x;
-      for (int k = 0; k < 3; ++k) x[k] = realField(f, w[k + 1], std::string("coordinate ") + "xyz"[k] + " of node " + w[0], true);
+      for (int k = 0; k < 3; ++k)
+        x[k] = realField(f, w[k + 1], std::string("coordinate ") + "xyz"[k] + " of node " + w[0], true);
       d.nodeIds.push_back(id);
       d.coordinates.push_back(x);
     });
@@ -143,15 +151,17 @@ FeBodyData readAnsysFe(const AnsysFeFiles& files) {
   std::map<int, int> index;
   for (int a = 0; a < d.numNodes(); ++a) index[d.nodeIds[a]] = a;
   {
-    static const std::map<std::string, int> counts = {{"Tet4", 4},     {"Tet10", 10},    {"Wedge6", 6},
-                                                      {"Wedge15", 15}, {"Pyramid5", 5},  {"Pyramid13", 13},
+    static const std::map<std::string, int> counts = {{"Tet4", 4},     {"Tet10", 10},   {"Wedge6", 6},
+                                                      {"Wedge15", 15}, {"Pyramid5", 5}, {"Pyramid13", 13},
                                                       {"Hex8", 8},     {"Hex20", 20}};
     TextFile f(files.elements);
     readTable(f, "elements", [&](const std::vector<std::string>& w) {
-      if (w.size() < 2) f.fail("the line has " + std::to_string(w.size()) + " fields; expected 'element type nodes...'");
+      if (w.size() < 2)
+        f.fail("the line has " + std::to_string(w.size()) + " fields; expected 'element type nodes...'");
       const auto it = counts.find(w[1]);
       if (it == counts.end()) {
-        f.fail("element type '" + w[1] + "'; expected Tet4, Tet10, Wedge6, Wedge15, Pyramid5, Pyramid13, Hex8 or Hex20");
+        f.fail("element type '" + w[1] +
+               "'; expected Tet4, Tet10, Wedge6, Wedge15, Pyramid5, Pyramid13, Hex8 or Hex20");
       }
       if (static_cast<int>(w.size()) != it->second + 2) {
         f.fail("element " + w[0] + " has " + std::to_string(w.size() - 2) + " nodes; expected " +
@@ -162,7 +172,8 @@ FeBodyData readAnsysFe(const AnsysFeFiles& files) {
       e.type = w[1];
       for (size_t i = 2; i < w.size(); ++i) {
         const auto a = index.find(static_cast<int>(integerField(f, w[i], "a node of element " + w[0])));
-        if (a == index.end()) f.fail("element " + w[0] + " names node " + w[i] + ", which the nodal coordinates do not give");
+        if (a == index.end())
+          f.fail("element " + w[0] + " names node " + w[i] + ", which the nodal coordinates do not give");
         e.nodes.push_back(a->second);
       }
       d.elements.push_back(std::move(e));

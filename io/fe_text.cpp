@@ -83,8 +83,8 @@ SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, Symmetri
   double largest = 0.0;
   for (const MatrixEntry& e : entries) {
     if (e.row < 0 || e.col < 0 || e.row >= n || e.col >= n) {
-      throw InputError(where(e.line) + "entry " + pos(e.row, e.col) + " is outside the " + std::to_string(n) +
-                       " x " + std::to_string(n) + " matrix; expected row and column from 1 to " + std::to_string(n));
+      throw InputError(where(e.line) + "entry " + pos(e.row, e.col) + " is outside the " + std::to_string(n) + " x " +
+                       std::to_string(n) + " matrix; expected row and column from 1 to " + std::to_string(n));
     }
     if (storage == SymmetricStorage::Lower && e.row < e.col) {
       throw InputError(where(e.line) + "entry " + pos(e.row, e.col) +
@@ -110,8 +110,7 @@ SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, Symmetri
     const double other = partner == stored.end() ? 0.0 : partner->second->value;
     if (std::abs(e.value - other) > kSymmetryTolerance * largest) {
       throw InputError(where(e.line) + "entry " + pos(e.row, e.col) + " = " + fmt(e.value) + " but entry " +
-                       pos(e.col, e.row) + " = " + fmt(other) +
-                       (partner == stored.end() ? " (not given)" : "") +
+                       pos(e.col, e.row) + " = " + fmt(other) + (partner == stored.end() ? " (not given)" : "") +
                        "; expected a symmetric matrix with both triangles stored (to " + fmt(kSymmetryTolerance) +
                        " of the largest entry, " + fmt(largest) + ")");
     }
@@ -139,7 +138,8 @@ void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::
   }
   const auto sizeOk = [&](const SpMat& A) { return A.rows() == nd && A.cols() == nd; };
   if (!sizeOk(d.mass)) throw InputError(massPath + ": the mass matrix is not " + dofText + " x " + dofText);
-  if (!sizeOk(d.stiffness)) throw InputError(stiffnessPath + ": the stiffness matrix is not " + dofText + " x " + dofText);
+  if (!sizeOk(d.stiffness))
+    throw InputError(stiffnessPath + ": the stiffness matrix is not " + dofText + " x " + dofText);
   const VecX kdiag = d.stiffness.diagonal();
   for (int i = 0; i < nd; ++i) {
     if (!(kdiag[i] > 0.0)) {
@@ -155,8 +155,8 @@ void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::
     for (int i = 0; i < nd; ++i) r[i] = d.dofs[i].direction == k ? 1.0 : 0.0;
     const double m = r.dot(d.mass * r);
     if (!(m > 0.0)) {
-      throw InputError(massPath + ": the total mass in direction " + "xyz"[k] + " (r^T M r, r the rigid translation) is " +
-                       fmt(m) + "; expected a positive mass");
+      throw InputError(massPath + ": the total mass in direction " + "xyz"[k] +
+                       " (r^T M r, r the rigid translation) is " + fmt(m) + "; expected a positive mass");
     }
   }
 }

@@ -23,8 +23,8 @@
 #include <string>
 
 #include "bodies/fe_body_model.hpp"
-#include "bodies/modal_reduction.hpp"
 #include "bodies/ffr_body_3d.hpp"
+#include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
@@ -40,7 +40,7 @@ namespace {
 
 const std::string kRotorDir = std::string(FLEXMBD_SOURCE_DIR) + "/../shared/data/exudyn-rotor";
 
-#define SKIP_WITHOUT_ROTOR_DATA()                                                                      \
+#define SKIP_WITHOUT_ROTOR_DATA() \
   if (!fs::exists(kRotorDir + "/rotorDiscTest.inp")) GTEST_SKIP() << "no rotor data at " << kRotorDir
 
 FeBodyData abaqusRotor() {
@@ -201,10 +201,10 @@ TEST(FeImport, FirstFreeFreeFrequencyOfTheRotorEqualsThePublishedValues) {
   for (int i = 0; i < 8; ++i) {
     EXPECT_NEAR(a.naturalFrequencies()[i] / n.naturalFrequencies()[i], 1.0, 1e-6) << "mode " << i + 1;
   }
-  std::printf("[ figures ] rotor f1: Abaqus (K x 1e-2) %.10f Hz (rel. error %.2e), Ansys %.10f Hz (%.2e); "
-              "rigid |lambda| <= %.1e, %.1e of lambda_7\n",
-              fa, ea, fn, en, a.rigidEigenvalues().cwiseAbs().maxCoeff() / la,
-              n.rigidEigenvalues().cwiseAbs().maxCoeff() / ln);
+  std::printf(
+      "[ figures ] rotor f1: Abaqus (K x 1e-2) %.10f Hz (rel. error %.2e), Ansys %.10f Hz (%.2e); "
+      "rigid |lambda| <= %.1e, %.1e of lambda_7\n",
+      fa, ea, fn, en, a.rigidEigenvalues().cwiseAbs().maxCoeff() / la, n.rigidEigenvalues().cwiseAbs().maxCoeff() / ln);
   std::printf("[ figures ] rotor f1..f8 (Ansys), Hz:");
   for (int i = 0; i < 8; ++i) std::printf(" %.6f", n.naturalFrequencies()[i] / (2.0 * kPi));
   std::printf("\n");
@@ -253,14 +253,16 @@ TEST(FeImport, MassAndInertiaOfTheRotor) {
   EXPECT_LT((va.firstMoment / va.mass - vn.firstMoment / vn.mass).norm(), 6e-8 * 0.5);
   const Mat3 Ia = inertiaAboutCentre(va), In = inertiaAboutCentre(vn);
   EXPECT_LT((Ia - In).norm(), 3e-7 * In.norm());
-  std::printf("[ figures ] rotor mass: Abaqus %.10f kg, Ansys %.10f kg (rel. %.2e), rho V %.10f kg (Abaqus rel. %.2e); "
-              "centre of mass (%.6g, %.6g, %.6g) m\n",
-              va.mass, vn.mass, va.mass / vn.mass - 1.0, rhoV, va.mass / rhoV - 1.0, va.firstMoment.x() / va.mass,
-              va.firstMoment.y() / va.mass, va.firstMoment.z() / va.mass);
-  std::printf("[ figures ] inertia about the centre of mass (Abaqus): diag (%.9g, %.9g, %.9g) kg m^2, "
-              "largest off-diagonal %.2e; Abaqus vs Ansys %.2e relative\n",
-              Ia(0, 0), Ia(1, 1), Ia(2, 2), (Ia - Mat3(Ia.diagonal().asDiagonal())).cwiseAbs().maxCoeff(),
-              (Ia - In).norm() / In.norm());
+  std::printf(
+      "[ figures ] rotor mass: Abaqus %.10f kg, Ansys %.10f kg (rel. %.2e), rho V %.10f kg (Abaqus rel. %.2e); "
+      "centre of mass (%.6g, %.6g, %.6g) m\n",
+      va.mass, vn.mass, va.mass / vn.mass - 1.0, rhoV, va.mass / rhoV - 1.0, va.firstMoment.x() / va.mass,
+      va.firstMoment.y() / va.mass, va.firstMoment.z() / va.mass);
+  std::printf(
+      "[ figures ] inertia about the centre of mass (Abaqus): diag (%.9g, %.9g, %.9g) kg m^2, "
+      "largest off-diagonal %.2e; Abaqus vs Ansys %.2e relative\n",
+      Ia(0, 0), Ia(1, 1), Ia(2, 2), (Ia - Mat3(Ia.diagonal().asDiagonal())).cwiseAbs().maxCoeff(),
+      (Ia - In).norm() / In.norm());
 }
 
 TEST(FeImport, ReducedInvariantsAreValidAndOnMeanAxes) {
@@ -339,9 +341,10 @@ TEST(FeImport, FreeSpinningRotorConservesEnergyAndMomentum) {
   EXPECT_LT(dE, 1e-6);
   EXPECT_LT(dL, 1e-6);
   EXPECT_LT(dH, 1e-6);
-  std::printf("[ figures ] free spinning rotor, 4 modes, 0.05 s, rtol 1e-9: energy drift %.2e, |dL|/|L| %.2e, "
-              "|dH|/|H| %.2e, %d steps\n",
-              dE, dL, dH, static_cast<int>(sum.stats.steps));
+  std::printf(
+      "[ figures ] free spinning rotor, 4 modes, 0.05 s, rtol 1e-9: energy drift %.2e, |dL|/|L| %.2e, "
+      "|dH|/|H| %.2e, %d steps\n",
+      dE, dL, dH, static_cast<int>(sum.stats.steps));
 }
 
 TEST(FeImport, StiffnessThatDoesNotMatchTheCoordinatesIsRefused) {
@@ -365,9 +368,9 @@ namespace {
 class FeFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("flexmbd_fe_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ =
+        fs::temp_directory_path() / ("flexmbd_fe_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                     "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
@@ -425,7 +428,8 @@ TEST_F(FeFiles, AbaqusMalformedNodeLine) {
 }
 
 TEST_F(FeFiles, AbaqusElementOfAnUndefinedNodeOrUnknownType) {
-  const std::string p = inp(), q = inp("1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n", "1, 1, 2, 3, 9\n");
+  const std::string p = inp(),
+                    q = inp("1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n", "1, 1, 2, 3, 9\n");
   expectMentions(errorOf([&] { readAbaqusFe(q, mtx("m.mtx", 1.0), mtx("k.mtx", 1.0)); }),
                  {"line 9", "element 1 names node 9"});
   const std::string r = write("s4.inp", "*Node\n1, 0., 0., 0.\n*Element, type=S4R\n1, 1, 1, 1, 1\n");
@@ -485,8 +489,9 @@ class AnsysFiles : public FeFiles {
  protected:
   AnsysFeFiles files(const std::string& dofMap = "2\n1\n3\n4\n", const std::string& stiffness = "") {
     AnsysFeFiles f;
-    f.coordinates = write("xyz.txt", "Knotennummer\tX\tY\tZ\t\n1\t0,\t0,\t0,\t\n2\t1,e+000\t0,\t0,\t\n"
-                                     "3\t0,\t1,\t0,\t\n4\t0,\t0,\t1,\t\n");
+    f.coordinates = write("xyz.txt",
+                          "Knotennummer\tX\tY\tZ\t\n1\t0,\t0,\t0,\t\n2\t1,e+000\t0,\t0,\t\n"
+                          "3\t0,\t1,\t0,\t\n4\t0,\t0,\t1,\t\n");
     f.elements = write("elements.txt", "Elementnummer\tElementtyp\tKnoten\t\n1\tTet4\t1\t2\t3\t4\t\n");
     f.dofMap = write("map.txt", "%%MatrixMarket matrix array integer general\n%====\n4 1\n" + dofMap);
     f.mass = write("mass.txt", marketText("symmetric", 2.0, "", 0));
