@@ -3,8 +3,17 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
+// GCC 12 warns -Wuse-after-free inside Spectra (Eigen temporaries freed and reallocated
+// by resize): a false positive of its inlining analysis (as integrators/linearization.cpp).
+#if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
+#pragma GCC diagnostic ignored "-Wuse-after-free"
+#endif
+#include <Spectra/MatOp/SparseCholesky.h>
+#include <Spectra/MatOp/SparseSymMatProd.h>
+#include <Spectra/SymGEigsSolver.h>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
@@ -48,6 +57,71 @@ MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, con
     if (omega) (*omega)[k] = std::sqrt(std::max(eig.eigenvalues()[keep[k] - 1], 0.0));
   }
   return Phi;
+}
+
+MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count, const std::string& owner,
+                   VecX* omega, VecX* rigidEigenvalues) {
+  const int n = static_cast<int>(K.rows());
+  if (count < 1 || count + 6 >= n) {
+    throw InputError(owner + ": " + std::to_string(count) + " free-free modes asked of " + std::to_string(n) +
+                     " DOF; expected 1 to " + std::to_string(n - 7) + " (six rigid-body modes are dropped)");
+  }
+  // The shift: below zero by 1e-4 of the mean diagonal ratio tr K / tr M, far from the
+  // rigid eigenvalues' round-off (~1e-16 of it) and of the order of the lowest elastic
+  // ones, so that the wanted nu are the largest and well separated.
+  const double sigma = -1e-4 * std::abs(K.diagonal().sum() / M.diagonal().sum());
+  const SpMat C = K - sigma * M;
+  Spectra::SparseCholesky<double> cop(C);
+  if (cop.info() != Spectra::CompInfo::Successful) {
+    throw InputError(owner + ": K - sigma M is not positive definite at sigma = " + std::to_string(sigma) +
+                     "; expected a free-free stiffness (positive semi-definite) and a mass with positive total mass");
+  }
+  Spectra::SparseSymMatProd<double> mop(M);
+  const int nev = count + 6;
+  const int ncv = std::min(n, std::max(2 * nev + 1, 20));
+  Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>,
+                          Spectra::GEigsMode::Cholesky>
+      eigs(mop, cop, nev, ncv);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-13);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw InputError(owner + ": the free-free eigensolver (Spectra, shift-invert) did not converge");
+  }
+  const VecX nu = eigs.eigenvalues();  // descending: lambda ascending where nu > 0
+  const MatX X = eigs.eigenvectors();
+  VecX lambda(nev);
+  for (int i = 0; i < nev; ++i) {
+    if (!(nu[i] > 0.0)) {
+      throw InputError(owner + ": the mass matrix gives a mode of negative mass among the lowest " +
+                       std::to_string(nev) + "; expected a mass positive on the low modes");
+    }
+    lambda[i] = sigma + 1.0 / nu[i];
+  }
+  // six rigid-body modes: |lambda| <= 1e-6 lambda_7 (a rigid mode's eigenvalue is the
+  // round-off of K, ~1e-16 of its largest; the rotor's measure 1e-11 of lambda_7)
+  constexpr double kRigidFraction = 1e-6;
+  int rigidCount = 0;
+  for (int i = 0; i < nev; ++i) rigidCount += std::abs(lambda[i]) <= kRigidFraction * std::abs(lambda[6]) ? 1 : 0;
+  if (rigidCount != 6 || !(lambda[6] > 0.0)) {
+    throw InputError(owner + ": the free-free body has " + std::to_string(rigidCount) +
+                     " rigid-body modes (|lambda| <= 1e-6 lambda_7, lambda_7 = " + std::to_string(lambda[6]) +
+                     "); expected exactly six (fewer: supports in the exported stiffness; more: a mechanism or "
+                     "disconnected parts)");
+  }
+  if (rigidEigenvalues != nullptr) *rigidEigenvalues = lambda.head(6);
+  MatX phi = X.middleCols(6, count);
+  // mean axes exactly: phi -= R (R^T M R)^-1 R^T M phi
+  const MatX MR = M * rigid;
+  phi -= rigid * (rigid.transpose() * MR).ldlt().solve(MR.transpose() * phi);
+  // mass-normalise: phi L^-T with L L^T = phi^T M phi (the modes are M-orthogonal to
+  // round-off, so this only scales them)
+  const MatX mphi = phi.transpose() * (M * phi);
+  const Eigen::LLT<MatX> llt(mphi);
+  if (llt.info() != Eigen::Success) throw InputError(owner + ": the elastic modes have no positive mass");
+  phi = llt.matrixU().solve<Eigen::OnTheRight>(phi);
+  if (omega != nullptr) omega->resize(count);
+  for (int i = 0; i < count && omega != nullptr; ++i) (*omega)[i] = std::sqrt(lambda[6 + i]);
+  return phi;
 }
 
 MatX interfaceConditions(const SpMat& B2, int nodeDofs, const std::vector<int>& nodes, const std::string& owner,

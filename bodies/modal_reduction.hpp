@@ -42,6 +42,22 @@ std::vector<int> chosenModes(int count, const std::vector<int>& set, const std::
 MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, const std::string& owner,
                  VecX* omega = nullptr, const std::string& what = "mode");
 
+/// The free-free normal modes of a body whose stiffness K (n x n, symmetric positive
+/// semi-definite) vanishes on the rigid motions `rigid` (n x 6: three translations, three
+/// rotations), mass M symmetric (not necessarily positive definite: solid element masses
+/// as stored may not be, docs/fe-import.md): the first `count` elastic modes, the six
+/// rigid-body eigenvalues (|lambda| <= 1e-6 lambda_7, else InputError) dropped.
+/// Shift-invert with a C-inner product, C = K - sigma M positive definite (sigma < 0):
+/// M phi = nu C phi, nu = 1 / (lambda - sigma), the largest nu by Spectra's Lanczos
+/// (SymGEigsSolver, Cholesky mode). The modes are made exactly M-orthogonal to `rigid`
+/// (mean axes: the deformation carries no linear and, to first order, no angular momentum
+/// relative to the frame) and mass-normalised. `omega` receives their frequencies (rad/s),
+/// `rigidEigenvalues` (if given) the six dropped eigenvalues (rad^2/s^2).
+/// @throws InputError naming `owner`: count < 1 or count + 6 >= n, C not positive definite,
+/// the solver not converging, not exactly six near-zero eigenvalues.
+MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count, const std::string& owner,
+                   VecX* omega = nullptr, VecX* rigidEigenvalues = nullptr);
+
 /// The interface conditions G x of a body whose nodal coordinates (`nodeDofs` per node,
 /// node k's at nodeDofs k .. nodeDofs k + nodeDofs - 1) are q_n = B2 x: the rows of B2
 /// of every coordinate of the `nodes` (node order, then coordinate order). `dofs`

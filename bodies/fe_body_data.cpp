@@ -1,0 +1,18 @@
+#include "bodies/fe_body_data.hpp"
+
+#include <algorithm>
+
+namespace flexmbd {
+
+int FeBodyData::nodeIndex(int id) const {
+  const auto it = std::find(nodeIds.begin(), nodeIds.end(), id);
+  return it == nodeIds.end() ? -1 : static_cast<int>(it - nodeIds.begin());
+}
+
+std::vector<int> FeBodyData::dofIndex() const {
+  std::vector<int> idx(3 * nodeIds.size(), -1);
+  for (int i = 0; i < numDofs(); ++i) idx[3 * dofs[i].node + dofs[i].direction] = i;
+  return idx;
+}
+
+}  // namespace flexmbd

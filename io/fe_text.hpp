@@ -1,0 +1,81 @@
+// What the readers of finite element exports (io/fe_abaqus.hpp, io/fe_ansys.hpp) share:
+// a text file read line by line whose errors name the file and the line, number fields,
+// the sparse symmetric matrices (coordinate entries, checked for symmetry and duplicates)
+// and the checks of the assembled body data. docs/fe-import.md.
+#pragma once
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "bodies/fe_body_data.hpp"
+
+namespace flexmbd::feread {
+
+/// A matrix is symmetric when |A_ij - A_ji| <= kSymmetryTolerance max |A|: the exports
+/// print 16 significant digits (Abaqus, Ansys), so a symmetric matrix differs by the
+/// round-off of its printing, 1e-16 of the entry; 1e-8 also admits codes that print 9
+/// digits, while a wrong or missing entry differs by the entry itself.
+constexpr double kSymmetryTolerance = 1e-8;
+
+/// A text file read line by line; every error names the file and the line.
+class TextFile {
+ public:
+  /// @throws InputError naming the file if it cannot be opened.
+  explicit TextFile(std::string path);
+  /// The next line (without its line end; "\r\n" accepted) or false at the end.
+  bool next(std::string& line);
+  int lineNumber() const { return line_; }
+  const std::string& path() const { return path_; }
+  /// @throws InputError "<file>, line <n>: <what>" (the current line).
+  [[noreturn]] void fail(const std::string& what) const;
+  /// @throws InputError "<file>, line <line>: <what>".
+  [[noreturn]] void failAt(int line, const std::string& what) const;
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  int line_ = 0;
+};
+
+/// The fields of `line` separated by any of `separators`, each trimmed of blanks; empty
+/// fields are kept except one after a trailing separator ("1, 2," has two fields).
+std::vector<std::string> splitFields(const std::string& line, const std::string& separators);
+/// The line without leading and trailing blanks (spaces, tabs).
+std::string trimmed(const std::string& s);
+
+/// A finite real number filling the whole field ("1.5e-3"; with `decimalComma` also
+/// "1,5e-3", German-locale Ansys output). @throws InputError at the file's current line
+/// naming `what` and the field.
+double realField(const TextFile& f, const std::string& field, const std::string& what, bool decimalComma = false);
+/// An integer filling the whole field. @throws InputError as realField.
+long integerField(const TextFile& f, const std::string& field, const std::string& what);
+
+/// One stored entry of a sparse matrix: 0-based row and column, and the line it came from.
+struct MatrixEntry {
+  int row = 0;
+  int col = 0;
+  double value = 0.0;
+  int line = 0;
+};
+
+/// How a file stores a symmetric matrix.
+enum class SymmetricStorage {
+  Both,   ///< both triangles (Abaqus .mtx): checked A_ij = A_ji to kSymmetryTolerance
+  Lower,  ///< the lower triangle only (MatrixMarket "symmetric"): row >= column required
+};
+
+/// The n x n symmetric matrix of `entries`, both triangles stored.
+/// @throws InputError naming `path`, the line and what was expected: an entry outside
+/// n x n, an entry given twice, an upper entry in Lower storage, A_ij != A_ji (Both).
+SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, SymmetricStorage storage,
+                        const std::string& path);
+
+/// The checks every reader ends with: one row per (node, direction), each once, matrices
+/// numDofs() x numDofs(), every DOF with a positive stiffness diagonal (else a node outside
+/// every element, or matrices of another mesh), positive total mass r_k^T M r_k in each
+/// direction k (r_k the rigid translation along k).
+/// @throws InputError naming `massPath` or `stiffnessPath` and what was expected.
+void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::string& stiffnessPath);
+
+}  // namespace flexmbd::feread
