@@ -4,8 +4,9 @@
 // and modes keys, beam theories, arrays of placed shapes, geometry, bushings placed in the
 // world) — deleted keys, wrong types, huge, tiny and non-finite numbers, deep nesting,
 // truncated and binary files, long and hostile names, keys of other objects inserted —
-// and runs `flexmbd run`, `kinematics` or `modes` on each, then `flexmbd summary` and
-// (one case in kPlotEvery) `flexmbd plot` on the output folder. A second test damages the
+// and runs `flexmbd run`, `kinematics` or `modes` on each (with damaged options now and
+// then), then, one case in kSummaryEvery, `flexmbd summary` and, one in kPlotEvery,
+// `flexmbd plot` on the output folder (sometimes with its summary.json or results damaged). A second test damages the
 // study files of `flexmbd-study` the same way. Every case must end by itself or stop on
 // SIGTERM at its time limit (below), with exit status 0, 1 or 2; never exit 0 with a
 // non-finite number or one beyond 1e100 in its results (results.csv, kinematics.csv,
@@ -14,7 +15,9 @@
 // Reproduce a case: FLEXMBD_FUZZ_KEEP=1 keeps the scene (and study file) of each failed
 // case in /tmp (flexmbd_fuzz_case_N.json, flexmbd_fuzz_study_N.json).
 // Explore further: FLEXMBD_FUZZ_SEED=n and FLEXMBD_FUZZ_CASES=n change the seed and count;
-// FLEXMBD_FUZZ_TIME_SCALE=x multiplies every time limit (a sanitizer build: 10).
+// FLEXMBD_FUZZ_TIME_SCALE=x multiplies every time limit (a sanitizer build: 10);
+// FLEXMBD_FUZZ_WRAPPER runs the binary under a memory checker (cli() below);
+// FLEXMBD_FUZZ_LOG=file appends one line per process (exit status, seconds, case).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -34,9 +37,10 @@ using nlohmann::json;
 
 namespace {
 
-// Number of damaged scenes and the seed of the generator: 400 cases take about 30 s in
-// Release on the 2-core machine (most are input errors, found in milliseconds); the
-// study test runs kCases / kStudyShare studies (about 1 s each: a Python start).
+// Number of damaged scenes and the seed of the generator: 400 cases take about 50 s in
+// Release on the 2-core machine loaded by two other builds (most are input errors, found
+// in milliseconds); the study test runs kCases / kStudyShare studies (about 10 s: each a
+// Python start).
 constexpr int kCases = 400;
 constexpr unsigned kSeed = 20261123;
 constexpr int kSummaryEvery = 4;  // one case in 4 also runs flexmbd summary on its output folder
@@ -603,7 +607,13 @@ class Fuzz : public Cli {
   std::map<std::string, double> baseline_;
 };
 
-std::string cli() { return shellQuote(FLEXMBD_CLI); }
+/// The binary, behind FLEXMBD_FUZZ_WRAPPER if set: a memory checker on the Release build,
+/// e.g. "valgrind -q --error-exitcode=99" (an error is then an exit status outside 0-2: a
+/// failure), with FLEXMBD_FUZZ_TIME_SCALE=30.
+std::string cli() {
+  const char* wrapper = std::getenv("FLEXMBD_FUZZ_WRAPPER");
+  return (wrapper ? std::string(wrapper) + " " : std::string()) + shellQuote(FLEXMBD_CLI);
+}
 
 TEST_F(Fuzz, DamagedScenesOfEverySubcommand) {
   const int n = cases();
