@@ -100,10 +100,10 @@ def _fail(where, message):
 
 def _allow_only(obj, allowed, where):
     if not isinstance(obj, dict):
-        _fail(where, f"must be an object, got {_shown(obj)}")
+        _fail(where, f"must be an object (keys: {', '.join(sorted(allowed))}), got {_shown(obj)}")
     unknown = sorted(set(obj) - allowed)
     if unknown:
-        _fail(where, f"unknown key {unknown[0]!r} (allowed keys: {', '.join(sorted(allowed))})")
+        _fail(where, f"unknown key {_shown(unknown[0])} (allowed keys: {', '.join(sorted(allowed))})")
 
 
 class Study:
@@ -203,7 +203,7 @@ class Study:
                     _fail(w, 'key "range" must be [low, high]')
                 spacing = a.get("spacing", "linear")
                 if spacing not in ("linear", "log"):
-                    _fail(w, f'key "spacing" must be "linear" or "log", got {spacing!r}')
+                    _fail(w, f'key "spacing" must be "linear" or "log", got {_shown(spacing)}')
                 if spacing == "log" and not (r[0] > 0 and r[1] > 0):
                     _fail(w, "a log range needs positive bounds")
                 count = a.get("count")
@@ -243,7 +243,7 @@ class Study:
             return points
         for a in self.axes:
             if a["values"] is None:
-                _fail(where, f'axis {a["name"]!r}: a range needs "count" in a {combine} study')
+                _fail(where, f'axis {a["name"]!r}: a range needs "count" in a {_shown(combine)} study')
         if combine == "grid":
             return [dict(zip([a["name"] for a in self.axes], combo))
                     for combo in itertools.product(*[a["values"] for a in self.axes])]
@@ -252,7 +252,7 @@ class Study:
             if len(lengths) != 1:
                 _fail(where, '"combine": "zip" needs axes of equal length')
             return [dict(zip([a["name"] for a in self.axes], combo)) for combo in zip(*[a["values"] for a in self.axes])]
-        _fail(where, f'key "combine" must be "grid", "zip" or "random", got {combine!r}')
+        _fail(where, f'key "combine" must be "grid", "zip" or "random", got {_shown(combine)}')
         return []
 
     def overrides_of(self, point):

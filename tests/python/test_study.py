@@ -179,7 +179,12 @@ AXIS = [{"key": "drivers[0].law.speed", "values": [100.0]}]
     (json.dumps({"axes": AXIS, "outputs": {"at": "x"}}), 'outputs: key "at" must be a list'),
     (json.dumps({"axes": AXIS, "combine": "random", "samples": {"count": 2, "seed": [1]}}),
      'key "samples": "seed" must be an integer'),
-    (json.dumps({"axes": ["b" * 100000]}), 'axes[0]: must be an object, got "bbbbbbbb'),
+    (json.dumps({"axes": ["b" * 100000]}), 'axes[0]: must be an object (keys: count, key, name, range, spacing, '
+                                           'values), got "bbbbbbbb'),
+    (json.dumps({"axes": AXIS, "outputs": None}), "outputs: must be an object (keys: after, at, "),
+    (json.dumps({"axes": [{"key": "solver.rtol", "range": [1e-6, 1e-4], "spacing": "l" * 100000}]}),
+     'key "spacing" must be "linear" or "log", got "llll'),
+    (json.dumps({"axes": AXIS, "k" * 100000: 1}), 'unknown key "kkkk'),
 ])
 def test_damaged_study_files_are_input_errors_on_one_short_line(tmp_path, capsys, text, words):
     if text.startswith("{") and '"scene"' not in text:
