@@ -12,28 +12,31 @@
 namespace flexmbd::jsonread {
 
 std::string readSceneFile(const std::string& path) {
+  // the path as messages show it: a 100 KB path (refused by the system) keeps them one line
+  constexpr std::size_t kMaxQuotedPath = 300;
+  const std::string shown = shorten(path, kMaxQuotedPath);
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
-    throw InputError("cannot open scene file '" + path + "': " +
+    throw InputError("cannot open scene file '" + shown + "': " +
                      (errno == ENOENT ? std::string("no such file") : std::strerror(errno)));
   }
-  if (S_ISDIR(st.st_mode)) throw InputError("cannot read scene file '" + path + "': it is a directory");
+  if (S_ISDIR(st.st_mode)) throw InputError("cannot read scene file '" + shown + "': it is a directory");
   if (!S_ISREG(st.st_mode)) {
     const char* kind = S_ISFIFO(st.st_mode)  ? "a FIFO (named pipe)"
                        : S_ISCHR(st.st_mode) ? "a character device (an endless or special file such as /dev/zero)"
                        : S_ISSOCK(st.st_mode) ? "a socket"
                                               : "not a regular file";
-    throw InputError("cannot read scene file '" + path + "': it is " + kind +
+    throw InputError("cannot read scene file '" + shown + "': it is " + kind +
                      "; a scene must be a regular file (of at most 64 MiB)");
   }
   auto tooLarge = [&](std::uintmax_t bytes) {
-    return InputError("scene file '" + path + "' is " + std::to_string(bytes) + " bytes, more than the limit of " +
+    return InputError("scene file '" + shown + "' is " + std::to_string(bytes) + " bytes, more than the limit of " +
                       std::to_string(kMaxSceneFileBytes) + " bytes (64 MiB) for a scene file");
   };
   if (static_cast<std::uintmax_t>(st.st_size) > kMaxSceneFileBytes) throw tooLarge(st.st_size);
   // O_NONBLOCK: a file that became a FIFO after the check does not block the open
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) throw InputError("cannot open scene file '" + path + "' for reading: " + std::strerror(errno));
+  if (fd < 0) throw InputError("cannot open scene file '" + shown + "' for reading: " + std::strerror(errno));
   std::string text;
   char buf[1 << 16];
   for (;;) {
@@ -42,7 +45,7 @@ std::string readSceneFile(const std::string& path) {
     if (n < 0) {
       const int err = errno;
       ::close(fd);
-      throw InputError("cannot read scene file '" + path + "': " + std::strerror(err));
+      throw InputError("cannot read scene file '" + shown + "': " + std::strerror(err));
     }
     if (n == 0) break;
     text.append(buf, static_cast<std::size_t>(n));

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <utility>
 
 #include <Eigen/LU>
 #include <Eigen/SVD>
@@ -267,22 +268,35 @@ SingularPosition KinematicAnalysis::locate(const KinematicState& regular, double
 
 namespace {
 
-/// The first non-finite quantity of a state ("" if all are finite): a run never reports a
-/// position, transfer function, velocity or acceleration that is inf or NaN (issue 11).
-std::string firstNonFinite(const KinematicState& s) {
-  if (!s.x.allFinite()) return "positions";
-  if (!s.xp.allFinite() || !s.xpp.allFinite()) return "transfer functions";
-  if (!s.v.allFinite()) return "velocities (X' times the input speed)";
-  if (!s.a.allFinite()) return "accelerations (X'' times speed^2 plus X' times the input acceleration)";
-  if (!std::isfinite(s.residual)) return "residual";
+/// Largest magnitude a result may have: the bound of scene numbers (kMaxInputMagnitude,
+/// io/json_reader.hpp). Inputs within it can still give results beyond it (an input
+/// acceleration of 1e100 rad/s^2 on a 30 cm crank: 3e101 m/s^2; issue 26).
+constexpr double kMaxResultMagnitude = 1e100;
+
+/// The first quantity of a state that is non-finite or beyond kMaxResultMagnitude, with
+/// what is wrong ("" if none): a run never reports a position, transfer function,
+/// velocity or acceleration that is inf, NaN (issue 11) or absurdly large.
+std::string firstOutOfRange(const KinematicState& s) {
+  const std::pair<Eigen::ArrayXd, const char*> parts[] = {
+      {s.x.array(), "positions"},
+      {s.xp.array(), "transfer functions"},
+      {s.xpp.array(), "transfer functions"},
+      {s.v.array(), "velocities (X' times the input speed)"},
+      {s.a.array(), "accelerations (X'' times speed^2 plus X' times the input acceleration)"},
+      {Eigen::ArrayXd::Constant(1, s.residual), "residual"}};
+  for (const auto& [values, what] : parts) {  // the non-finite first: the more severe
+    if (!values.allFinite()) return std::string("non-finite ") + what;
+  }
+  for (const auto& [values, what] : parts) {
+    if (!(values.abs() <= kMaxResultMagnitude).all()) return std::string(what) + " beyond 1e100";
+  }
   return "";
 }
 
-void stopAtNonFinite(KinematicSummary& summary, const KinematicState& s, const std::string& what,
-                     const KinematicState* prev) {
+void stopAtOutOfRange(KinematicSummary& summary, const KinematicState& s, const std::string& what,
+                      const KinematicState* prev) {
   summary.ok = false;
-  summary.message = "non-finite " + what + " at step " + std::to_string(s.step) +
-                    ", alpha = " + fmt(s.alpha, kNumberDigits) +
+  summary.message = what + " at step " + std::to_string(s.step) + ", alpha = " + fmt(s.alpha, kNumberDigits) +
                     " (overflow: are the input speed and acceleration within range?); " +
                     (prev ? "results kept up to alpha = " + fmt(prev->alpha, kNumberDigits) + " (step " +
                                 std::to_string(prev->step) + ")"
@@ -303,8 +317,8 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
   c0.residual = maxAbs(linkage_.deformations(x0_));
   KinematicState prev = makeState(0, settings_.start, x0_, c0);
   int prevSign = transferFunctions(x0_).determinantSign;
-  if (const std::string bad = firstNonFinite(prev); !bad.empty()) {
-    stopAtNonFinite(summary, prev, bad, nullptr);
+  if (const std::string bad = firstOutOfRange(prev); !bad.empty()) {
+    stopAtOutOfRange(summary, prev, bad, nullptr);
     summary.stepsCompleted = 0;
     summary.alphaReached = settings_.start;
     summary.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -342,8 +356,8 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
       break;
     }
     KinematicState state = makeState(k, alpha, X, c);
-    if (const std::string bad = firstNonFinite(state); !bad.empty()) {
-      stopAtNonFinite(summary, state, bad, &prev);
+    if (const std::string bad = firstOutOfRange(state); !bad.empty()) {
+      stopAtOutOfRange(summary, state, bad, &prev);
       break;
     }
     prevSign = tf.determinantSign;

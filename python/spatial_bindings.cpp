@@ -108,7 +108,11 @@ double nonNegativeArg(const py::handle& h, const char* fn, const char* arg) {
 }
 int intArg(const py::handle& h, const char* fn, const char* arg) {
   if (!py::isinstance<py::int_>(h) || py::isinstance<py::bool_>(h)) badArgument(fn, arg, "an integer", h);
-  return h.cast<int>();
+  try {
+    return h.cast<int>();
+  } catch (const py::cast_error&) {  // beyond int: pybind11's RuntimeError names nothing
+    throw InputError(std::string(fn) + ": " + arg + " is beyond the range of an int, got " + pyRepr(h));
+  }
 }
 
 Law lawArg(const py::handle& h, const char* fn, const char* arg) {
@@ -464,11 +468,14 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
 
   // ----- given invariants (bodies/ffr_invariants_3d.hpp): NumPy arrays in, sparse inside ----
   py::class_<FfrPoint3d>(m, "FfrPoint3d")
-      .def(py::init([](const py::object& position, const MatX& shape, const MatX& rotationShape) {
+      .def(py::init([](const py::object& position, const py::object& shape, const py::object& rotationShape) {
+             // converted to the fields' own 3 x nf types: a matrix of other rows is a
+             // TypeError here (assigned as MatX it overran the field's memory)
+             using Mat3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
              FfrPoint3d p;
              p.position = vec3Arg(position, "FfrPoint3d", "position");
-             p.shape = shape;
-             p.rotationShape = rotationShape;
+             p.shape = argumentAs<Mat3X>(shape, "FfrPoint3d", "shape", "a 3 x nf matrix");
+             p.rotationShape = argumentAs<Mat3X>(rotationShape, "FfrPoint3d", "rotation_shape", "a 3 x nf matrix");
              return p;
            }),
            py::arg("position"), py::arg("shape"), py::arg("rotation_shape"),
@@ -505,12 +512,19 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def_property("m_ff", mffGet, mffSet)
       .def_property("k_ff", kffGet, kffSet)
       .def_property("d_ff", dffGet, dffSet)
-      .def_readwrite("points", &FfrInvariants3d::points)
+      // copies both ways, as the matrices: def_readwrite handed out references into the
+      // vector, left dangling (a use after free) once the list was set again
+      .def_property(
+          "points", [](const FfrInvariants3d& v) { return v.points; },
+          [](FfrInvariants3d& v, const std::vector<FfrPoint3d>& x) { v.points = x; })
       .def_readwrite("second_moment", &FfrInvariants3d::secondMoment)
       .def_property(
           "position_shape", [](const FfrInvariants3d& v) { return std::vector<MatX>(v.positionShape.begin(), v.positionShape.end()); },
           [](FfrInvariants3d& v, const std::vector<MatX>& x) {
-            if (x.size() != 3) throw InputError("FfrInvariants3d.position_shape: expected 3 matrices (x, y, z), 3 x nf each");
+            // checked before the assignment: a MatX of other rows would overrun the 3 x nf field
+            if (x.size() != 3 || x[0].rows() != 3 || x[1].rows() != 3 || x[2].rows() != 3) {
+              throw InputError("FfrInvariants3d.position_shape: expected 3 matrices (x, y, z), 3 x nf each");
+            }
             for (int k = 0; k < 3; ++k) v.positionShape[k] = x[k];
           })
       .def_property(

@@ -121,6 +121,23 @@ TEST(HardeningLibrary, KinematicsStopsAtTheFirstNonFiniteState) {
   EXPECT_NE(summary.message.find("non-finite accelerations"), std::string::npos) << summary.message;
 }
 
+// Issue 26 (fuzz case 3654): inputs within the bound of scene numbers gave results beyond
+// it with status ok (an input acceleration of 1e100 rad/s^2: 3e101 m/s^2 at the joints).
+TEST(HardeningLibrary, KinematicsStopsAtResultsBeyondTheBoundOfSceneNumbers) {
+  flexmbd::KinematicsScene scene = flexmbd::loadKinematicsScene(kSourceDir + "/examples/kinematics_four_bar.json");
+  flexmbd::KinematicSettings settings = scene.settings;
+  settings.acceleration = 1e100;
+  long rows = 0;
+  const flexmbd::KinematicSummary summary =
+      flexmbd::analyzeKinematics(scene.linkage, settings, [&](const flexmbd::KinematicState&) { ++rows; });
+  EXPECT_FALSE(summary.ok);
+  EXPECT_EQ(rows, 0);
+  EXPECT_NE(summary.message.find("accelerations (X'' times speed^2 plus X' times the input acceleration) beyond "
+                                 "1e100 at step 0"),
+            std::string::npos)
+      << summary.message;
+}
+
 TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   const fs::path dir = fs::temp_directory_path() / ("flexmbd_test_writer_" + std::to_string(::getpid()));
   fs::remove_all(dir);

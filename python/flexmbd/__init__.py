@@ -357,14 +357,23 @@ def parse_json(text, source):
         out = {}
         for k, v in items:
             if k in out:
-                raise InputError(f"{source}: not valid JSON: the key {k!r} appears twice in an object")
+                shown = repr(k) if len(k) <= 60 else repr(k[:57] + "...")
+                raise InputError(f"{source}: not valid JSON: the key {shown} appears twice in an object")
             out[k] = v
         return out
 
+    def number(text):  # 1e999 is inf to Python's reader; the engine refuses it
+        x = float(text)
+        if not math.isfinite(x):
+            raise InputError(f"{source}: not valid JSON: the number {text[:60]} is beyond the range of a double")
+        return x
+
     try:
-        return json.loads(text, parse_constant=constant, object_pairs_hook=pairs)
+        return json.loads(text, parse_constant=constant, parse_float=number, object_pairs_hook=pairs)
     except json.JSONDecodeError as e:
         raise InputError(f"{source}: not valid JSON: {e}") from None
+    except RecursionError:  # 100,000 nested arrays: Python's reader gives up
+        raise InputError(f"{source}: not valid JSON: arrays or objects nested too deep") from None
 
 
 def run_tensegrity(scene, overrides=None):

@@ -59,16 +59,51 @@ def _check_name(name, key, where):
         _fail(where, f"key {key!r}: the name {json.dumps(name)[:60]} {problem} ({NAME_RULE})")
 
 
+def _shown(value, limit=60, quoted=True):
+    """A value as a message shows it: JSON, cut to limit characters (a 100 kB string keeps
+    the message one readable line, as the engine's messages)."""
+    text = json.dumps(value) if quoted else str(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _check_outputs(outputs, where):
+    """The outputs spec's types, before any point runs (a wrong type was a traceback after
+    the study ran)."""
+    _allow_only(outputs, OUTPUT_KEYS, where)
+    for kind in ("summary", "max_abs", "max", "min", "final", "functions"):
+        columns = outputs.get(kind, [])
+        if not isinstance(columns, list) or not all(isinstance(c, str) for c in columns):
+            _fail(where, f"key {kind!r} must be a list of column names, got {_shown(columns)}")
+    for c in outputs.get("functions", []):
+        if ":" not in c:
+            _fail(where, f'key "functions": {_shown(c)} is not "module:function"')
+    after = outputs.get("after", 0.0)
+    if not isinstance(after, (int, float)) or isinstance(after, bool):
+        _fail(where, f'key "after" must be a number (a time), got {_shown(after)}')
+    at = outputs.get("at", [])
+    if not isinstance(at, list):
+        _fail(where, f'key "at" must be a list of {{"column", "t", "name"}}, got {_shown(at)}')
+    for i, a in enumerate(at):
+        w = f"{where}.at[{i}]"
+        _allow_only(a, {"column", "t", "name"}, w)
+        if not isinstance(a.get("column"), str):
+            _fail(w, f'key "column" must be a column name, got {_shown(a.get("column"))}')
+        if not isinstance(a.get("t"), (int, float)) or isinstance(a.get("t"), bool):
+            _fail(w, f'key "t" must be a number (a time), got {_shown(a.get("t"))}')
+        if "name" in a:
+            _check_name(a["name"], "name", w)
+
+
 def _fail(where, message):
     raise InputError(f"{where}: {message}")
 
 
 def _allow_only(obj, allowed, where):
     if not isinstance(obj, dict):
-        _fail(where, f"must be an object, got {json.dumps(obj)}")
+        _fail(where, f"must be an object (keys: {', '.join(sorted(allowed))}), got {_shown(obj)}")
     unknown = sorted(set(obj) - allowed)
     if unknown:
-        _fail(where, f"unknown key {unknown[0]!r} (allowed keys: {', '.join(sorted(allowed))})")
+        _fail(where, f"unknown key {_shown(unknown[0])} (allowed keys: {', '.join(sorted(allowed))})")
 
 
 class Study:
@@ -95,11 +130,8 @@ class Study:
         self.axes = self._parse_axes(spec, where)
         self.points = self._make_points(spec, where)
         self.outputs = spec.get("outputs", {"summary": ["steps", "cpu_seconds"]})
-        _allow_only(self.outputs, OUTPUT_KEYS, where + ": outputs")
+        _check_outputs(self.outputs, where + ": outputs")
         self.output_names = output_names(self.outputs)
-        for i, a in enumerate(self.outputs.get("at", []) if isinstance(self.outputs.get("at"), list) else []):
-            if isinstance(a, dict) and "name" in a:
-                _check_name(a["name"], "name", f"{where}: outputs.at[{i}]")
         self.plot = spec.get("plot")
         if self.plot is not None:
             self._check_plot(where + ": plot")
@@ -118,7 +150,8 @@ class Study:
         columns = self.columns
         for key, c in [("x", spec["x"])] + [("y", y) for y in ys] + ([("group", spec["group"])] if "group" in spec else []):
             if not isinstance(c, str) or c not in columns:
-                _fail(where, f"key {key!r}: no column {json.dumps(c)[:60]} in the study (columns: {', '.join(columns)})")
+                listed = ", ".join(_shown(x, quoted=False) for x in columns[:20]) + (", ..." if len(columns) > 20 else "")
+                _fail(where, f"key {key!r}: no column {_shown(c)} in the study (columns: {listed})")
             if key != "group" and c in text_axes:
                 _fail(where, f"key {key!r}: the axis {c!r} has values that are not numbers (expected a numeric "
                              f"column; an axis of strings can be the plot's \"group\")")
@@ -170,7 +203,7 @@ class Study:
                     _fail(w, 'key "range" must be [low, high]')
                 spacing = a.get("spacing", "linear")
                 if spacing not in ("linear", "log"):
-                    _fail(w, f'key "spacing" must be "linear" or "log", got {spacing!r}')
+                    _fail(w, f'key "spacing" must be "linear" or "log", got {_shown(spacing)}')
                 if spacing == "log" and not (r[0] > 0 and r[1] > 0):
                     _fail(w, "a log range needs positive bounds")
                 count = a.get("count")
@@ -192,6 +225,8 @@ class Study:
             samples = spec.get("samples")
             if not isinstance(samples, dict) or not isinstance(samples.get("count"), int) or samples["count"] < 1:
                 _fail(where, 'random studies need "samples": {"count": N, "seed": S}')
+            if not isinstance(samples.get("seed", 0), int) or isinstance(samples.get("seed"), bool):
+                _fail(where, f'key "samples": "seed" must be an integer, got {_shown(samples["seed"])}')
             rng = random.Random(samples.get("seed", 0))
             points = []
             for _ in range(samples["count"]):
@@ -208,7 +243,7 @@ class Study:
             return points
         for a in self.axes:
             if a["values"] is None:
-                _fail(where, f'axis {a["name"]!r}: a range needs "count" in a {combine} study')
+                _fail(where, f'axis {a["name"]!r}: a range needs "count" in a {_shown(combine)} study')
         if combine == "grid":
             return [dict(zip([a["name"] for a in self.axes], combo))
                     for combo in itertools.product(*[a["values"] for a in self.axes])]
@@ -217,7 +252,7 @@ class Study:
             if len(lengths) != 1:
                 _fail(where, '"combine": "zip" needs axes of equal length')
             return [dict(zip([a["name"] for a in self.axes], combo)) for combo in zip(*[a["values"] for a in self.axes])]
-        _fail(where, f'key "combine" must be "grid", "zip" or "random", got {combine!r}')
+        _fail(where, f'key "combine" must be "grid", "zip" or "random", got {_shown(combine)}')
         return []
 
     def overrides_of(self, point):

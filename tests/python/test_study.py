@@ -165,3 +165,35 @@ def test_study_and_scene_files_follow_the_scene_file_rules(tmp_path):
     (tmp_path / "nan.json").write_text('{"scene": "x.json", "axes": [{"key": "solver.rtol", "values": [NaN]}]}')
     with pytest.raises(InputError, match="NaN is not a JSON number"):
         st.load_study(str(tmp_path / "nan.json"))
+
+
+AXIS = [{"key": "drivers[0].law.speed", "values": [100.0]}]
+
+
+@pytest.mark.parametrize("text,words", [
+    # found by the fuzz test (issue 26): each was a Python traceback, exit 1
+    ("[" * 100000 + "]" * 100000, "not valid JSON: arrays or objects nested too deep"),
+    ('{"scene": "x.json", "axes": [], "outputs": {"after": -1e400}}', "the number -1e400 is beyond the range of a double"),
+    (json.dumps({"axes": AXIS, "outputs": {"summary": "steps"}}), "outputs: key 'summary' must be a list of column names"),
+    (json.dumps({"axes": AXIS, "outputs": {"at": [{"column": "slider.x"}]}}), 'outputs.at[0]: key "t" must be a number'),
+    (json.dumps({"axes": AXIS, "outputs": {"at": "x"}}), 'outputs: key "at" must be a list'),
+    (json.dumps({"axes": AXIS, "combine": "random", "samples": {"count": 2, "seed": [1]}}),
+     'key "samples": "seed" must be an integer'),
+    (json.dumps({"axes": ["b" * 100000]}), 'axes[0]: must be an object (keys: count, key, name, range, spacing, '
+                                           'values), got "bbbbbbbb'),
+    (json.dumps({"axes": AXIS, "outputs": None}), "outputs: must be an object (keys: after, at, "),
+    (json.dumps({"axes": [{"key": "solver.rtol", "range": [1e-6, 1e-4], "spacing": "l" * 100000}]}),
+     'key "spacing" must be "linear" or "log", got "llll'),
+    (json.dumps({"axes": AXIS, "k" * 100000: 1}), 'unknown key "kkkk'),
+])
+def test_damaged_study_files_are_input_errors_on_one_short_line(tmp_path, capsys, text, words):
+    if text.startswith("{") and '"scene"' not in text:
+        spec = json.loads(text)
+        spec["scene"] = os.path.join(SOURCE, "examples", "slider_crank_rigid.json")
+        text = json.dumps(spec)
+    path = tmp_path / "study.json"
+    path.write_text(text)
+    assert st.main([str(path), "--out", str(tmp_path / "out"), "--workers", "0", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert words in err
+    assert err.count("\n") == 1 and len(err) < 400 and "Traceback" not in err
