@@ -30,6 +30,7 @@
 #include "integrators/simulation.hpp"
 #include "io/fe_abaqus.hpp"
 #include "io/fe_ansys.hpp"
+#include "free_body_drift.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
@@ -306,45 +307,24 @@ TEST(FeImport, FreeSpinningRotorConservesEnergyAndMomentum) {
   s.position = Vec3(0.1, -0.2, 0.3);
   s.velocity = Vec3(0.5, 0.0, -0.2);
   s.angularVelocity = Vec3(0.3, -0.2, 2.0 * kPi * 10.0);  // about z, the rotor axis, and a wobble
-  System sys;
-  auto body = std::make_unique<FfrBody3d>("rotor", n.invariants(), s, VecX::Zero(nf), qf0dot);
-  const FfrBody3d* b = body.get();
-  sys.addBody(std::move(body));
-  sys.finalize();
-  const int oq = sys.coordinateOffset(BodyIndex(1)), ov = sys.velocityOffset(BodyIndex(1));
-  std::vector<double> E;
-  std::vector<Vec3> L, H;
   SolverSettings st;
   st.rtol = 1e-9;
   st.atol = 1e-11;
   st.tEnd = 0.05;  // five periods of the first mode, half a revolution
   st.outputStep = 0.001;
-  st.progress = false;
-  const SimulationSummary sum = simulate(sys, st, [&](const OutputSample& out) {
-    const VecX q = out.q.segment(oq, 7 + nf), v = out.v.segment(ov, 6 + nf);
-    VecX Mv = VecX::Zero(6 + nf);
-    b->addMassTimes(q, v, Mv);
-    E.push_back(0.5 * v.dot(Mv) + b->internalPotential(q));
-    L.push_back(Mv.head<3>());
-    H.push_back(Vec3(q.head<3>()).cross(Vec3(Mv.head<3>())) + FfrBody3d::rotationOf(q) * Mv.segment<3>(3));
-  });
-  ASSERT_TRUE(sum.ok) << sum.message;
-  ASSERT_GT(E.size(), 10u);
-  double dE = 0.0, dL = 0.0, dH = 0.0;
-  for (size_t k = 0; k < E.size(); ++k) {
-    dE = std::max(dE, std::abs(E[k] - E[0]) / E[0]);
-    dL = std::max(dL, (L[k] - L[0]).norm() / L[0].norm());
-    dH = std::max(dH, (H[k] - H[0]).norm() / H[0].norm());
-  }
+  const testsupport::FreeBodyDrift d =
+      testsupport::freeBodyDrift(std::make_unique<FfrBody3d>("rotor", n.invariants(), s, VecX::Zero(nf), qf0dot), st);
+  ASSERT_TRUE(d.summary.ok) << d.summary.message;
+  ASSERT_GT(d.outputs, 10u);
   // BDF at rtol 1e-9 over five vibration periods: drift well below 1e-6 (as the beam
   // body's test in test_ffr_body_3d.cpp)
-  EXPECT_LT(dE, 1e-6);
-  EXPECT_LT(dL, 1e-6);
-  EXPECT_LT(dH, 1e-6);
+  EXPECT_LT(d.energy, 1e-6);
+  EXPECT_LT(d.momentum, 1e-6);
+  EXPECT_LT(d.angularMomentum, 1e-6);
   std::printf(
       "[ figures ] free spinning rotor, 4 modes, 0.05 s, rtol 1e-9: energy drift %.2e, |dL|/|L| %.2e, "
       "|dH|/|H| %.2e, %d steps\n",
-      dE, dL, dH, static_cast<int>(sum.stats.steps));
+      d.energy, d.momentum, d.angularMomentum, static_cast<int>(d.summary.stats.steps));
 }
 
 TEST(FeImport, StiffnessThatDoesNotMatchTheCoordinatesIsRefused) {

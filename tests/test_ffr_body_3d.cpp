@@ -27,6 +27,7 @@
 #include "ffr3d_test_models.hpp"
 #include "integrators/simulation.hpp"
 #include "joints/spatial_joint.hpp"
+#include "free_body_drift.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
@@ -460,42 +461,22 @@ TEST(FfrBody3d, FreeFlexibleBodyConservesEnergyAndMomentum) {
   Fixture f;
   VecX qf0 = VecX::Zero(f.nf), qf0dot = VecX::Zero(f.nf);
   for (int k = 0; k < f.nf; ++k) qf0dot[k] = (k % 6 < 3 ? 0.02 : 0.1) * std::sin(1.0 + k);  // vibrating
-  System sys;
-  auto body = std::make_unique<FfrBody3d>("flex", f.chain.inv, someFrame(), qf0, qf0dot);
-  const FfrBody3d* b = body.get();
-  sys.addBody(std::move(body));
-  sys.finalize();
-  const int oq = sys.coordinateOffset(BodyIndex(1)), ov = sys.velocityOffset(BodyIndex(1));
-  std::vector<double> E;
-  std::vector<Vec3> L, H;
   SolverSettings st;
   st.rtol = 1e-9;
   st.atol = 1e-11;
   st.tEnd = 0.3;
   st.outputStep = 0.01;
-  st.progress = false;
-  const SimulationSummary s = simulate(sys, st, [&](const OutputSample& o) {
-    const VecX q = o.q.segment(oq, 7 + f.nf), v = o.v.segment(ov, 6 + f.nf);
-    VecX Mv = VecX::Zero(6 + f.nf);
-    b->addMassTimes(q, v, Mv);
-    E.push_back(0.5 * v.dot(Mv) + b->internalPotential(q));
-    L.push_back(Mv.head<3>());
-    H.push_back(Vec3(q.head<3>()).cross(Vec3(Mv.head<3>())) + FfrBody3d::rotationOf(q) * Mv.segment<3>(3));
-  });
-  ASSERT_TRUE(s.ok) << s.message;
-  ASSERT_GT(E.size(), 10u);
-  double dE = 0.0, dL = 0.0, dH = 0.0;
-  for (size_t k = 0; k < E.size(); ++k) {
-    dE = std::max(dE, std::abs(E[k] - E[0]) / E[0]);
-    dL = std::max(dL, (L[k] - L[0]).norm() / L[0].norm());
-    dH = std::max(dH, (H[k] - H[0]).norm() / H[0].norm());
-  }
+  const testsupport::FreeBodyDrift d =
+      testsupport::freeBodyDrift(std::make_unique<FfrBody3d>("flex", f.chain.inv, someFrame(), qf0, qf0dot), st);
+  ASSERT_TRUE(d.summary.ok) << d.summary.message;
+  ASSERT_GT(d.outputs, 10u);
   // BDF at rtol 1e-9 over ~30 vibration periods of the first modes: drift well below 1e-6
-  EXPECT_LT(dE, 1e-6);
-  EXPECT_LT(dL, 1e-6);
-  EXPECT_LT(dH, 1e-6);
+  EXPECT_LT(d.energy, 1e-6);
+  EXPECT_LT(d.momentum, 1e-6);
+  EXPECT_LT(d.angularMomentum, 1e-6);
   std::printf("[ figures ] free flexible body, 0.3 s, rtol 1e-9: energy drift %s, |dL|/|L| %s, |dH|/|H| %s, %d steps\n",
-              sci(dE).c_str(), sci(dL).c_str(), sci(dH).c_str(), static_cast<int>(s.stats.steps));
+              sci(d.energy).c_str(), sci(d.momentum).c_str(), sci(d.angularMomentum).c_str(),
+              static_cast<int>(d.summary.stats.steps));
 }
 
 TEST(FfrBody3d, FlexiblePendulumOnASphericalJointConservesEnergy) {
