@@ -267,21 +267,29 @@ SolidShape readSolidShape(const ObjectReader& r, const std::string& type) {
   return s;
 }
 
-const std::array<const char*, 4> kShapeTypes = {"box", "cylinder", "tube", "sphere"};
+/// The keys allowed for each type of shape, in the order box, cylinder, tube, sphere.
+using ShapeKeys = std::array<const scenekeys::Keys*, 4>;
+
+/// A "shape" or "geometry" object's "type" and shape, its keys checked against those of
+/// its type (`what` ends the message: " shape", " in \"geometry\" ...").
+SolidShape readTypedShape(const ObjectReader& r, const ShapeKeys& keys, const std::string& what) {
+  static const std::array<const char*, 4> types = {"box", "cylinder", "tube", "sphere"};
+  const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
+  for (std::size_t k = 0; k < types.size(); ++k) {
+    if (type == types[k]) r.allowOnly(*keys[k], " for a " + type + what);
+  }
+  return readSolidShape(r, type);
+}
 
 /// One shape of key "shape" of a spatial rigid body: {"type": "box" | "cylinder" | "tube" |
 /// "sphere", its dimensions, exactly one of "mass" or "density", optional "offset" and
 /// "orientation" in body axes}.
 ShapePart parseShapePart(const json& j, const std::string& where) {
   const ObjectReader r(j, where);
-  const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
-  static const std::array<const scenekeys::Keys*, 4> keys = {&scenekeys::kShapeBox, &scenekeys::kShapeCylinder,
-                                                             &scenekeys::kShapeTube, &scenekeys::kShapeSphere};
-  for (std::size_t k = 0; k < kShapeTypes.size(); ++k) {
-    if (type == kShapeTypes[k]) r.allowOnly(*keys[k], " for a " + type + " shape");
-  }
+  static const ShapeKeys keys = {&scenekeys::kShapeBox, &scenekeys::kShapeCylinder, &scenekeys::kShapeTube,
+                                 &scenekeys::kShapeSphere};
   ShapePart part;
-  part.shape = readSolidShape(r, type);
+  part.shape = readTypedShape(r, keys, " shape");
   if (r.has("mass") == r.has("density")) r.fail("give exactly one of \"mass\" or \"density\"");
   part.mass = r.has("mass") ? r.positive("mass") : 0.0;
   part.density = r.has("density") ? r.positive("density") : 0.0;
@@ -343,13 +351,9 @@ Mat3 parseOrientation(const json& j, const std::string& where) {
 std::vector<SolidShape> parseGeometry(const json& j, const std::string& where) {
   return readShapeList<SolidShape>(j, where, [](const json& v, const std::string& at) {
     const ObjectReader r(v, at);
-    const std::string type = readType(r, "shape", {"box", "cylinder", "tube", "sphere"});
-    static const std::array<const scenekeys::Keys*, 4> keys = {&scenekeys::kGeometryBox, &scenekeys::kGeometryCylinder,
-                                                               &scenekeys::kGeometryTube, &scenekeys::kGeometrySphere};
-    for (std::size_t k = 0; k < kShapeTypes.size(); ++k) {
-      if (type == kShapeTypes[k]) r.allowOnly(*keys[k], " for a " + type + " in \"geometry\" (viewing only: no mass)");
-    }
-    SolidShape s = readSolidShape(r, type);
+    static const ShapeKeys keys = {&scenekeys::kGeometryBox, &scenekeys::kGeometryCylinder,
+                                   &scenekeys::kGeometryTube, &scenekeys::kGeometrySphere};
+    SolidShape s = readTypedShape(r, keys, " in \"geometry\" (viewing only: no mass)");
     located(r.where(), [&] { return surfaceMesh(s); });  // the dimensions' checks
     return s;
   });
