@@ -11,6 +11,9 @@
 //   positionShape[k](l, (b l)) = int rho u0_k n_b dV = sum_a X_ak m_ab
 //   S_kl((a k), (b l))     = int rho n_a n_b dV    = m_ab              (S_kk = D_k M D_k)
 //   m_ff = S_xx + S_yy + S_zz = M,  K_ff = K (scaled).
+// A point mass m_p at node a is a lumped m_aa += m_p (M gains it in the node's three
+// diagonal entries), so every invariant above includes it; modal damping
+// D_ff = diag(2 zeta omega_i) with the mass-normalised modes (Geradin & Rixen, 2.3).
 // The cross terms (k != l) are not blocks of M (which is zero there): they need m_ab,
 // so the mass must have the solid element structure, checked below. Solid nodes carry
 // no rotation: rotation shapes zero, rKL and hI absent.
@@ -92,9 +95,25 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   if (!(options.stiffnessScale > 0.0) || !std::isfinite(options.stiffnessScale)) {
     throw InputError(owner_ + ": stiffness scale " + fmt(options.stiffnessScale) + "; expected a positive number");
   }
+  if (!(options.dampingRatio >= 0.0 && options.dampingRatio <= 1.0)) {
+    throw InputError(owner_ + ": damping ratio " + fmt(options.dampingRatio) + "; expected a number in [0, 1]");
+  }
   const int nn = d.numNodes(), nd = d.numDofs();
-  const SpMat m = nodeMass(d, owner_);
   const std::vector<int> dof = d.dofIndex();
+  SpMat m = nodeMass(d, owner_);
+  SpMat mass = d.mass;
+  for (const FePointMass& p : options.pointMasses) {
+    if (p.node < 0 || p.node >= nn) {
+      throw InputError(owner_ + ": a point mass at node index " + std::to_string(p.node) + "; the mesh has " +
+                       std::to_string(nn) + " nodes");
+    }
+    if (!(p.mass > 0.0) || !std::isfinite(p.mass)) {
+      throw InputError(owner_ + ": point mass " + fmt(p.mass) + " at node " + std::to_string(d.nodeIds[p.node]) +
+                       "; expected a positive mass");
+    }
+    m.coeffRef(p.node, p.node) += p.mass;  // lumped: m_aa += m_p
+    for (int k = 0; k < 3; ++k) mass.coeffRef(dof[3 * p.node + k], dof[3 * p.node + k]) += p.mass;
+  }
   MatX X(nn, 3);
   for (int a = 0; a < nn; ++a) X.row(a) = d.coordinates[a].transpose();
   const VecX m1 = m * VecX::Ones(nn);  // sum_a m_ab (m symmetric)
@@ -132,7 +151,7 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
       v.sKL[k][l].setFromTriplets(t.begin(), t.end());
     }
   }
-  v.mff = d.mass;
+  v.mff = mass;
   v.kff = options.stiffnessScale * d.stiffness;
   v.dff.resize(nd, nd);
   for (int a = 0; a < nn; ++a) {
@@ -146,6 +165,9 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
 
   basis_ = freeFreeModes(v.kff, v.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
   reduced_ = nodal_.transformed(basis_.sparseView());
+  if (options.dampingRatio > 0.0) {
+    reduced_.dff = SpMat(VecX(2.0 * options.dampingRatio * omega_).asDiagonal());  // D_ff = diag(2 zeta omega)
+  }
 }
 
 }  // namespace flexmbd

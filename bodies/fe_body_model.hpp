@@ -5,20 +5,31 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "bodies/fe_body_data.hpp"
 #include "bodies/ffr_invariants_3d.hpp"
 
 namespace flexmbd {
 
+/// A point mass lumped at a node of the mesh (an unbalance, a sensor, a bolt): added to
+/// the node's m_aa, so to its three diagonal entries of M, before the modes are computed.
+struct FePointMass {
+  int node = 0;       ///< index into FeBodyData::nodeIds (not the FE code's number)
+  double mass = 0.0;  ///< kg, > 0
+};
+
 struct FeBodyOptions {
   int modes = 8;                ///< free-free elastic modes kept (the six rigid ones dropped)
   double stiffnessScale = 1.0;  ///< K multiplied by it (EXUDYN's ScaleStiffnessMatrix; > 0)
+  double dampingRatio = 0.0;    ///< modal damping: D_ff = diag(2 zeta omega_i), in [0, 1]
+  std::vector<FePointMass> pointMasses;
 };
 
 class FeBodyModel {
  public:
-  /// @throws InputError naming `owner`: a mass matrix that couples directions or differs
+  /// @throws InputError naming `owner`: a point mass at no node or not positive, a damping
+  /// ratio outside [0, 1], a mass matrix that couples directions or differs
   /// between them (expected a solid element mass M(a k, b l) = delta_kl m_ab, to 1e-10 of
   /// its largest entry), a stiffness that does not vanish on the nodes' rigid motions
   /// (coordinates or DOF map not those of the matrices; to 1e-8), a bad scale or mode

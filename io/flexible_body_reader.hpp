@@ -15,7 +15,7 @@
 
 namespace flexmbd::scenereaders {
 
-/// The "type" (one of rigid, flexible, flexible_invariants) and "name" of a body object,
+/// The "type" (one of rigid, flexible, flexible_invariants, fe_body) and "name" of a body object,
 /// the name "ground" refused (reserved for the fixed ground body).
 std::pair<std::string, std::string> readBodyTypeAndName(jsonread::ObjectReader& r);
 

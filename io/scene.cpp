@@ -208,6 +208,7 @@ void parseBody(const json& j, const std::string& where, System& sys) {
   const auto [type, name] = scenereaders::readBodyTypeAndName(r);
   if (type == "flexible") return parseFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
+  if (type == "fe_body") r.fail("an fe_body (a solid FE mesh) is spatial: give the scene \"dimension\": 3");
   r.allowOnly(scenekeys::kRigidBody, " for a rigid body");
   RigidBodyProperties props;
   props.mass = r.positive("mass");
@@ -594,7 +595,7 @@ void checkSolverSettings(const SolverSettings& s) {
   }
 }
 
-Scene parseScene(const json& j) {
+Scene parseScene(const json& j, const std::string& baseDir) {
   ObjectReader top(j, "top level");
   top.allowOnly(scenekeys::kScene);
   Scene scene;
@@ -608,7 +609,7 @@ Scene parseScene(const json& j) {
   if (bodies.empty()) top.fail("key \"bodies\" must list at least one body");
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::string at = "bodies[" + std::to_string(i) + "]";
-    spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys) : parseBody(bodies[i], at, sys);
+    spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys, baseDir) : parseBody(bodies[i], at, sys);
     if (bodies[i].contains("geometry")) {  // a rigid body's (the readers refuse the key elsewhere)
       const BodyIndex b(sys.numBodies() - 1);
       scene.geometry.push_back({b, scenereaders::parseGeometry(bodies[i]["geometry"],
@@ -674,7 +675,8 @@ Scene parseSceneText(const std::string& text, const std::string& source) {
   }
   checkSceneKind(j, SceneKind::Multibody, source);
   try {
-    return parseScene(j);
+    // files a scene names (an fe_body's exports) are relative to the scene file's folder
+    return parseScene(j, std::filesystem::path(source).parent_path().string());
   } catch (const ModelError& e) {
     throw ModelError(source + ": " + e.what());
   } catch (const InputError& e) {

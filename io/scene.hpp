@@ -60,14 +60,16 @@ struct Scene {
 ///         nlohmann's byte position), or does not describe a valid scene.
 Scene loadScene(const std::string& path);
 
-/// Parses JSON text; `source` names the text in error messages (a file path).
+/// Parses JSON text; `source` names the text in error messages (a file path; the files
+/// the scene names are relative to its folder).
 /// A number too large for a double (1e999) is an InputError naming its location.
 Scene parseSceneText(const std::string& text, const std::string& source = "<scene>");
 
-/// Builds a scene from parsed JSON; the System is finalized at the end.
+/// Builds a scene from parsed JSON; the System is finalized at the end. Files the scene
+/// names (an fe_body's exports) are relative to `baseDir` ("": the working directory).
 /// @throws InputError (one line, starting with the location, e.g.
 ///         `bodies[1] ("rod"): key "mass" must be > 0, got -1`) on any invalid input.
-Scene parseScene(const nlohmann::json& j);
+Scene parseScene(const nlohmann::json& j, const std::string& baseDir = "");
 
 /// One output object of the scene format ("point", "deflection", "energy"; the keys of
 /// docs/scene-format.md, "Outputs") for `sys` (finalized or not); `earlier`: the outputs

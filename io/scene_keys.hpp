@@ -90,6 +90,12 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
                                    "r_yy",  "r_yz",         "r_zz",          "h_x",   "h_y",
                                    "h_z"};
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
+inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
+                               "angular_velocity", "abaqus",  "ansys",         "modes",           "stiffness_scale",
+                               "damping_ratio", "point_masses", "elastic_coordinates", "elastic_velocities"};
+inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
+inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
+inline const Keys kFePointMass = {"node", "mass"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames", "world"};
 inline const Keys kJointWorld = {"point", "axis", "x_axis", "orientation"};
@@ -175,6 +181,10 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"beam.3d", &kBeam3d},
       {"invariants.3d", &kInvariants3d},
       {"invariants.point.3d", &kInvariantsPoint3d},
+      {"body.fe_body.3d", &kFeBody3d},
+      {"fe.files.abaqus", &kFeFilesAbaqus},
+      {"fe.files.ansys", &kFeFilesAnsys},
+      {"fe.point_mass", &kFePointMass},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},
       {"joint.3d.prismatic", &kSpatialJoint},

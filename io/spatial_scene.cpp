@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
+#include "io/fe_body_reader.hpp"
 #include "io/scene_keys.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
@@ -234,6 +235,21 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
   located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
 }
 
+/// A body of "type": "fe_body": a solid mesh from an FE code's export, reduced to
+/// free-free modes on mean axes (FeBodyModel; docs/fe-import.md).
+void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const std::string& baseDir, System& sys) {
+  r.allowOnly(scenekeys::kFeBody3d, " for an fe_body in a spatial scene");
+  const FeBodyData data = readFeBodyFiles(r, baseDir);
+  const FeBodyOptions options = readFeBodyOptions(r, data);
+  FfrInvariants3d inv =
+      located(r.where(), [&] { return FeBodyModel(data, options, "body '" + name + "'").invariants(); });
+  const int nf = inv.numElastic();
+  const FrameState3d init = parseFrameState3d(r);
+  const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
+  const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
+  located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
+}
+
 /// The type, dimensions, "offset" and "orientation" of a shape (in "shape" and "geometry");
 /// the caller has checked the keys.
 SolidShape readSolidShape(const ObjectReader& r, const std::string& type) {
@@ -359,9 +375,10 @@ std::vector<SolidShape> parseGeometry(const json& j, const std::string& where) {
   });
 }
 
-void parseSpatialBody(const json& j, const std::string& where, System& sys) {
+void parseSpatialBody(const json& j, const std::string& where, System& sys, const std::string& baseDir) {
   ObjectReader r(j, where);
   const auto [type, name] = readBodyTypeAndName(r);
+  if (type == "fe_body") return parseSpatialFeBody(r, name, baseDir, sys);
   if (type == "flexible") return parseSpatialFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseSpatialInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");

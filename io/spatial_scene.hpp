@@ -34,7 +34,8 @@ SpringDamperLaw readSpringDamperLaw(const jsonread::ObjectReader& r, const std::
 /// orthonormal, determinant +1). Exactly one form.
 Mat3 parseOrientation(const nlohmann::json& j, const std::string& where);
 
-void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys);
+/// A body object; `baseDir`: the folder the files of an "fe_body" are relative to.
+void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys, const std::string& baseDir = "");
 /// Key "geometry" of a rigid body (planar or spatial): one shape or an array of them,
 /// placed in the body frame, for viewing only. @throws InputError starting with `where`.
 std::vector<SolidShape> parseGeometry(const nlohmann::json& j, const std::string& where);

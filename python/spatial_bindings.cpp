@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bindings_support.hpp"
+#include "bodies/fe_body_model.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
@@ -22,6 +23,8 @@
 #include "builders/spatial_builders.hpp"
 #include "core/magnitude_checks.hpp"
 #include "elements/beam_section.hpp"
+#include "io/fe_abaqus.hpp"
+#include "io/fe_ansys.hpp"
 #include "joints/world_frames.hpp"
 
 namespace flexmbd::pybind {
@@ -546,6 +549,50 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             v.validateSectionRotation(owner);
           },
           py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
+
+  // ----- bodies from FE codes (bodies/fe_body_model.hpp, io/fe_abaqus.hpp, io/fe_ansys.hpp) ----
+  py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
+      .def_property_readonly("num_nodes", &FeBodyData::numNodes)
+      .def_property_readonly("num_dofs", &FeBodyData::numDofs)
+      .def_readonly("node_ids", &FeBodyData::nodeIds, "the FE code's node numbers")
+      .def_readonly("coordinates", &FeBodyData::coordinates)
+      .def_readonly("node_sets", &FeBodyData::nodeSets, "node indices (not numbers), by set name")
+      .def_readonly("source", &FeBodyData::source);
+  m.def("read_abaqus_fe", &readAbaqusFe, py::arg("input"), py::arg("mass"), py::arg("stiffness"),
+        "An Abaqus export: the .inp and the *MATRIX GENERATE mass and stiffness (.mtx); InputError names the file "
+        "and line");
+  m.def(
+      "read_ansys_fe",
+      [](const std::string& coordinates, const std::string& elements, const std::string& dofMap,
+         const std::string& mass, const std::string& stiffness) {
+        return readAnsysFe(AnsysFeFiles{coordinates, elements, dofMap, mass, stiffness});
+      },
+      py::arg("coordinates"), py::arg("elements"), py::arg("dof_map"), py::arg("mass"), py::arg("stiffness"),
+      "An Ansys export (MatrixMarket matrices, DOF map, tables); InputError names the file and line");
+  py::class_<FeBodyModel, std::shared_ptr<FeBodyModel>>(m, "FeBodyModel",
+                                                        "An FE body reduced to free-free modes on mean axes")
+      .def(py::init([](const FeBodyData& data, const py::object& modes, const py::object& scale,
+                       const py::object& damping, const std::vector<std::pair<int, double>>& pointMasses,
+                       const std::string& owner) {
+             constexpr const char* fn = "FeBodyModel";
+             FeBodyOptions o;
+             o.modes = intArg(modes, fn, "modes");
+             o.stiffnessScale = positiveArg(scale, fn, "stiffness_scale");
+             o.dampingRatio = nonNegativeArg(damping, fn, "damping_ratio");
+             for (const auto& [id, mass] : pointMasses) {
+               const int a = data.nodeIndex(id);
+               if (a < 0) throw InputError(std::string(fn) + ": point_masses: no node " + std::to_string(id));
+               o.pointMasses.push_back({a, mass});
+             }
+             return std::make_shared<FeBodyModel>(data, o, owner);
+           }),
+           py::arg("data"), py::arg("modes") = 8, py::arg("stiffness_scale") = 1.0, py::arg("damping_ratio") = 0.0,
+           py::arg("point_masses") = std::vector<std::pair<int, double>>{}, py::arg("owner") = "FE body",
+           "point_masses: [(FE node number, kg), ...]")
+      .def_property_readonly(
+          "invariants", [](const FeBodyModel& mdl) { return mdl.invariants(); },
+          "A copy of the reduced invariants (FfrInvariants3d): add them with System.add_flexible_body_3d")
+      .def_property_readonly("natural_frequencies", &FeBodyModel::naturalFrequencies, "rad/s, the kept modes");
 
   // ----- the builders: methods of System ------------------------------------------------------
   system

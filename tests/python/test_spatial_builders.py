@@ -308,6 +308,42 @@ def test_a_body_of_given_invariants_is_the_body_of_its_beam_model():
         flexmbd.Scene("bad").system.add_flexible_body_3d("beam", inv)
 
 
+ROTOR = os.path.join(SOURCE, "..", "shared", "data", "exudyn-rotor")
+
+
+@pytest.mark.skipif(not os.path.exists(os.path.join(ROTOR, "rotorDiscTest.inp")), reason="no rotor data in ../shared")
+def test_an_fe_body_from_python_is_the_scene_body():
+    # EXUDYN's rotor from its Abaqus export: the first free-free frequency equals the
+    # published 104.63701326 Hz (1e-6, as tests/test_fe_import.cpp), and the body added from
+    # the model's invariants has the coordinates of the scene's fe_body of the same files
+    # (tests/test_fe_scene.cpp compares their invariants); errors name the node or file.
+    data = flexmbd.read_abaqus_fe(os.path.join(ROTOR, "rotorDiscTest.inp"),
+                                  os.path.join(ROTOR, "rotorDiscTestMASS1.mtx"),
+                                  os.path.join(ROTOR, "rotorDiscTestSTIF1.mtx"))
+    assert data.num_nodes == 115 and data.num_dofs == 345
+    model = flexmbd.FeBodyModel(data, modes=4, stiffness_scale=0.01, point_masses=[(10, 0.1)])
+    assert model.natural_frequencies[0] / (2 * math.pi) == pytest.approx(104.6, rel=5e-3)  # with the unbalance
+    plain = flexmbd.FeBodyModel(data, modes=4, stiffness_scale=0.01)
+    assert plain.natural_frequencies[0] / (2 * math.pi) == pytest.approx(104.63701326, rel=1e-6)
+    inv = model.invariants
+    assert inv.mass == pytest.approx(plain.invariants.mass + 0.1, rel=1e-13)
+    scene = flexmbd.Scene("rotor")
+    scene.system.add_flexible_body_3d("rotor", inv)
+    text = {"dimension": 3, "bodies": [{"type": "fe_body", "name": "rotor", "modes": 4, "stiffness_scale": 0.01,
+                                        "point_masses": [{"node": 10, "mass": 0.1}],
+                                        "abaqus": {"input": os.path.join(ROTOR, "rotorDiscTest.inp"),
+                                                   "mass": os.path.join(ROTOR, "rotorDiscTestMASS1.mtx"),
+                                                   "stiffness": os.path.join(ROTOR, "rotorDiscTestSTIF1.mtx")}}]}
+    from_scene = flexmbd.scene_from_dict(text)
+    scene.system.finalize()
+    assert from_scene.system.coordinate_names() == scene.system.coordinate_names()
+    assert len(scene.system.coordinate_names()) == 7 + 4
+    with pytest.raises(flexmbd.InputError, match="point_masses: no node 9999"):
+        flexmbd.FeBodyModel(data, point_masses=[(9999, 1.0)])
+    with pytest.raises(flexmbd.InputError, match="no_such.inp"):
+        flexmbd.read_abaqus_fe("no_such.inp", "m.mtx", "k.mtx")
+
+
 @pytest.mark.parametrize("call, error, words", [
     (lambda: flexmbd.FrameState3d(position="up"), TypeError, "FrameState3d: position must be 3 numbers"),
     (lambda: flexmbd.FrameState3d(orientation=[[1, 0, 0], [0, 2, 0], [0, 0, 1]]), flexmbd.InputError,

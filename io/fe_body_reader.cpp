@@ -1,0 +1,70 @@
+#include "io/fe_body_reader.hpp"
+
+#include <array>
+#include <filesystem>
+#include <limits>
+
+#include "io/fe_abaqus.hpp"
+#include "io/fe_ansys.hpp"
+#include "io/scene_keys.hpp"
+
+namespace flexmbd::scenereaders {
+
+using jsonread::json;
+using jsonread::ObjectReader;
+
+namespace {
+
+/// Key `key` of `files`: a file path, relative to `baseDir` unless absolute.
+std::string filePath(const ObjectReader& files, const std::string& key, const std::string& baseDir) {
+  const std::filesystem::path p(files.nonEmptyString(key));
+  if (p.is_absolute() || baseDir.empty()) return p.string();
+  return (std::filesystem::path(baseDir) / p).string();
+}
+
+}  // namespace
+
+FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
+  static const std::array<const char*, 2> kFormats = {"abaqus", "ansys"};
+  int given = 0;
+  for (const char* f : kFormats) given += r.has(f) ? 1 : 0;
+  if (given != 1) {
+    r.fail("give exactly one of \"abaqus\" {\"input\", \"mass\", \"stiffness\"} or \"ansys\" {\"coordinates\", "
+           "\"elements\", \"dof_map\", \"mass\", \"stiffness\"}: the files of the FE export");
+  }
+  if (r.has("abaqus")) {
+    const ObjectReader f(r.object("abaqus"), r.where() + ".abaqus");
+    f.allowOnly(scenekeys::kFeFilesAbaqus, " for Abaqus files");
+    return readAbaqusFe(filePath(f, "input", baseDir), filePath(f, "mass", baseDir), filePath(f, "stiffness", baseDir));
+  }
+  const ObjectReader f(r.object("ansys"), r.where() + ".ansys");
+  f.allowOnly(scenekeys::kFeFilesAnsys, " for Ansys files");
+  AnsysFeFiles files;
+  files.coordinates = filePath(f, "coordinates", baseDir);
+  files.elements = filePath(f, "elements", baseDir);
+  files.dofMap = filePath(f, "dof_map", baseDir);
+  files.mass = filePath(f, "mass", baseDir);
+  files.stiffness = filePath(f, "stiffness", baseDir);
+  return readAnsysFe(files);
+}
+
+FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
+  FeBodyOptions o;
+  o.modes = static_cast<int>(r.integer("modes", o.modes, 1));
+  o.stiffnessScale = r.positive("stiffness_scale", 1.0);
+  o.dampingRatio = r.nonNegative("damping_ratio", 0.0);
+  if (o.dampingRatio > 1.0) r.fail("key \"damping_ratio\" must be in [0, 1], got " + fmt(o.dampingRatio));
+  const json& masses = r.array("point_masses");
+  for (std::size_t k = 0; k < masses.size(); ++k) {
+    const ObjectReader p(masses[k], r.where() + ".point_masses[" + std::to_string(k) + "]");
+    p.allowOnly(scenekeys::kFePointMass, " for a point mass");
+    if (!p.has("node")) p.fail("missing required key \"node\" (the FE code's node number)");
+    const long id = p.integer("node", 0, std::numeric_limits<int>::min());
+    const int a = data.nodeIndex(static_cast<int>(id));
+    if (a < 0) p.fail("key \"node\": the mesh of " + data.source + " has no node " + std::to_string(id));
+    o.pointMasses.push_back({a, p.positive("mass")});
+  }
+  return o;
+}
+
+}  // namespace flexmbd::scenereaders
