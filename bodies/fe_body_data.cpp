@@ -15,4 +15,13 @@ std::vector<int> FeBodyData::dofIndex() const {
   return idx;
 }
 
+std::vector<int> FeBodyData::dofsOfNodes(const std::vector<int>& nodes) const {
+  const std::vector<int> idx = dofIndex();
+  std::vector<int> rows;
+  for (int a : nodes) {
+    for (int k = 0; k < 3; ++k) rows.push_back(idx.at(3 * static_cast<size_t>(a) + k));
+  }
+  return rows;
+}
+
 }  // namespace flexmbd

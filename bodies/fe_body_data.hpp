@@ -42,6 +42,9 @@ struct FeBodyData {
   int nodeIndex(int id) const;
   /// dofIndex()[3 a + k]: the row of node a's direction k.
   std::vector<int> dofIndex() const;
+  /// The rows of the DOF of `nodes` (indices into nodeIds; each node's x, y, z in turn),
+  /// e.g. the held DOF of clampedModes (bodies/modal_reduction.hpp).
+  std::vector<int> dofsOfNodes(const std::vector<int>& nodes) const;
 };
 
 }  // namespace flexmbd

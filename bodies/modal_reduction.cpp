@@ -59,6 +59,34 @@ MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, con
   return Phi;
 }
 
+namespace {
+
+/// The `nev` largest eigenvalues nu (descending) and their eigenvectors of A x = nu C x,
+/// A symmetric, C symmetric positive definite: Lanczos in the C-inner product (Spectra's
+/// SymGEigsSolver, Cholesky mode, on the sparse Cholesky factor of C; A only multiplied).
+/// @throws InputError naming `owner`: C not positive definite (`notDefinite` says why
+/// and what was expected), the solver not converging (`solver` names it).
+void largestOfPencil(const SpMat& A, const SpMat& C, int nev, const std::string& owner, const std::string& notDefinite,
+                     const std::string& solver, VecX& nu, MatX& X) {
+  const int n = static_cast<int>(A.rows());
+  Spectra::SparseCholesky<double> cop(C);
+  if (cop.info() != Spectra::CompInfo::Successful) throw InputError(owner + ": " + notDefinite);
+  Spectra::SparseSymMatProd<double> mop(A);
+  const int ncv = std::min(n, std::max(2 * nev + 1, 20));
+  Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>,
+                          Spectra::GEigsMode::Cholesky>
+      eigs(mop, cop, nev, ncv);
+  eigs.init();
+  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-13);
+  if (eigs.info() != Spectra::CompInfo::Successful) {
+    throw InputError(owner + ": the " + solver + " eigensolver (Spectra, shift-invert) did not converge");
+  }
+  nu = eigs.eigenvalues();
+  X = eigs.eigenvectors();
+}
+
+}  // namespace
+
 MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count, const std::string& owner,
                    VecX* omega, VecX* rigidEigenvalues) {
   const int n = static_cast<int>(K.rows());
@@ -70,25 +98,14 @@ MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count,
   // rigid eigenvalues' round-off (~1e-16 of it) and of the order of the lowest elastic
   // ones, so that the wanted nu are the largest and well separated.
   const double sigma = -1e-4 * std::abs(K.diagonal().sum() / M.diagonal().sum());
-  const SpMat C = K - sigma * M;
-  Spectra::SparseCholesky<double> cop(C);
-  if (cop.info() != Spectra::CompInfo::Successful) {
-    throw InputError(owner + ": K - sigma M is not positive definite at sigma = " + std::to_string(sigma) +
-                     "; expected a free-free stiffness (positive semi-definite) and a mass with positive total mass");
-  }
-  Spectra::SparseSymMatProd<double> mop(M);
   const int nev = count + 6;
-  const int ncv = std::min(n, std::max(2 * nev + 1, 20));
-  Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>,
-                          Spectra::GEigsMode::Cholesky>
-      eigs(mop, cop, nev, ncv);
-  eigs.init();
-  eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-13);
-  if (eigs.info() != Spectra::CompInfo::Successful) {
-    throw InputError(owner + ": the free-free eigensolver (Spectra, shift-invert) did not converge");
-  }
-  const VecX nu = eigs.eigenvalues();  // descending: lambda ascending where nu > 0
-  const MatX X = eigs.eigenvectors();
+  VecX nu;
+  MatX X;
+  largestOfPencil(M, K - sigma * M, nev, owner,
+                  "K - sigma M is not positive definite at sigma = " + std::to_string(sigma) +
+                      "; expected a free-free stiffness (positive semi-definite) and a mass with positive total mass",
+                  "free-free", nu, X);
+  // nu descending: lambda = sigma + 1 / nu ascending where nu > 0
   VecX lambda(nev);
   for (int i = 0; i < nev; ++i) {
     if (!(nu[i] > 0.0)) {
@@ -121,6 +138,60 @@ MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count,
   phi = llt.matrixU().solve<Eigen::OnTheRight>(phi);
   if (omega != nullptr) omega->resize(count);
   for (int i = 0; i < count && omega != nullptr; ++i) (*omega)[i] = std::sqrt(lambda[6 + i]);
+  return phi;
+}
+
+MatX clampedModes(const SpMat& K, const SpMat& M, const std::vector<int>& held, int count, const std::string& owner,
+                  VecX* omega) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<char> isHeld(n, 0);
+  for (int i : held) {
+    if (i < 0 || i >= n || isHeld[i]) {
+      throw InputError(owner + ": held DOF " + std::to_string(i) +
+                       " is out of range or given twice; expected distinct DOF from 0 to " + std::to_string(n - 1));
+    }
+    isHeld[i] = 1;
+  }
+  std::vector<int> freeDofs;  // the kept DOF, ascending; position in the clamped problem
+  std::vector<int> position(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (!isHeld[i]) {
+      position[i] = static_cast<int>(freeDofs.size());
+      freeDofs.push_back(i);
+    }
+  }
+  const int nf = static_cast<int>(freeDofs.size());
+  if (count < 1 || count >= nf) {
+    throw InputError(owner + ": " + std::to_string(count) + " clamped modes asked of " + std::to_string(nf) +
+                     " free DOF; expected 1 to " + std::to_string(nf - 1));
+  }
+  // K_ff, M_ff: the rows and columns of the free DOF (P^T K P, P the selection)
+  std::vector<Eigen::Triplet<double>> tp;
+  for (int i = 0; i < nf; ++i) tp.emplace_back(freeDofs[i], i, 1.0);
+  SpMat P(n, nf);
+  P.setFromTriplets(tp.begin(), tp.end());
+  const SpMat Kf = P.transpose() * K * P, Mf = P.transpose() * M * P;
+  // K_ff is positive definite once the supports hold every rigid motion: the shift
+  // sigma = 0 (C = K_ff) and M_ff phi = nu K_ff phi, nu = 1 / lambda; M_ff never factored
+  VecX nu;
+  MatX X;
+  largestOfPencil(Mf, Kf, count, owner,
+                  "the clamped stiffness K_ff is not positive definite; expected supports that hold every rigid "
+                  "motion of the body",
+                  "clamped", nu, X);
+  if (omega != nullptr) omega->resize(count);
+  MatX phi = MatX::Zero(n, count);
+  for (int j = 0; j < count; ++j) {
+    // nu > 0: a mode of positive mass (phi^T M phi = nu phi^T K phi); the negative-mass
+    // modes of an indefinite M have nu < 0 and come last
+    if (!(nu[j] > 0.0)) {
+      throw InputError(owner + ": only " + std::to_string(j) + " clamped modes of positive mass; expected " +
+                       std::to_string(count));
+    }
+    const VecX x = X.col(j) / std::sqrt(X.col(j).dot(Mf * X.col(j)));  // mass-normalised
+    for (int i = 0; i < nf; ++i) phi(freeDofs[i], j) = x[i];
+    if (omega != nullptr) (*omega)[j] = std::sqrt(1.0 / nu[j]);  // lambda = 1 / nu
+  }
   return phi;
 }
 

@@ -58,6 +58,20 @@ MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, con
 MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count, const std::string& owner,
                    VecX* omega = nullptr, VecX* rigidEigenvalues = nullptr);
 
+/// The clamped normal modes of a body of stiffness K and mass M (n x n, symmetric; M not
+/// necessarily positive definite, as freeFreeModes) with the DOF `held` (0-based rows)
+/// removed: K_ff phi = lambda M_ff phi over the other DOF, the lowest `count` with lambda
+/// > 0. K_ff is positive definite when the held DOF stop every rigid motion, so the shift
+/// is sigma = 0: M_ff phi = nu K_ff phi, nu = 1 / lambda, the largest nu by the Lanczos of
+/// freeFreeModes (M never factored; the negative-mass modes of an indefinite M have nu < 0
+/// and are not among them). Returns n x count, zero at the held DOF, mass-normalised
+/// (phi^T M phi = I); `omega` receives the frequencies (rad/s), ascending.
+/// @throws InputError naming `owner`: a held DOF out of range or given twice, count < 1 or
+/// count >= the free DOF, K_ff not positive definite (a rigid motion left free), the
+/// solver not converging, fewer than `count` modes of positive mass.
+MatX clampedModes(const SpMat& K, const SpMat& M, const std::vector<int>& held, int count, const std::string& owner,
+                  VecX* omega = nullptr);
+
 /// The interface conditions G x of a body whose nodal coordinates (`nodeDofs` per node,
 /// node k's at nodeDofs k .. nodeDofs k + nodeDofs - 1) are q_n = B2 x: the rows of B2
 /// of every coordinate of the `nodes` (node order, then coordinate order). `dofs`

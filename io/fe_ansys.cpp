@@ -11,15 +11,6 @@ using namespace feread;
 
 namespace {
 
-/// The whitespace-separated fields of a line (tabs, blanks; runs count as one).
-std::vector<std::string> words(const std::string& line) {
-  std::vector<std::string> out;
-  for (const std::string& s : splitFields(line, " \t")) {
-    if (!s.empty()) out.push_back(s);
-  }
-  return out;
-}
-
 /// A table with one header line (its first field not a number): the data lines' fields.
 template <class Row>
 void readTable(TextFile& f, const std::string& what, Row row) {

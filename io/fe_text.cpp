@@ -91,6 +91,11 @@ SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, Symmetri
                        " is above the diagonal; expected the lower triangle only (row >= column) of a "
                        "MatrixMarket symmetric matrix");
     }
+    if (storage == SymmetricStorage::Upper && e.row > e.col) {
+      throw InputError(where(e.line) + "entry " + pos(e.row, e.col) +
+                       " is below the diagonal; expected the upper triangle only (row <= column), as CalculiX "
+                       "stores a symmetric matrix");
+    }
     const auto ins = stored.emplace(std::make_pair(e.row, e.col), &e);
     if (!ins.second) {
       throw InputError(where(e.line) + "entry " + pos(e.row, e.col) + " is given twice (first on line " +
@@ -102,7 +107,7 @@ SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, Symmetri
   t.reserve(2 * entries.size());
   for (const MatrixEntry& e : entries) {
     t.emplace_back(e.row, e.col, e.value);
-    if (storage == SymmetricStorage::Lower) {
+    if (storage != SymmetricStorage::Both) {
       if (e.row != e.col) t.emplace_back(e.col, e.row, e.value);
       continue;
     }
@@ -118,6 +123,39 @@ SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, Symmetri
   SpMat A(n, n);
   A.setFromTriplets(t.begin(), t.end());
   return A;
+}
+
+std::vector<std::string> words(const std::string& line) {
+  std::vector<std::string> out;
+  for (const std::string& s : splitFields(line, " \t")) {
+    if (!s.empty()) out.push_back(s);
+  }
+  return out;
+}
+
+SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage storage, const std::string& dofWhat) {
+  TextFile f(path);
+  std::vector<MatrixEntry> entries;
+  std::string line;
+  while (f.next(line)) {
+    const std::string t = trimmed(line);
+    if (t.empty()) continue;
+    std::vector<std::string> fields;
+    for (const std::string& s : splitFields(t, " \t,")) {
+      if (!s.empty()) fields.push_back(s);
+    }
+    if (fields.size() != 3)
+      f.fail("the line has " + std::to_string(fields.size()) + " fields; expected 'row column value'");
+    const long r = integerField(f, fields[0], "the row"), c = integerField(f, fields[1], "the column");
+    if (r < 1 || c < 1 || r > n || c > n) {
+      f.fail("entry (" + fields[0] + ", " + fields[1] + ") is outside the " + std::to_string(n) + " DOF " + dofWhat +
+             "; expected row and column from 1 to " + std::to_string(n));
+    }
+    entries.push_back(
+        {static_cast<int>(r - 1), static_cast<int>(c - 1), realField(f, fields[2], "the value"), f.lineNumber()});
+  }
+  if (entries.empty()) throw InputError(path + ": no matrix entries; expected lines 'row column value'");
+  return assembleSymmetric(entries, n, storage, path);
 }
 
 void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::string& stiffnessPath) {

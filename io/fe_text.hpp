@@ -63,13 +63,27 @@ struct MatrixEntry {
 enum class SymmetricStorage {
   Both,   ///< both triangles (Abaqus .mtx): checked A_ij = A_ji to kSymmetryTolerance
   Lower,  ///< the lower triangle only (MatrixMarket "symmetric"): row >= column required
+  Upper,  ///< the upper triangle only (CalculiX .sti, .mas): row <= column required
 };
 
 /// The n x n symmetric matrix of `entries`, both triangles stored.
 /// @throws InputError naming `path`, the line and what was expected: an entry outside
-/// n x n, an entry given twice, an upper entry in Lower storage, A_ij != A_ji (Both).
+/// n x n, an entry given twice, an upper entry in Lower storage (a lower one in Upper),
+/// A_ij != A_ji (Both).
 SpMat assembleSymmetric(const std::vector<MatrixEntry>& entries, int n, SymmetricStorage storage,
                         const std::string& path);
+
+/// The n x n symmetric matrix of the file `path` of lines "row column value" (1-based,
+/// blanks, tabs or commas between; blank lines skipped): Abaqus .mtx (Both), CalculiX
+/// .sti and .mas (Upper). `dofWhat` says where the n DOF come from, for the messages
+/// ("of the nodes (3 per node)").
+/// @throws InputError naming the file, the line and what was expected: a line of other
+/// than 3 fields, a row or column that is not an integer from 1 to n, a value that is not
+/// a finite real, no entries, and assembleSymmetric's errors.
+SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage storage, const std::string& dofWhat);
+
+/// The fields of a line separated by blanks or tabs (runs count as one), none empty.
+std::vector<std::string> words(const std::string& line);
 
 /// The checks every reader ends with: one row per (node, direction), each once, matrices
 /// numDofs() x numDofs(), every DOF with a positive stiffness diagonal (else a node outside

@@ -1,0 +1,23 @@
+// The mesh part of an input deck in the Abaqus keyword format, which Abaqus and CalculiX
+// share (io/fe_abaqus.hpp, io/fe_calculix.hpp): *Node, *Element (solid types), *Nset.
+// docs/fe-import.md.
+#pragma once
+
+#include <string>
+
+#include "bodies/fe_body_data.hpp"
+
+namespace flexmbd::feread {
+
+/// The nodes (ascending label order), elements and node sets of the deck `path`; no DOF
+/// map and no matrices. Keywords and parameter names are case-insensitive. Nodes: every
+/// *Node line "label, x, y, z" (labels unique); *Element, type=C3D4/C3D6/C3D8/C3D10/
+/// C3D15/C3D20 (with suffixes R, I, H, M, T: e.g. C3D20R) lines "label, n1, ..."
+/// (continued on the next lines until the type's node count); *Nset, nset=NAME
+/// [, generate] (also *Node, nset=); *Include is refused (not followed); other keywords
+/// and their data are skipped.
+/// @throws InputError naming the file, the line and what was expected: a malformed line,
+/// an unknown element type, a node used but not defined, a label given twice, no nodes.
+FeBodyData readInpMesh(const std::string& path);
+
+}  // namespace flexmbd::feread

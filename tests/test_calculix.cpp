@@ -1,0 +1,500 @@
+// CalculiX import (docs/fe-import.md, "CalculiX"): the readers of io/fe_calculix.hpp and
+// the clamped modes of bodies/modal_reduction.hpp against ccx itself. The test meshes a
+// steel bar (1 x 0.1 x 0.1 m, 10 x 2 x 2 C3D20R bricks, 321 nodes) and runs `ccx` three
+// times in a temporary folder (skipped without ccx on PATH):
+//  - clamped (*BOUNDARY on the x = 0 face, *FREQUENCY): its frequencies and mode shapes
+//    (.frd) against the clamped modes of the imported free matrices, the shapes as
+//    eigenvectors of the imported K and M;
+//  - free (*FREQUENCY, no boundary): its elastic frequencies against FeBodyModel's
+//    free-free ones;
+//  - the matrices (*FREQUENCY, SOLVER=MATRIXSTORAGE: .sti, .mas, .dof), read here; their
+//    total mass against rho V.
+// Then every strictness check of the readers on small broken files written here.
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bodies/fe_body_model.hpp"
+#include "bodies/modal_reduction.hpp"
+#include "core/errors.hpp"
+#include "io/fe_calculix.hpp"
+#include "test_support.hpp"
+
+using namespace flexmbd;
+using namespace flexmbd::testsupport;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kE = 2.1e11, kNu = 0.3, kRho = 7850.0;
+constexpr double kLength = 1.0, kWidth = 0.1, kHeight = 0.1;
+constexpr int kNx = 10, kNy = 2, kNz = 2;
+constexpr int kClampedModes = 8;  // compared; ccx is asked for 10
+constexpr int kFreeModes = 8;     // elastic ones compared; ccx is asked for 6 + 8
+
+/// The mesh part of the deck: 20-node bricks on a (2 kNx + 1) (2 kNy + 1) (2 kNz + 1)
+/// grid of points, a point a node if at most one of its indices is odd (corners and edge
+/// midpoints), numbered 1 + its grid index (so with gaps). Keywords in mixed case, as ccx
+/// accepts them. Node set FIX: the x = 0 face.
+std::string barMesh() {
+  const int gx = 2 * kNx + 1, gy = 2 * kNy + 1, gz = 2 * kNz + 1;
+  const auto id = [&](int i, int j, int k) { return 1 + i + gx * (j + gy * k); };
+  std::ostringstream s;
+  s.precision(17);
+  s << "*Heading\nsteel bar, C3D20R\n*NODE, nset=Nall\n";
+  std::vector<int> fixed;
+  for (int k = 0; k < gz; ++k) {
+    for (int j = 0; j < gy; ++j) {
+      for (int i = 0; i < gx; ++i) {
+        if (i % 2 + j % 2 + k % 2 > 1) continue;
+        s << id(i, j, k) << ", " << kLength * i / (gx - 1) << ", " << kWidth * j / (gy - 1) << ", "
+          << kHeight * k / (gz - 1) << "\n";
+        if (i == 0) fixed.push_back(id(i, j, k));
+      }
+    }
+  }
+  // C3D20 node order: corners (bottom face counter-clockwise, then top), midpoints of the
+  // bottom edges, of the top edges, of the vertical edges
+  static const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                   {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  static const int edge[12][2] = {{0, 1}, {1, 2}, {2, 3}, {3, 0}, {4, 5}, {5, 6},
+                                  {6, 7}, {7, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+  s << "*Element, TYPE=C3D20R, ELSET=Eall\n";
+  int label = 0;
+  for (int ez = 0; ez < kNz; ++ez) {
+    for (int ey = 0; ey < kNy; ++ey) {
+      for (int ex = 0; ex < kNx; ++ex) {
+        std::array<std::array<int, 3>, 8> c;
+        for (int a = 0; a < 8; ++a) c[a] = {2 * (ex + corner[a][0]), 2 * (ey + corner[a][1]), 2 * (ez + corner[a][2])};
+        std::vector<int> n;
+        for (int a = 0; a < 8; ++a) n.push_back(id(c[a][0], c[a][1], c[a][2]));
+        for (const auto& e : edge) {
+          n.push_back(id((c[e[0]][0] + c[e[1]][0]) / 2, (c[e[0]][1] + c[e[1]][1]) / 2, (c[e[0]][2] + c[e[1]][2]) / 2));
+        }
+        s << ++label;
+        for (int a = 0; a < 20; ++a) s << (a == 15 ? ",\n" : ", ") << n[a];  // 16 entries on the first line
+        s << "\n";
+      }
+    }
+  }
+  s << "*nset, NSET=FIX\n";
+  for (size_t a = 0; a < fixed.size(); ++a) s << fixed[a] << (a % 8 == 7 || a + 1 == fixed.size() ? "\n" : ", ");
+  s << "*MATERIAL, NAME=STEEL\n*ELASTIC\n"
+    << kE << ", " << kNu << "\n*DENSITY\n"
+    << kRho << "\n*SOLID SECTION, ELSET=Eall, MATERIAL=STEEL\n";
+  return s.str();
+}
+
+/// The folder of the three ccx runs, made once for all tests of the suite.
+class CalculixBar : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (std::system("command -v ccx > /dev/null 2>&1") != 0) {
+      skip_ = "ccx (CalculiX, Debian package calculix-ccx: scripts/setup.sh) is not on PATH";
+      return;
+    }
+    dir_ = fs::temp_directory_path() /
+           ("flexmbd_ccx_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()));
+    fs::create_directories(dir_);
+    const std::string mesh = barMesh();
+    const std::map<std::string, std::string> steps = {
+        {"clamped", "*BOUNDARY\nFIX, 1, 3\n*STEP\n*FREQUENCY\n10\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n"},
+        {"free", "*STEP\n*FREQUENCY\n14\n*NODE FILE\nU\n*END STEP\n"},
+        {"matrices", "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n"}};
+    for (const auto& [job, step] : steps) {
+      std::ofstream((dir_ / (job + ".inp")).string()) << mesh << step;
+      const std::string cmd =
+          "cd '" + dir_.string() + "' && OMP_NUM_THREADS=1 ccx -i " + job + " > " + job + ".log 2>&1";
+      if (std::system(cmd.c_str()) != 0) {
+        error_ = "ccx failed on " + job + ".inp: see " + (dir_ / (job + ".log")).string();
+        return;
+      }
+    }
+  }
+  static void TearDownTestSuite() {
+    if (!dir_.empty() && error_.empty()) fs::remove_all(dir_);
+  }
+  void SetUp() override {
+    if (!skip_.empty()) GTEST_SKIP() << skip_;
+    ASSERT_TRUE(error_.empty()) << error_;
+  }
+  static std::string job(const std::string& name) { return (dir_ / name).string(); }
+  static FeBodyData bar() { return readCalculixFe(CalculixFeFiles::ofJob(job("matrices"))); }
+
+  static fs::path dir_;
+  static std::string skip_, error_;
+};
+
+fs::path CalculixBar::dir_;
+std::string CalculixBar::skip_, CalculixBar::error_;
+
+/// The frequencies (Hz) of a frequency analysis' steps, in order.
+std::vector<double> frequencies(const FrdResults& r) {
+  std::vector<double> f;
+  for (const FrdStep& s : r.steps) f.push_back(s.value);
+  return f;
+}
+
+/// The sum of |A_ij| over the x-direction rows and columns of a body's matrix.
+double absSumX(const FeBodyData& d, const SpMat& A) {
+  double s = 0.0;
+  for (int j = 0; j < A.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(A, j); it; ++it) {
+      if (d.dofs[it.row()].direction == 0 && d.dofs[j].direction == 0) s += std::abs(it.value());
+    }
+  }
+  return s;
+}
+
+/// The free DOF (not of `held`), ascending.
+std::vector<int> freeDofs(int n, const std::vector<int>& held) {
+  std::vector<char> h(n, 0);
+  for (int i : held) h[i] = 1;
+  std::vector<int> out;
+  for (int i = 0; i < n; ++i) {
+    if (!h[i]) out.push_back(i);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_F(CalculixBar, MatricesAreReadAndHoldTheBarsMass) {
+  const FeBodyData d = bar();
+  EXPECT_EQ(d.numNodes(), 321);  // (21 x 5 x 5) grid points less those with two or three odd indices
+  EXPECT_EQ(d.numDofs(), 963);
+  ASSERT_EQ(d.elements.size(), 40u);
+  EXPECT_EQ(d.elements[0].type, "C3D20R");
+  EXPECT_EQ(d.nodeSets.at("FIX").size(), 21u);  // the 5 x 5 face less its 4 face-centre points
+  // total mass r_x^T M r_x = int rho (sum_a n_a)^2 dV = rho V for any quadrature exact
+  // for constants (C3D20R's reduced 2 x 2 x 2 rule is). The .mas prints 14 significant
+  // digits (relative 5e-14 per entry): the sum errs by at most 5e-14 sum |M_ij| (x block).
+  const double m = VecX::Ones(d.numDofs()).dot(d.mass * VecX::Ones(d.numDofs())) / 3.0;
+  const double rhoV = kRho * kLength * kWidth * kHeight;
+  const double printed = 5e-14 * absSumX(d, d.mass);
+  EXPECT_NEAR(m, rhoV, printed + 1e-15 * rhoV);
+  const FeBodyModel model(d, FeBodyOptions{}, "bar");
+  EXPECT_NEAR(model.invariants().mass, rhoV, printed + 1e-15 * rhoV);
+  // the finding of issue 27: the stored C3D20R mass is indefinite. Its LDL^T (a congruence,
+  // Sylvester's law of inertia) counts the negative eigenvalues; a Cholesky factor fails.
+  const Eigen::SimplicialLDLT<SpMat> ldlt(d.mass);
+  ASSERT_EQ(ldlt.info(), Eigen::Success);
+  const int negative = static_cast<int>((ldlt.vectorD().array() < 0.0).count());
+  EXPECT_GT(negative, 0);
+  EXPECT_NE(Eigen::SimplicialLLT<SpMat>(d.mass).info(), Eigen::Success);
+  std::printf(
+      "[ figures ] C3D20R bar: mass %.14g kg (rho V %.14g, rel. %.1e, print bound %.1e); M has %d negative of %d "
+      "eigenvalues\n",
+      m, rhoV, m / rhoV - 1.0, printed / rhoV, negative, d.numDofs());
+}
+
+TEST_F(CalculixBar, ClampedFrequenciesEqualCcxs) {
+  const FeBodyData d = bar();
+  VecX omega;
+  const std::vector<int> held = d.dofsOfNodes(d.nodeSets.at("FIX"));
+  const MatX phi = clampedModes(d.stiffness, d.mass, held, kClampedModes, "bar", &omega);
+  const std::vector<double> ccx = frequencies(readCalculixFrd(job("clamped.frd")));
+  ASSERT_GE(ccx.size(), static_cast<size_t>(kClampedModes));
+  // ccx prints each frequency to 10 significant digits (5e-10 relative) and its Lanczos
+  // (ARPACK) agrees with itself to ~2e-9 on the degenerate pairs of the square section;
+  // ours converges to 1e-13: 1e-6 relative (the brief's bound) holds with a margin of 1e2.
+  constexpr double kSameFrequency = 1e-6;
+  double worst = 0.0;
+  std::printf("[ figures ] clamped bar, Hz (ccx | imported | rel. error):");
+  for (int i = 0; i < kClampedModes; ++i) {
+    ASSERT_GT(ccx[i], 0.0) << "ccx mode " << i + 1 << " of negative eigenvalue";
+    const double f = omega[i] / (2.0 * kPi), e = f / ccx[i] - 1.0;
+    EXPECT_NEAR(f / ccx[i], 1.0, kSameFrequency) << "mode " << i + 1;
+    worst = std::max(worst, std::abs(e));
+    std::printf(" %.10g | %.10g | %.1e;", ccx[i], f, e);
+  }
+  std::printf(" worst %.1e\n", worst);
+  // mass-normalised and zero at the clamped DOF
+  EXPECT_LT((phi.transpose() * (d.mass * phi) - MatX::Identity(kClampedModes, kClampedModes)).cwiseAbs().maxCoeff(),
+            1e-10);
+  for (int i : held) EXPECT_EQ(phi.row(i).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST_F(CalculixBar, FreeFreeFrequenciesEqualCcxs) {
+  FeBodyOptions o;
+  o.modes = kFreeModes;
+  const FeBodyModel model(bar(), o, "bar");
+  const std::vector<double> ccx = frequencies(readCalculixFrd(job("free.frd")));
+  ASSERT_EQ(ccx.size(), 6u + kFreeModes);
+  // ccx's six rigid modes: its round-off, below 1e-5 of the first elastic frequency
+  for (int i = 0; i < 6; ++i) EXPECT_LT(ccx[i], 1e-5 * ccx[6]) << "ccx rigid mode " << i + 1;
+  constexpr double kSameFrequency = 1e-6;  // as the clamped frequencies
+  double worst = 0.0;
+  std::printf("[ figures ] free-free bar, Hz (ccx | imported | rel. error):");
+  for (int i = 0; i < kFreeModes; ++i) {
+    const double f = model.naturalFrequencies()[i] / (2.0 * kPi), e = f / ccx[6 + i] - 1.0;
+    EXPECT_NEAR(f / ccx[6 + i], 1.0, kSameFrequency) << "elastic mode " << i + 1;
+    worst = std::max(worst, std::abs(e));
+    std::printf(" %.10g | %.10g | %.1e;", ccx[6 + i], f, e);
+  }
+  std::printf(" worst %.1e\n", worst);
+}
+
+TEST_F(CalculixBar, FrdModeShapesAreEigenvectorsOfTheImportedMatrices) {
+  const FeBodyData d = bar();
+  const FrdResults r = readCalculixFrd(job("clamped.frd"));
+  EXPECT_EQ(r.nodes.size(), 321u);
+  ASSERT_GE(r.steps.size(), static_cast<size_t>(kClampedModes));
+  const std::vector<int> held = d.dofsOfNodes(d.nodeSets.at("FIX"));
+  const std::vector<int> fr = freeDofs(d.numDofs(), held);
+  const int nf = static_cast<int>(fr.size());
+  std::vector<Eigen::Triplet<double>> tp;
+  for (int i = 0; i < nf; ++i) tp.emplace_back(fr[i], i, 1.0);
+  SpMat P(d.numDofs(), nf);
+  P.setFromTriplets(tp.begin(), tp.end());
+  const SpMat K = P.transpose() * d.stiffness * P, M = P.transpose() * d.mass * P;
+  const SpMat Ka = K.cwiseAbs(), Ma = M.cwiseAbs();
+  // The .frd prints E12.5, 6 significant digits: each printed u_i = u*_i (1 + e_i), |e_i|
+  // <= 5e-6. With (K - lambda M) u* = 0, the residual of the printed shape is (K - lambda
+  // M) (u - u*), componentwise at most kRound (|K| + lambda |M|) |u|; lambda, from the
+  // 10-digit frequency (1e-9) of ccx's Lanczos (its degenerate pairs differ by 4e-9 in
+  // lambda), adds at most 1e-8 lambda |M| |u|. The generalized mass
+  // u^T M u = 1 (ccx mass-normalises) to 2 kRound |u|^T |M| |u|.
+  constexpr double kRound = 5e-6;
+  double worstRatio = 0.0;
+  for (int m = 0; m < kClampedModes; ++m) {
+    const FrdStep& s = r.steps[m];
+    EXPECT_EQ(s.mode, m + 1);
+    EXPECT_EQ(s.number, m + 1);
+    EXPECT_EQ(s.type, 2);  // frequency
+    EXPECT_EQ(s.analysis, "MODAL");
+    ASSERT_EQ(s.blocks.count("DISP"), 1u);
+    const FrdBlock& disp = s.blocks.at("DISP");
+    EXPECT_EQ(disp.components, (std::vector<std::string>{"D1", "D2", "D3"}));  // ALL: computed by the viewer
+    ASSERT_EQ(s.blocks.count("STRESS"), 1u);
+    EXPECT_EQ(s.blocks.at("STRESS").components, (std::vector<std::string>{"SXX", "SYY", "SZZ", "SXY", "SYZ", "SZX"}));
+    EXPECT_EQ(s.blocks.at("STRESS").values.size(), 321u);
+    VecX u(d.numDofs());
+    for (int i = 0; i < d.numDofs(); ++i) u[i] = disp.values.at(d.nodeIds[d.dofs[i].node]).at(d.dofs[i].direction);
+    for (int i : held) EXPECT_EQ(u[i], 0.0);
+    const VecX uf = P.transpose() * u, ua = uf.cwiseAbs();
+    const double lambda = std::pow(2.0 * kPi * s.value, 2);
+    const VecX residual = K * uf - lambda * (M * uf);
+    const VecX bound = kRound * (Ka * ua + lambda * (Ma * ua)) + 1e-8 * lambda * (Ma * ua);
+    const double ratio = residual.norm() / bound.norm();
+    EXPECT_LE(ratio, 1.0) << "mode " << m + 1;
+    worstRatio = std::max(worstRatio, ratio);
+    EXPECT_NEAR(uf.dot(M * uf), 1.0, 2.0 * kRound * ua.dot(Ma * ua)) << "mode " << m + 1;
+  }
+  std::printf("[ figures ] .frd mode shapes: |K u - lambda M u| <= %.2f of the printing bound (worst of %d)\n",
+              worstRatio, kClampedModes);
+}
+
+// ----- strictness of the readers, on small files written here -----------------------------
+
+namespace {
+
+class CalculixFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("flexmbd_ccxfiles_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const std::string p = (dir_ / name).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  /// One C3D8 brick, nodes 11..18 (lower case keywords), its node set by GENERATE.
+  static std::string deck() {
+    return "*node, NSET=all\n11, 0., 0., 0.\n12, 1., 0., 0.\n13, 1., 1., 0.\n14, 0., 1., 0.\n"
+           "15, 0., 0., 1.\n16, 1., 0., 1.\n17, 1., 1., 1.\n18, 0., 1., 1.\n"
+           "*element, type=C3D8R, elset=E\n1, 11, 12, 13, 14, 15, 16, 17, 18\n"
+           "*Nset, nset=top, generate\n15, 18\n*boundary\ntop, 1, 3\n";
+  }
+  /// The .dof of the brick's 24 equations, in node order, `extra` lines appended.
+  static std::string dofText(const std::string& extra = "") {
+    std::string s;
+    for (int n = 11; n <= 18; ++n) {
+      for (int k = 1; k <= 3; ++k) s += std::to_string(n) + "." + std::to_string(k) + "\n";
+    }
+    return s + extra;
+  }
+  /// A diagonal 24 x 24 matrix, upper triangle, `extra` lines appended.
+  static std::string matrixText(double diag, const std::string& extra = "") {
+    std::string s;
+    for (int i = 1; i <= 24; ++i) s += std::to_string(i) + " " + std::to_string(i) + "  " + std::to_string(diag) + "\n";
+    return s + extra;
+  }
+  CalculixFeFiles files(const std::string& dof = dofText(), const std::string& sti = matrixText(5.0, "1 2 0.5\n"),
+                        const std::string& mas = matrixText(2.0)) {
+    return {write("job.inp", deck()), write("job.sti", sti), write("job.mas", mas), write("job.dof", dof)};
+  }
+  template <class F>
+  std::string errorOf(F f) {
+    try {
+      f();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << "expected InputError";
+    return "";
+  }
+  fs::path dir_;
+};
+
+void expectMentions(const std::string& msg, std::initializer_list<std::string> parts) {
+  for (const std::string& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
+}
+
+}  // namespace
+
+TEST_F(CalculixFiles, SmallBodyIsRead) {
+  const FeBodyData d = readCalculixFe(files(dofText()));
+  EXPECT_EQ(d.numNodes(), 8);
+  EXPECT_EQ(d.nodeIds[d.dofs[3].node], 12);
+  EXPECT_EQ(d.dofs[5].direction, 2);
+  EXPECT_EQ(d.stiffness.coeff(0, 1), 0.5);  // the upper triangle mirrored
+  EXPECT_EQ(d.stiffness.coeff(1, 0), 0.5);
+  EXPECT_EQ(d.nodeSets.at("top"), (std::vector<int>{4, 5, 6, 7}));  // generate 15..18
+  EXPECT_EQ(d.elements.at(0).type, "C3D8R");
+  // the .dof's order rules: equations of node 18 first
+  std::string reversed;
+  for (int n = 18; n >= 11; --n) {
+    for (int k = 1; k <= 3; ++k) reversed += std::to_string(n) + "." + std::to_string(k) + "\n";
+  }
+  const FeBodyData r = readCalculixFe(files(reversed));
+  EXPECT_EQ(r.nodeIds[r.dofs[0].node], 18);
+  EXPECT_EQ(r.dofsOfNodes({7}), (std::vector<int>{0, 1, 2}));
+}
+
+TEST_F(CalculixFiles, MalformedOrUnknownDofEntries) {
+  CalculixFeFiles f = files(dofText("12x3\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.dofs, "line 25", "'12x3'", "expected 'node.direction'"});
+  f = files(dofText("12.3.1\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {"line 25", "expected 'node.direction'"});
+  f = files(dofText("19.1\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.dofs, "line 25", "node 19 is not defined in", f.inp});
+  f = files(dofText("12.4\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {"line 25", "direction 4", "expected 1, 2 or 3"});
+  f = files(dofText("12.2\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {"line 25", "given twice (first on line 5)"});
+  // a node's direction missing: matrices of a deck with *BOUNDARY
+  std::string held = dofText();
+  held.erase(0, held.find("12.1"));
+  f = files(held);
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.dofs, "node 11 direction 1 has no equation", "*BOUNDARY"});
+}
+
+TEST_F(CalculixFiles, MatrixEntriesOutsideTheTriangleOrTheDofs) {
+  CalculixFeFiles f = files(dofText(), matrixText(5.0, "2 1 0.5\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }),
+                 {f.stiffness, "line 25", "entry (2, 1) is below the diagonal", "row <= column"});
+  f = files(dofText(), matrixText(5.0), matrixText(2.0, "25 25 1.0\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }),
+                 {f.mass, "line 25", "outside the 24 DOF of " + f.dofs, "expected row and column from 1 to 24"});
+  f = files(dofText(), matrixText(5.0, "3 3 1.0\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.stiffness, "line 25", "given twice (first on line 3)"});
+  f = files(dofText(), matrixText(5.0, "1 2\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {"line 25", "2 fields", "expected 'row column value'"});
+  f = files(dofText(), matrixText(5.0, "1 2 0.5q\n"));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {"line 25", "'0.5q'", "expected a finite real number"});
+  // a DOF without stiffness, a non-positive mass (feread::checkBodyData)
+  f = files(dofText(), matrixText(5.0, "").substr(0, matrixText(5.0).find("24 24")));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.stiffness, "row 24 (node 18, direction z)"});
+  f = files(dofText(), matrixText(5.0), matrixText(-1.0));
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.mass, "expected a positive mass"});
+}
+
+TEST_F(CalculixFiles, DeckStrictness) {
+  CalculixFeFiles f = files();
+  write("job.inp", "*NODE\n1, 0., 0., 0.\n*INCLUDE, INPUT=mesh.inp\n");
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 3", "*INCLUDE is not followed"});
+  write("job.inp", "*NODE\n1, 0., 0.\n");
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 2", "expected 'label, x, y, z'"});
+  write("job.inp", deck() +
+                       "*ELEMENT, TYPE=C3D20R\n2, 11, 12, 13, 14, 15, 16, 17, 18, 11, 12, 13, 14, 15, 16, 17,\n"
+                       "18, 11, 12, 19, 20\n");
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 17", "element 2 names node 19"});
+  write("job.inp", "*NODE\n1, 0., 0., 0.\n*ELEMENT, TYPE=S8R\n1, 1, 1, 1, 1, 1, 1, 1, 1\n");
+  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 3", "'S8R'"});
+}
+
+namespace {
+
+/// A .frd of two nodes and one DISP block (as ccx writes them, long format); the pieces
+/// can be replaced to break it.
+std::string frdText(const std::string& dataLine2 = " -1         7 4.00000E-01-5.00000E-01 6.00000E+00",
+                    const std::string& end = " 9999\n", const std::string& count = "2") {
+  return "    1C\n    1UUSER\n    2C                             2                                     1\n"
+         " -1         5 0.00000E+00 0.00000E+00 0.00000E+00\n"
+         " -1         7 1.00000E+00 0.00000E+00 0.00000E+00\n -3\n"
+         "    1PMODE                         1\n"
+         "  100CL  101 12.34567890" +
+         std::string(12 - count.size(), ' ') + count +
+         "                     2    1MODAL      1\n"
+         " -4  DISP        4    1\n -5  D1          1    2    1    0\n -5  D2          1    2    2    0\n"
+         " -5  D3          1    2    3    0\n -5  ALL         1    2    0    0    1ALL\n"
+         " -1         5 1.00000E-01 2.00000E-01-3.00000E-01\n" +
+         dataLine2 + "\n -3\n" + end;
+}
+
+}  // namespace
+
+TEST_F(CalculixFiles, FrdIsReadStrictly) {
+  const FrdResults r = readCalculixFrd(write("a.frd", frdText()));
+  ASSERT_EQ(r.steps.size(), 1u);
+  EXPECT_EQ(r.steps[0].value, 12.3456789);
+  EXPECT_EQ(r.steps[0].mode, 1);
+  EXPECT_EQ(r.steps[0].analysis, "MODAL");
+  EXPECT_EQ(r.nodes.at(7).x(), 1.0);
+  EXPECT_EQ(r.steps[0].blocks.at("DISP").values.at(5), (std::vector<double>{0.1, 0.2, -0.3}));
+  EXPECT_EQ(r.steps[0].blocks.at("DISP").values.at(7)[1], -0.5);  // fields without a blank between
+
+  std::string p = write("b.frd", frdText(" -1         7 4.00000E-01-5.0000XE-01 6.00000E+00"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 15", "D2 of node 7", "'-5.0000XE-01'"});
+  p = write("c.frd", frdText(" -1         9 4.00000E-01-5.00000E-01 6.00000E+00"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 15", "node 9", "node block (2C) lacks"});
+  p = write("d.frd", frdText(" -1         7 4.00000E-01-5.00000E-01"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 15", "2 values; expected 3"});
+  p = write("e.frd", frdText(" -1         5 4.00000E-01-5.00000E-01 6.00000E+00"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 15", "node 5 is given twice"});
+  p = write("f.frd", frdText(" -1         7 4.00000E-01-5.00000E-01 6.00000E+00", ""));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "without '9999'"});
+  p = write("g.frd", frdText(" -1         7 4.00000E-01-5.00000E-01 6.00000E+00", " 9999\n", "3"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 8", "announces 3 nodes, the block has 2"});
+  p = write("h.frd", frdText(" -1         7 4.00000E-01-5.00000E-01 6.00000E+00 1.00000E+00"));
+  expectMentions(errorOf([&] { readCalculixFrd(p); }), {p, "line 15", "more than the 3 values"});
+}
+
+TEST(CalculixModes, ClampedModesRefuseAFreeBodyAndBadArguments) {
+  // a chain of three unit masses and two unit springs, not held: K singular
+  SpMat K(3, 3), M(3, 3);
+  K.insert(0, 0) = 1.0;
+  K.insert(0, 1) = -1.0;
+  K.insert(1, 0) = -1.0;
+  K.insert(1, 1) = 2.0;
+  K.insert(1, 2) = -1.0;
+  K.insert(2, 1) = -1.0;
+  K.insert(2, 2) = 1.0;
+  for (int i = 0; i < 3; ++i) M.insert(i, i) = 1.0;
+  try {
+    clampedModes(K, M, {}, 1, "chain");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not positive definite"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(clampedModes(K, M, {3}, 1, "chain"), InputError);
+  EXPECT_THROW(clampedModes(K, M, {0, 0}, 1, "chain"), InputError);
+  EXPECT_THROW(clampedModes(K, M, {0}, 2, "chain"), InputError);
+}
