@@ -19,11 +19,13 @@
 // no rotation: rotation shapes zero, rKL and hI absent.
 #include "bodies/fe_body_model.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
 #include "bodies/modal_reduction.hpp"
+#include "core/rotation_3d.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 
@@ -75,6 +77,93 @@ SpMat nodeMass(const FeBodyData& d, const std::string& owner) {
   return m;
 }
 
+/// The set's centroid, relative positions and H = sum (|r|^2 1 - r r^T) (Mat3 inverse).
+struct NodeSetGeometry {
+  Vec3 centroid = Vec3::Zero();
+  std::vector<Vec3> r;
+  Mat3 Hinv = Mat3::Zero();
+};
+
+/// @throws InputError naming `owner` and the interface: fewer than 3 nodes, a node out of
+/// range or twice, the nodes on one line.
+NodeSetGeometry nodeSetGeometry(const FeBodyData& d, const FeInterface& f, const std::string& owner) {
+  const std::string who = owner + ": interface '" + f.name + "'";
+  if (f.nodes.size() < 3) throw InputError(who + " has " + std::to_string(f.nodes.size()) + " nodes; expected at least 3 not on one line");
+  std::vector<char> seen(d.numNodes(), 0);
+  NodeSetGeometry g;
+  for (int a : f.nodes) {
+    if (a < 0 || a >= d.numNodes()) throw InputError(who + ": node index " + std::to_string(a) + " is not in the mesh");
+    if (seen[a]++) throw InputError(who + ": node " + std::to_string(d.nodeIds[a]) + " is given twice");
+    g.centroid += d.coordinates[a];
+  }
+  g.centroid /= static_cast<double>(f.nodes.size());
+  Mat3 H = Mat3::Zero();
+  double size = 0.0;
+  for (int a : f.nodes) {
+    g.r.push_back(d.coordinates[a] - g.centroid);
+    const Vec3& r = g.r.back();
+    H += r.squaredNorm() * Mat3::Identity() - r * r.transpose();  // int r~^T r~
+    size = std::max(size, r.squaredNorm());
+  }
+  // collinear nodes: H has a zero eigenvalue (rotation about the line); 1e-10 of the largest
+  // |r|^2 n is round-off of the coordinates, not a thin set
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(H);
+  if (!(eig.eigenvalues()[0] > 1e-10 * size * static_cast<double>(f.nodes.size()))) {
+    throw InputError(who + ": its nodes lie on one line; the rotation about it is undefined (expected at least 3 "
+                     "nodes not on one line)");
+  }
+  g.Hinv = H.inverse();
+  return g;
+}
+
+/// The rigid interfaces' map q_nodal = T q (q: the DOF not in a rigid set, in matrix order,
+/// then 6 per rigid interface, u_I then theta_I): u_a = u_I + theta_I x r_a, r_a = X_a - X_I.
+/// `masters[k]`: interface k's first column (-1 for averaging ones).
+SpMat rigidInterfaceMap(const FeBodyData& d, const FeBodyOptions& o, const std::vector<NodeSetGeometry>& geo,
+                        std::vector<int>& masters, const std::string& owner) {
+  const int nd = d.numDofs();
+  const std::vector<int> dof = d.dofIndex();
+  std::vector<int> slaveOf(d.numNodes(), -1);
+  for (std::size_t k = 0; k < o.interfaces.size(); ++k) {
+    if (o.interfaces[k].kind != FeInterfaceKind::Rigid) continue;
+    for (int a : o.interfaces[k].nodes) {
+      if (slaveOf[a] >= 0) {
+        throw InputError(owner + ": node " + std::to_string(d.nodeIds[a]) + " is in the rigid interfaces '" +
+                         o.interfaces[slaveOf[a]].name + "' and '" + o.interfaces[k].name +
+                         "'; a node can follow one rigid interface only");
+      }
+      slaveOf[a] = static_cast<int>(k);
+    }
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  int col = 0;
+  for (int i = 0; i < nd; ++i) {
+    if (slaveOf[d.dofs[i].node] < 0) t.emplace_back(i, col++, 1.0);
+  }
+  masters.assign(o.interfaces.size(), -1);
+  for (std::size_t k = 0; k < o.interfaces.size(); ++k) {
+    const FeInterface& f = o.interfaces[k];
+    if (f.kind != FeInterfaceKind::Rigid) continue;
+    masters[k] = col;
+    const Vec3 XI = f.atCentroid ? geo[k].centroid : f.point;
+    for (int a : f.nodes) {
+      const Vec3 r = d.coordinates[a] - XI;
+      for (int c = 0; c < 3; ++c) {
+        const int row = dof[3 * a + c];
+        t.emplace_back(row, col + c, 1.0);  // u_I
+        for (int j = 0; j < 3; ++j) {
+          const double v = Vec3::Unit(j).cross(r)[c];  // theta_j e_j x r_a
+          if (v != 0.0) t.emplace_back(row, col + 3 + j, v);
+        }
+      }
+    }
+    col += 6;
+  }
+  SpMat T(nd, col);
+  T.setFromTriplets(t.begin(), t.end());
+  return T;
+}
+
 }  // namespace
 
 MatX FeBodyModel::rigidBodyModes(const FeBodyData& d) {
@@ -88,6 +177,61 @@ MatX FeBodyModel::rigidBodyModes(const FeBodyData& d) {
     }
   }
   return R;
+}
+
+void FeBodyModel::addInterfaces(const FeBodyData& d, const FeBodyOptions& o, MatX& R) {
+  std::vector<NodeSetGeometry> geo;
+  for (const FeInterface& f : o.interfaces) geo.push_back(nodeSetGeometry(d, f, owner_));
+  std::vector<int> masters;
+  map_ = rigidInterfaceMap(d, o, geo, masters, owner_);
+  firstInterface_ = d.numNodes();
+  if (map_.cols() != map_.rows()) {
+    // condensed: every invariant (points included) through T; the rigid motions too, the
+    // frames' rows from their own u_I = t + theta x X_I, theta_I = theta
+    nodal_ = nodal_.transformed(map_);
+    MatX Rc = MatX::Zero(map_.cols(), 6);
+    int firstMaster = static_cast<int>(map_.cols());
+    for (int c : masters) {
+      if (c >= 0) firstMaster = std::min(firstMaster, c);
+    }
+    for (int j = 0; j < firstMaster; ++j) {  // a DOF kept as it is: its own rows of R
+      Rc.row(j) = R.row(SpMat::InnerIterator(map_, j).row());
+    }
+    for (std::size_t k = 0; k < masters.size(); ++k) {
+      if (masters[k] < 0) continue;
+      const Vec3 XI = o.interfaces[k].atCentroid ? geo[k].centroid : o.interfaces[k].point;
+      for (int j = 0; j < 3; ++j) {
+        Rc.block<3, 1>(masters[k], j) = Vec3::Unit(j);                      // translation: u_I = e_j
+        Rc.block<3, 1>(masters[k], 3 + j) = Vec3::Unit(j).cross(XI);        // rotation: u_I = e_j x X_I
+        Rc(masters[k] + 3 + j, 3 + j) = 1.0;                                // theta_I = e_j
+      }
+    }
+    R = Rc;
+  }
+  for (std::size_t k = 0; k < o.interfaces.size(); ++k) {
+    const FeInterface& f = o.interfaces[k];
+    const Vec3 XI = f.atCentroid ? geo[k].centroid : f.point;
+    FfrPoint3d p;
+    p.position = XI;
+    const int n = static_cast<int>(nodal_.mff.rows());
+    p.shape = Mat3X::Zero(3, n);
+    p.rotationShape = Mat3X::Zero(3, n);
+    if (f.kind == FeInterfaceKind::Rigid) {
+      for (int c = 0; c < 3; ++c) {
+        p.shape(c, masters[k] + c) = 1.0;
+        p.rotationShape(c, masters[k] + 3 + c) = 1.0;
+      }
+    } else {
+      // RBE3: u_c = mean N_a, theta = H^-1 sum r_a x (N_a q), u_I = u_c + theta x (X_I - X_c)
+      for (std::size_t i = 0; i < f.nodes.size(); ++i) {
+        const Mat3X& Na = nodal_.points[f.nodes[i]].shape;
+        p.shape += Na / static_cast<double>(f.nodes.size());
+        p.rotationShape += geo[k].Hinv * (skew(geo[k].r[i]) * Na);
+      }
+      p.shape -= skew(XI - geo[k].centroid) * p.rotationShape;  // theta x d = -d~ theta
+    }
+    nodal_.points.push_back(std::move(p));
+  }
 }
 
 FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std::string owner)
@@ -122,7 +266,7 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   // the rigid motions of the nodes must be the stiffness's null space: coordinates and DOF
   // map are those of the matrices (measured 6e-16 and 3e-13 for the rotor's two exports)
   constexpr double kRigidTolerance = 1e-8;
-  const MatX R = rigidBodyModes(d);
+  MatX R = rigidBodyModes(d);
   const double kr = (d.stiffness * R).cwiseAbs().maxCoeff() / (maxAbsOf(d.stiffness) * R.cwiseAbs().maxCoeff());
   if (kr > kRigidTolerance) {
     throw InputError(owner_ + ": the stiffness of " + d.source +
@@ -163,7 +307,8 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
     v.points.push_back(std::move(p));
   }
 
-  basis_ = freeFreeModes(v.kff, v.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
+  addInterfaces(d, options, R);
+  basis_ = freeFreeModes(nodal_.kff, nodal_.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
   reduced_ = nodal_.transformed(basis_.sparseView());
   if (options.dampingRatio > 0.0) {
     reduced_.dff = SpMat(VecX(2.0 * options.dampingRatio * omega_).asDiagonal());  // D_ff = diag(2 zeta omega)

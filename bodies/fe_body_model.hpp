@@ -19,11 +19,31 @@ struct FePointMass {
   double mass = 0.0;  ///< kg, > 0
 };
 
+/// An interface frame over a node set (docs/fe-import.md, "Interfaces"): a point with a
+/// translation and a small rotation of its own, where joints and forces attach.
+///  - Rigid (RBE2): the set moves rigidly with the frame, u_a = u_I + theta_I x (X_a - X_I);
+///    the set's 3 n DOF are replaced by the frame's 6 before the modes are computed (the
+///    interface stiffens the body).
+///  - Averaging (RBE3): the frame carries the set's mean translation and least-squares
+///    rotation, u_c = sum u_a / n, theta_I = H^-1 sum r_a x u_a with r_a = X_a - X_c,
+///    H = sum (|r_a|^2 1 - r_a r_a^T), and u_I = u_c + theta_I x (X_I - X_c); adds no
+///    stiffness or mass.
+/// The set must not lie on one line (H singular: the rotation about the line undefined).
+enum class FeInterfaceKind { Rigid, Averaging };
+struct FeInterface {
+  std::string name;
+  std::vector<int> nodes;  ///< indices into FeBodyData::nodeIds, at least 3, not collinear
+  FeInterfaceKind kind = FeInterfaceKind::Averaging;
+  bool atCentroid = true;   ///< the frame's point X_I: the set's centroid X_c, or `point`
+  Vec3 point = Vec3::Zero();
+};
+
 struct FeBodyOptions {
   int modes = 8;                ///< free-free elastic modes kept (the six rigid ones dropped)
   double stiffnessScale = 1.0;  ///< K multiplied by it (EXUDYN's ScaleStiffnessMatrix; > 0)
   double dampingRatio = 0.0;    ///< modal damping: D_ff = diag(2 zeta omega_i), in [0, 1]
   std::vector<FePointMass> pointMasses;
+  std::vector<FeInterface> interfaces;  ///< their points follow the nodes' in the invariants
 };
 
 class FeBodyModel {
@@ -36,12 +56,17 @@ class FeBodyModel {
   /// count, or the eigensolver's errors (freeFreeModes).
   FeBodyModel(const FeBodyData& data, const FeBodyOptions& options, std::string owner);
 
-  /// The invariants in all 3 N nodal DOF (matrix order), no reference conditions: K_ff
-  /// singular (six rigid modes), so not a body by itself.
+  /// The invariants in the nodal DOF (matrix order; a rigid interface's set replaced by its
+  /// frame's 6 DOF, appended), no reference conditions: K_ff singular (six rigid modes), so
+  /// not a body by itself. Points: the nodes (in node order), then the interfaces.
   const FfrInvariants3d& nodalInvariants() const { return nodal_; }
+  /// The map from those DOF to the matrices' 3 N (identity without rigid interfaces).
+  const SpMat& nodalMap() const { return map_; }
+  /// The index of interface `k` among the invariants' points (numNodes + k).
+  int interfacePoint(int k) const { return firstInterface_ + k; }
   /// The invariants in the free-free modal coordinates (m_ff = I, K_ff = diag(omega^2)).
   const FfrInvariants3d& invariants() const { return reduced_; }
-  /// The modes (3 N x modes, columns M-normalised, M-orthogonal to the rigid motions).
+  /// The modes (nodal DOF x modes, columns M-normalised, M-orthogonal to the rigid motions).
   const MatX& basis() const { return basis_; }
   /// Their natural frequencies, rad/s.
   const VecX& naturalFrequencies() const { return omega_; }
@@ -53,8 +78,14 @@ class FeBodyModel {
   static MatX rigidBodyModes(const FeBodyData& data);
 
  private:
+  /// The interfaces (FeInterface): the rigid ones' condensation of nodal_ (map_, and the
+  /// rigid motions `R` into the condensed DOF), then every interface's point appended.
+  void addInterfaces(const FeBodyData& d, const FeBodyOptions& options, MatX& R);
+
   std::string owner_;
   FfrInvariants3d nodal_, reduced_;
+  SpMat map_;
+  int firstInterface_ = 0;
   MatX basis_;
   VecX omega_, rigidEigenvalues_;
 };

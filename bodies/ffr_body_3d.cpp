@@ -675,7 +675,9 @@ void FfrBody3d::pointKinematics(const ConstVecRef&, const Vec2&, int, const std:
 int FfrBody3d::resolvePoint(const Vec3& point, const std::string& user) const {
   double scale = 1.0;
   for (const auto& p : inv_.points) scale = std::max(scale, p.position.norm());
-  for (size_t k = 0; k < inv_.points.size(); ++k) {
+  // from the last: an FE body's interface frames follow its nodes and take precedence over
+  // a node at the same place (docs/fe-import.md, "Interfaces")
+  for (size_t k = inv_.points.size(); k-- > 0;) {
     if ((inv_.points[k].position - point).norm() <= 1e-9 * scale) return static_cast<int>(k);
   }
   std::ostringstream os;

@@ -6,10 +6,12 @@
 
 #include "io/fe_abaqus.hpp"
 #include "io/fe_ansys.hpp"
+#include "io/fe_calculix.hpp"
 #include "io/scene_keys.hpp"
 
 namespace flexmbd::scenereaders {
 
+using jsonread::inQuotes;
 using jsonread::json;
 using jsonread::ObjectReader;
 
@@ -25,17 +27,22 @@ std::string filePath(const ObjectReader& files, const std::string& key, const st
 }  // namespace
 
 FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
-  static const std::array<const char*, 2> kFormats = {"abaqus", "ansys"};
+  static const std::array<const char*, 3> kFormats = {"abaqus", "ansys", "calculix"};
   int given = 0;
   for (const char* f : kFormats) given += r.has(f) ? 1 : 0;
   if (given != 1) {
-    r.fail("give exactly one of \"abaqus\" {\"input\", \"mass\", \"stiffness\"} or \"ansys\" {\"coordinates\", "
-           "\"elements\", \"dof_map\", \"mass\", \"stiffness\"}: the files of the FE export");
+    r.fail("give exactly one of \"abaqus\" {\"input\", \"mass\", \"stiffness\"}, \"ansys\" {\"coordinates\", "
+           "\"elements\", \"dof_map\", \"mass\", \"stiffness\"} or \"calculix\" {\"job\"}: the files of the FE export");
   }
   if (r.has("abaqus")) {
     const ObjectReader f(r.object("abaqus"), r.where() + ".abaqus");
     f.allowOnly(scenekeys::kFeFilesAbaqus, " for Abaqus files");
     return readAbaqusFe(filePath(f, "input", baseDir), filePath(f, "mass", baseDir), filePath(f, "stiffness", baseDir));
+  }
+  if (r.has("calculix")) {
+    const ObjectReader f(r.object("calculix"), r.where() + ".calculix");
+    f.allowOnly(scenekeys::kFeFilesCalculix, " for CalculiX files");
+    return readCalculixFe(CalculixFeFiles::ofJob(filePath(f, "job", baseDir)));
   }
   const ObjectReader f(r.object("ansys"), r.where() + ".ansys");
   f.allowOnly(scenekeys::kFeFilesAnsys, " for Ansys files");
@@ -63,6 +70,46 @@ FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
     const int a = data.nodeIndex(static_cast<int>(id));
     if (a < 0) p.fail("key \"node\": the mesh of " + data.source + " has no node " + std::to_string(id));
     o.pointMasses.push_back({a, p.positive("mass")});
+  }
+  const json& interfaces = r.array("interfaces");
+  for (std::size_t k = 0; k < interfaces.size(); ++k) {
+    const ObjectReader f(interfaces[k], r.where() + ".interfaces[" + std::to_string(k) + "]");
+    f.allowOnly(scenekeys::kFeInterface, " for an interface");
+    FeInterface i;
+    i.name = f.name("name");
+    const std::string kind = f.string("kind", "averaging");
+    if (kind != "rigid" && kind != "averaging") {
+      f.fail("key \"kind\" must be \"rigid\" (RBE2: the nodes move rigidly with the frame) or \"averaging\" "
+             "(RBE3: the frame follows their mean motion), got " + inQuotes(kind));
+    }
+    i.kind = kind == "rigid" ? FeInterfaceKind::Rigid : FeInterfaceKind::Averaging;
+    if (f.has("nodes") == f.has("node_set")) {
+      f.fail("give exactly one of \"nodes\" [FE node numbers] or \"node_set\" (a node set of the export)");
+    }
+    if (f.has("node_set")) {
+      const std::string set = f.nonEmptyString("node_set");
+      const auto it = data.nodeSets.find(set);
+      if (it == data.nodeSets.end()) {
+        std::string known;
+        for (const auto& [n, nodes] : data.nodeSets) known += (known.empty() ? "" : ", ") + n;
+        f.fail("key \"node_set\": " + data.source + " has no node set " + inQuotes(set) + " (it has: " +
+               (known.empty() ? std::string("none") : known) + ")");
+      }
+      i.nodes = it->second;
+    } else {
+      const json& ids = f.requiredArray("nodes");
+      for (std::size_t n = 0; n < ids.size(); ++n) {
+        const int id = f.index(ids[n], "nodes[" + std::to_string(n) + "]");
+        const int a = data.nodeIndex(id);
+        if (a < 0) f.fail("key \"nodes\": the mesh of " + data.source + " has no node " + std::to_string(id));
+        i.nodes.push_back(a);
+      }
+    }
+    if (f.has("point")) {
+      i.atCentroid = false;
+      i.point = f.vector("point", 3);
+    }
+    o.interfaces.push_back(std::move(i));
   }
   return o;
 }

@@ -1,6 +1,6 @@
 // The scene object of a flexible body imported from a finite element code ("type":
 // "fe_body", docs/scene-format.md "FE bodies"; docs/fe-import.md): which export to read
-// ("abaqus" or "ansys" files, relative to the scene file's folder), and the reduction
+// ("abaqus", "ansys" or "calculix" files, relative to the scene file's folder), and the reduction
 // options of FeBodyModel (modes, stiffness scale, modal damping, point masses).
 #pragma once
 
@@ -11,13 +11,15 @@
 
 namespace flexmbd::scenereaders {
 
-/// The FE data of the body object `r` (exactly one of the keys "abaqus", "ansys"), each
+/// The FE data of the body object `r` (exactly one of the keys "abaqus", "ansys",
+/// "calculix"), each
 /// file path relative to `baseDir` unless absolute.
 /// @throws InputError naming the key, or the file and line (the readers).
 FeBodyData readFeBodyFiles(const jsonread::ObjectReader& r, const std::string& baseDir);
 
 /// The options of `r`: "modes", "stiffness_scale", "damping_ratio", "point_masses"
-/// [{"node": FE node number, "mass": kg}, ...] (nodes of `data`).
+/// [{"node": FE node number, "mass": kg}, ...], "interfaces" [{"name", "kind": "rigid" |
+/// "averaging", "nodes": [numbers] or "node_set": name, "point"}, ...] (nodes of `data`).
 /// @throws InputError naming the key.
 FeBodyOptions readFeBodyOptions(const jsonread::ObjectReader& r, const FeBodyData& data);
 

@@ -91,11 +91,13 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
                                    "h_z"};
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
-                               "angular_velocity", "abaqus",  "ansys",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "elastic_coordinates", "elastic_velocities"};
+                               "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
+                               "damping_ratio", "point_masses", "interfaces", "elastic_coordinates", "elastic_velocities"};
 inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
+inline const Keys kFeFilesCalculix = {"job"};
 inline const Keys kFePointMass = {"node", "mass"};
+inline const Keys kFeInterface = {"name", "kind", "nodes", "node_set", "point"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
 inline const Keys kSpatialJoint = {"name", "type", "bodies", "frames", "world"};
 inline const Keys kJointWorld = {"point", "axis", "x_axis", "orientation"};
@@ -184,7 +186,9 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"body.fe_body.3d", &kFeBody3d},
       {"fe.files.abaqus", &kFeFilesAbaqus},
       {"fe.files.ansys", &kFeFilesAnsys},
+      {"fe.files.calculix", &kFeFilesCalculix},
       {"fe.point_mass", &kFePointMass},
+      {"fe.interface", &kFeInterface},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},
       {"joint.3d.prismatic", &kSpatialJoint},

@@ -25,15 +25,20 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "bodies/fe_body_model.hpp"
+#include "bodies/ffr_body_3d.hpp"
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "io/fe_calculix.hpp"
+#include "io/scene.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::testsupport;
 namespace fs = std::filesystem;
+using json = nlohmann::json;
 
 namespace {
 
@@ -245,6 +250,22 @@ TEST_F(CalculixBar, FreeFreeFrequenciesEqualCcxs) {
     std::printf(" %.10g | %.10g | %.1e;", ccx[6 + i], f, e);
   }
   std::printf(" worst %.1e\n", worst);
+}
+
+TEST_F(CalculixBar, SceneBodyOfTheJobIsTheModelsBody) {
+  // "type": "fe_body" with "calculix": {"job"} relative to the scene's folder: the same
+  // first frequency as the model built from the files (one code path: equal to the bit),
+  // and so ccx's free-free frequency to the tolerance of the test above.
+  const json scene = {{"dimension", 3},
+                      {"bodies",
+                       {{{"type", "fe_body"}, {"name", "bar"}, {"calculix", {{"job", "matrices"}}}, {"modes", 2}}}}};
+  const Scene s = parseSceneText(scene.dump(), job("scene.json"));
+  const auto& body = dynamic_cast<const FfrBody3d&>(s.system.body(BodyIndex(1)));
+  FeBodyOptions o;
+  o.modes = 2;
+  const FeBodyModel model(bar(), o, "bar");
+  EXPECT_EQ(body.invariants().kff.coeff(0, 0), model.invariants().kff.coeff(0, 0));
+  EXPECT_EQ(body.invariants().mass, model.invariants().mass);
 }
 
 TEST_F(CalculixBar, FrdModeShapesAreEigenvectorsOfTheImportedMatrices) {
