@@ -21,6 +21,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
 
@@ -182,7 +183,7 @@ MatX FeBodyModel::rigidBodyModes(const FeBodyData& d) {
 void FeBodyModel::addInterfaces(const FeBodyData& d, const FeBodyOptions& o, MatX& R) {
   std::vector<NodeSetGeometry> geo;
   for (const FeInterface& f : o.interfaces) geo.push_back(nodeSetGeometry(d, f, owner_));
-  std::vector<int> masters;
+  std::vector<int>& masters = masterColumn_;
   map_ = rigidInterfaceMap(d, o, geo, masters, owner_);
   firstInterface_ = d.numNodes();
   if (map_.cols() != map_.rows()) {
@@ -308,11 +309,78 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   }
 
   addInterfaces(d, options, R);
-  basis_ = freeFreeModes(nodal_.kff, nodal_.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
+  if (options.reduction == FeReduction::CraigBampton) {
+    reduceCraigBampton(options);
+  } else {
+    basis_ = freeFreeModes(nodal_.kff, nodal_.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
+  }
   reduced_ = nodal_.transformed(basis_.sparseView());
   if (options.dampingRatio > 0.0) {
-    reduced_.dff = SpMat(VecX(2.0 * options.dampingRatio * omega_).asDiagonal());  // D_ff = diag(2 zeta omega)
+    // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes, the
+    // last `modes` coordinates; none on constraint modes (Geradin & Rixen, 2.3)
+    const int nm = static_cast<int>(omega_.size()), nb = static_cast<int>(basis_.cols()) - nm;
+    std::vector<Eigen::Triplet<double>> t;
+    for (int i = 0; i < nm; ++i) t.emplace_back(nb + i, nb + i, 2.0 * options.dampingRatio * omega_[i]);
+    reduced_.dff.resize(basis_.cols(), basis_.cols());
+    reduced_.dff.setFromTriplets(t.begin(), t.end());
   }
+}
+
+void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
+  int ref = -1;
+  std::string names;
+  for (std::size_t k = 0; k < o.interfaces.size(); ++k) {
+    if (o.interfaces[k].name == o.reference) ref = static_cast<int>(k);
+    if (o.interfaces[k].kind == FeInterfaceKind::Rigid) names += (names.empty() ? "'" : ", '") + o.interfaces[k].name + "'";
+  }
+  if (ref < 0 || masterColumn_[ref] < 0) {
+    throw InputError(owner_ + ": Craig-Bampton needs the reference to be a rigid interface the frame follows; '" +
+                     o.reference + "' is " + (ref < 0 ? "not an interface" : "an averaging interface") +
+                     " (rigid interfaces: " + (names.empty() ? std::string("none") : names) + ")");
+  }
+  const int n = static_cast<int>(nodal_.kff.rows());
+  std::vector<int> held, boundary;
+  for (int c = 0; c < 6; ++c) held.push_back(masterColumn_[ref] + c);
+  for (std::size_t k = 0; k < masterColumn_.size(); ++k) {
+    if (static_cast<int>(k) == ref || masterColumn_[k] < 0) continue;
+    for (int c = 0; c < 6; ++c) boundary.push_back(masterColumn_[k] + c);
+  }
+  // fixed-interface modes: every rigid interface held
+  std::vector<int> fixed = held;
+  fixed.insert(fixed.end(), boundary.begin(), boundary.end());
+  const MatX Phi = clampedModes(nodal_.kff, nodal_.mff, fixed, o.modes, owner_, &omega_);
+  // constraint modes: psi_b = e_b at the boundary, 0 at the reference, -K_ii^-1 K_ib inside
+  std::vector<int> inner(n, 0);  // position among the inner DOF, or -1
+  for (int i : fixed) inner[i] = -1;
+  int ni = 0;
+  for (int i = 0; i < n; ++i) inner[i] = inner[i] < 0 ? -1 : ni++;
+  std::vector<int> bpos(n, -1);
+  for (std::size_t j = 0; j < boundary.size(); ++j) bpos[boundary[j]] = static_cast<int>(j);
+  std::vector<Eigen::Triplet<double>> tii, tib;
+  for (int j = 0; j < nodal_.kff.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(nodal_.kff, j); it; ++it) {
+      const int r = inner[it.row()];
+      if (r < 0) continue;
+      if (inner[j] >= 0) tii.emplace_back(r, inner[j], it.value());
+      if (bpos[j] >= 0) tib.emplace_back(r, bpos[j], it.value());
+    }
+  }
+  SpMat Kii(ni, ni), Kib(ni, static_cast<int>(boundary.size()));
+  Kii.setFromTriplets(tii.begin(), tii.end());
+  Kib.setFromTriplets(tib.begin(), tib.end());
+  const Eigen::SimplicialLDLT<SpMat> ldlt(Kii);
+  if (ldlt.info() != Eigen::Success) {
+    throw InputError(owner_ + ": the stiffness with the rigid interfaces held is singular (a part of the body moves "
+                     "freely: is every part connected to an interface?)");
+  }
+  const MatX inside = -(ldlt.solve(MatX(Kib)));  // -K_ii^-1 K_ib (Craig & Bampton 1968)
+  MatX Psi = MatX::Zero(n, static_cast<int>(boundary.size()));
+  for (std::size_t j = 0; j < boundary.size(); ++j) Psi(boundary[j], static_cast<int>(j)) = 1.0;
+  for (int i = 0; i < n; ++i) {
+    if (inner[i] >= 0) Psi.row(i) = inside.row(inner[i]);
+  }
+  basis_.resize(n, Psi.cols() + Phi.cols());
+  basis_ << Psi, Phi;
 }
 
 }  // namespace flexmbd

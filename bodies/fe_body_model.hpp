@@ -38,12 +38,23 @@ struct FeInterface {
   Vec3 point = Vec3::Zero();
 };
 
+/// How the nodal model is reduced.
+///  - FreeFree: `modes` free-free normal modes on mean axes (Tisserand frame).
+///  - CraigBampton (Craig & Bampton 1968): the frame follows the rigid interface named
+///    `reference` (its 6 DOF held: the reference conditions); the coordinates are the 6
+///    constraint modes of every other rigid interface (static shapes, psi = -K_ii^-1 K_ib,
+///    exact for static loads there) and `modes` fixed-interface modes (every rigid
+///    interface held; M never factored, clampedModes).
+enum class FeReduction { FreeFree, CraigBampton };
+
 struct FeBodyOptions {
   int modes = 8;                ///< free-free elastic modes kept (the six rigid ones dropped)
   double stiffnessScale = 1.0;  ///< K multiplied by it (EXUDYN's ScaleStiffnessMatrix; > 0)
   double dampingRatio = 0.0;    ///< modal damping: D_ff = diag(2 zeta omega_i), in [0, 1]
   std::vector<FePointMass> pointMasses;
   std::vector<FeInterface> interfaces;  ///< their points follow the nodes' in the invariants
+  FeReduction reduction = FeReduction::FreeFree;
+  std::string reference;  ///< Craig-Bampton: the rigid interface the frame follows
 };
 
 class FeBodyModel {
@@ -68,9 +79,10 @@ class FeBodyModel {
   const FfrInvariants3d& invariants() const { return reduced_; }
   /// The modes (nodal DOF x modes, columns M-normalised, M-orthogonal to the rigid motions).
   const MatX& basis() const { return basis_; }
-  /// Their natural frequencies, rad/s.
+  /// Their natural frequencies, rad/s (Craig-Bampton: of the fixed-interface modes, which
+  /// follow the 6 constraint modes of each boundary interface in the basis).
   const VecX& naturalFrequencies() const { return omega_; }
-  /// The six dropped rigid-body eigenvalues (rad^2/s^2; round-off of zero).
+  /// The six dropped rigid-body eigenvalues (rad^2/s^2; round-off of zero; free-free only).
   const VecX& rigidEigenvalues() const { return rigidEigenvalues_; }
 
   /// The rigid motions of the nodes (3 N x 6, matrix order): translations along x, y, z,
@@ -81,11 +93,14 @@ class FeBodyModel {
   /// The interfaces (FeInterface): the rigid ones' condensation of nodal_ (map_, and the
   /// rigid motions `R` into the condensed DOF), then every interface's point appended.
   void addInterfaces(const FeBodyData& d, const FeBodyOptions& options, MatX& R);
+  /// basis_ and omega_ of the Craig-Bampton reduction (FeReduction::CraigBampton).
+  void reduceCraigBampton(const FeBodyOptions& options);
 
   std::string owner_;
   FfrInvariants3d nodal_, reduced_;
   SpMat map_;
   int firstInterface_ = 0;
+  std::vector<int> masterColumn_;  // per interface: its first column in nodal_ (rigid), or -1
   MatX basis_;
   VecX omega_, rigidEigenvalues_;
 };

@@ -111,6 +111,19 @@ FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
     }
     o.interfaces.push_back(std::move(i));
   }
+  const std::string reduction = r.string("reduction", "free_free");
+  if (reduction != "free_free" && reduction != "craig_bampton") {
+    r.fail("key \"reduction\" must be \"free_free\" (normal modes on mean axes) or \"craig_bampton\" (the frame on "
+           "the rigid interface \"reference\"), got " + inQuotes(reduction));
+  }
+  if ((reduction == "craig_bampton") != r.has("reference")) {
+    r.fail("key \"reference\" (the rigid interface the frame follows) goes with \"reduction\": \"craig_bampton\", and "
+           "only with it");
+  }
+  if (reduction == "craig_bampton") {
+    o.reduction = FeReduction::CraigBampton;
+    o.reference = r.nonEmptyString("reference");
+  }
   return o;
 }
 

@@ -19,7 +19,8 @@ FeBodyData readFeBodyFiles(const jsonread::ObjectReader& r, const std::string& b
 
 /// The options of `r`: "modes", "stiffness_scale", "damping_ratio", "point_masses"
 /// [{"node": FE node number, "mass": kg}, ...], "interfaces" [{"name", "kind": "rigid" |
-/// "averaging", "nodes": [numbers] or "node_set": name, "point"}, ...] (nodes of `data`).
+/// "averaging", "nodes": [numbers] or "node_set": name, "point"}, ...] (nodes of `data`),
+/// "reduction" ("free_free" or "craig_bampton") with "reference" (a rigid interface).
 /// @throws InputError naming the key.
 FeBodyOptions readFeBodyOptions(const jsonread::ObjectReader& r, const FeBodyData& data);
 

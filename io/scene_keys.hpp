@@ -92,7 +92,8 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "interfaces", "elastic_coordinates", "elastic_velocities"};
+                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference",
+                               "elastic_coordinates", "elastic_velocities"};
 inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
