@@ -1,5 +1,7 @@
 #include "io/fe_calculix.hpp"
 
+#include <array>
+
 #include <map>
 #include <set>
 #include <utility>
@@ -287,5 +289,55 @@ class FrdReader {
 }  // namespace
 
 FrdResults readCalculixFrd(const std::string& path) { return FrdReader(path).read(); }
+
+FeStressSamples stressSamplesFromFrd(const FrdResults& frd, const FeBodyData& d, const std::string& frdPath,
+                                     const std::string& owner) {
+  static const std::array<const char*, 3> kDisp = {"D1", "D2", "D3"};
+  static const std::array<const char*, 6> kStress = {"SXX", "SYY", "SZZ", "SXY", "SYZ", "SZX"};
+  std::vector<const FrdStep*> steps;
+  for (const FrdStep& s : frd.steps) {
+    if (s.blocks.count("DISP") && s.blocks.count("STRESS")) steps.push_back(&s);
+  }
+  if (steps.empty()) {
+    throw InputError(owner + ": " + frdPath + " has no step with both DISP and STRESS (CalculiX: *NODE FILE U and "
+                     "*EL FILE S in the step)");
+  }
+  // the column of each named component in a block, or a message naming the missing one
+  auto columns = [&](const FrdBlock& b, const auto& names, const FrdStep& s) {
+    std::vector<int> col;
+    for (const char* n : names) {
+      int c = -1;
+      for (std::size_t k = 0; k < b.components.size(); ++k) {
+        if (b.components[k] == n) c = static_cast<int>(k);
+      }
+      if (c < 0) {
+        throw InputError(owner + ": " + frdPath + ", step " + std::to_string(s.number) + ": block " + b.name +
+                         " has no component " + n);
+      }
+      col.push_back(c);
+    }
+    return col;
+  };
+  const std::vector<int> dof = d.dofIndex();
+  FeStressSamples out;
+  out.displacement = MatX::Zero(d.numDofs(), static_cast<int>(steps.size()));
+  out.stress = MatX::Zero(6 * d.numNodes(), static_cast<int>(steps.size()));
+  for (std::size_t j = 0; j < steps.size(); ++j) {
+    const FrdStep& s = *steps[j];
+    const FrdBlock &u = s.blocks.at("DISP"), &sg = s.blocks.at("STRESS");
+    const std::vector<int> cu = columns(u, kDisp, s), cs = columns(sg, kStress, s);
+    for (int a = 0; a < d.numNodes(); ++a) {
+      const auto iu = u.values.find(d.nodeIds[a]), is = sg.values.find(d.nodeIds[a]);
+      if (iu == u.values.end() || is == sg.values.end()) {
+        throw InputError(owner + ": " + frdPath + ", step " + std::to_string(s.number) + ": node " +
+                         std::to_string(d.nodeIds[a]) + " of the body has no " +
+                         (iu == u.values.end() ? "DISP" : "STRESS") + " value");
+      }
+      for (int k = 0; k < 3; ++k) out.displacement(dof[3 * a + k], static_cast<int>(j)) = iu->second[cu[k]];
+      for (int k = 0; k < 6; ++k) out.stress(6 * a + k, static_cast<int>(j)) = is->second[cs[k]];
+    }
+  }
+  return out;
+}
 
 }  // namespace flexmbd

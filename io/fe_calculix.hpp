@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bodies/fe_body_data.hpp"
+#include "bodies/fe_stress.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
@@ -75,5 +76,12 @@ struct FrdResults {
 /// header's, a block name given twice in a step, a block not closed by " -3", no "9999"
 /// at the end (an unfinished run).
 FrdResults readCalculixFrd(const std::string& path);
+
+/// The steps of `frd` with both a DISP and a STRESS block (CalculiX *NODE FILE U and
+/// *EL FILE S): every node of `data` must have both.
+/// @throws InputError naming `owner`, the file and the step: no such step, a node of the
+/// body missing from a block.
+FeStressSamples stressSamplesFromFrd(const FrdResults& frd, const FeBodyData& data, const std::string& frdPath,
+                                     const std::string& owner);
 
 }  // namespace flexmbd

@@ -28,6 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bodies/fe_body_model.hpp"
+#include "bodies/fe_stress.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
@@ -109,17 +110,39 @@ std::string barMesh() {
 const Vec3 kTipForce(0.0, -1000.0, 500.0), kTipMoment(50.0, 0.0, 0.0);
 const Vec3 kTipPoint(kLength, kWidth / 2, kHeight / 2);
 
-std::string staticTipLoadStep() {
+/// The model data of the tip's rigid body: its reference and rotation nodes at
+/// kTipPoint, the clamped face held.
+std::string clampedWithRigidTip() {
   std::ostringstream s;
   s.precision(17);
   s << "*NODE\n9001, " << kTipPoint.x() << ", " << kTipPoint.y() << ", " << kTipPoint.z() << "\n9002, "
     << kTipPoint.x() << ", " << kTipPoint.y() << ", " << kTipPoint.z() << "\n"
-    << "*BOUNDARY\nFIX, 1, 3\n*RIGID BODY, NSET=TIP, REF NODE=9001, ROT NODE=9002\n*STEP\n*STATIC\n*CLOAD\n";
+    << "*BOUNDARY\nFIX, 1, 3\n*RIGID BODY, NSET=TIP, REF NODE=9001, ROT NODE=9002\n";
+  return s.str();
+}
+
+std::string staticTipLoadStep() {
+  std::ostringstream s;
+  s.precision(17);
+  s << clampedWithRigidTip() << "*STEP\n*STATIC\n*CLOAD\n";
   for (int k = 0; k < 3; ++k) {
     if (kTipForce[k] != 0.0) s << "9001, " << k + 1 << ", " << kTipForce[k] << "\n";
     if (kTipMoment[k] != 0.0) s << "9002, " << k + 1 << ", " << kTipMoment[k] << "\n";
   }
-  s << "*NODE PRINT, NSET=Nall\nU\n*END STEP\n";
+  s << "*NODE PRINT, NSET=Nall\nU\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n";
+  return s.str();
+}
+
+/// Six static load cases: a unit force along x, y, z at the tip's reference node, then a
+/// unit moment about x, y, z at its rotation node (the static responses whose span is
+/// the Craig-Bampton constraint modes of the tip), with displacements and stresses.
+std::string unitTipLoadCases() {
+  std::ostringstream s;
+  s << clampedWithRigidTip();
+  for (int c = 0; c < 6; ++c) {
+    s << "*STEP\n*STATIC\n*CLOAD, OP=NEW\n" << (c < 3 ? 9001 : 9002) << ", " << c % 3 + 1
+      << ", 1.\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n";
+  }
   return s.str();
 }
 
@@ -154,7 +177,9 @@ class CalculixBar : public ::testing::Test {
         {"clamped", "*BOUNDARY\nFIX, 1, 3\n*STEP\n*FREQUENCY\n10\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n"},
         {"free", "*STEP\n*FREQUENCY\n14\n*NODE FILE\nU\n*END STEP\n"},
         {"matrices", "*STEP\n*FREQUENCY, SOLVER=MATRIXSTORAGE\n*END STEP\n"},
-        {"static", staticTipLoadStep()}};
+        {"static", staticTipLoadStep()},
+        {"unit_cases", unitTipLoadCases()},
+        {"fixed_fixed", "*BOUNDARY\nFIX, 1, 3\nTIP, 1, 3\n*STEP\n*FREQUENCY\n10\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n"}};
     for (const auto& [job, step] : steps) {
       std::ofstream((dir_ / (job + ".inp")).string()) << mesh << step;
       const std::string cmd =
@@ -338,6 +363,74 @@ TEST_F(CalculixBar, StaticTipLoadThroughARigidInterfaceEqualsCcxs) {
   EXPECT_LT(worst, 1e-6 * largest);
   std::printf("[ figures ] RBE2 tip load: largest displacement %.6e m, worst difference to ccx %.1e of it\n", largest,
               worst / largest);
+}
+
+TEST_F(CalculixBar, StressOfAStaticTipLoadRecoveredFromStressShapesEqualsCcxs) {
+  // The bar reduced by Craig-Bampton on a rigid root (FIX) with a rigid tip interface (6
+  // constraint modes) and 4 fixed-interface modes. Stress samples from ccx: the six unit
+  // tip load cases and the fixed-fixed modes (DISP and STRESS of each); every coordinate's
+  // stress shape is the samples' combination that gives its displacement (stressShapes).
+  // The static tip load of the RBE2 test, solved in the reduced coordinates, then
+  // sigma = S q_f at every node, against ccx's own stress of that load. Both sides print 6
+  // digits (E12.5, 5e-6 of each value) and the unit cases combine with weights up to 1e3:
+  // 1e-4 of the largest von Mises stress.
+  const FeBodyData d = bar();
+  FeBodyOptions o;
+  o.modes = 4;
+  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
+  FeInterface tip{"tip", d.nodeSets.at("TIP"), FeInterfaceKind::Rigid};
+  tip.atCentroid = false;
+  tip.point = kTipPoint;
+  o.interfaces.push_back(tip);
+  o.reduction = FeReduction::CraigBampton;
+  o.reference = "root";
+  const FeBodyModel m(d, o, "bar");
+  const FeStressSamples samples =
+      joinedSamples(stressSamplesFromFrd(readCalculixFrd(job("unit_cases.frd")), d, "unit_cases.frd", "bar"),
+                    stressSamplesFromFrd(readCalculixFrd(job("fixed_fixed.frd")), d, "fixed_fixed.frd", "bar"));
+  ASSERT_EQ(samples.displacement.cols(), 6 + 10);
+  const MatX S = stressShapes(m, samples, "bar");
+  ASSERT_EQ(S.cols(), 6 + 4);
+  // static: (B^T K B) q = B^T f, f at the tip's frame DOF (the last 6 of the nodal DOF)
+  const MatX K = MatX(m.nodalInvariants().kff);
+  const int n = static_cast<int>(K.rows());
+  VecX f = VecX::Zero(n);
+  f.segment<3>(n - 6) = kTipForce;
+  f.segment<3>(n - 3) = kTipMoment;
+  const MatX& B = m.basis();
+  const VecX q = (B.transpose() * K * B).ldlt().solve(B.transpose() * f);
+  const VecX sigma = S * q;
+  const FrdResults ccx = readCalculixFrd(job("static.frd"));
+  ASSERT_EQ(ccx.steps.size(), 1u);
+  const FrdBlock& st = ccx.steps[0].blocks.at("STRESS");
+  double largest = 0.0, worst = 0.0, rootBending = 0.0, rootWorst = 0.0;
+  std::vector<char> isRoot(d.numNodes(), 0);
+  for (int a : d.nodeSets.at("FIX")) isRoot[a] = 1;
+  for (int a = 0; a < d.numNodes(); ++a) {
+    const std::vector<double>& c = st.values.at(d.nodeIds[a]);
+    const Eigen::Matrix<double, 6, 1> theirs = Eigen::Map<const Eigen::Matrix<double, 6, 1>>(c.data());
+    largest = std::max(largest, vonMises(theirs));
+    worst = std::max(worst, (sigma.segment<6>(6 * a) - theirs).cwiseAbs().maxCoeff());
+    if (isRoot[a]) {
+      rootBending = std::max(rootBending, std::abs(theirs[0]));
+      rootWorst = std::max(rootWorst, std::abs(sigma[6 * a] - theirs[0]));
+    }
+  }
+  EXPECT_LT(worst, 1e-4 * largest);
+  EXPECT_LT(rootWorst, 1e-4 * rootBending);
+  std::printf(
+      "[ figures ] stress recovery, static tip load: largest von Mises %.6e Pa, worst component difference to ccx "
+      "%.1e of it; root bending stress sxx up to %.6e Pa, recovered to %.1e of it\n",
+      largest, worst / largest, rootBending, rootWorst / rootBending);
+  // a basis the samples do not span is refused naming the coordinate: free-free modes
+  FeBodyOptions ff;
+  ff.modes = 2;
+  try {
+    stressShapes(FeBodyModel(d, ff, "bar"), samples, "body 'bar'");
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("do not span elastic coordinate 1"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(CalculixBar, FreeFreeFrequenciesEqualCcxs) {
