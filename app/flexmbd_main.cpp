@@ -246,7 +246,7 @@ int runCommand(const Options& o) {
   try {
     writer.emplace(outDir, *scene, o.format);
     if (o.vtk) {
-      vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system, "bodies", 4, scene->geometry);
+      vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system, "bodies", 4, scene->geometry, scene->feBodies);
       for (const std::string& b : vtk->bodiesNotDrawn()) {
         std::cerr << "flexmbd: warning: --vtk: body \"" << oneLine(b)
                   << "\" has no points to draw (a flexible_invariants body without \"points\"); it is not in "

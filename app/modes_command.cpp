@@ -224,7 +224,7 @@ void writeShapesVtk(const fs::path& dir, const Scene& scene, const ReferenceStat
   for (size_t k = 0; k < modes.size(); ++k) {
     char prefix[32];
     std::snprintf(prefix, sizeof prefix, "mode_%02zu", k + 1);
-    VtkWriter vtk(dir, sys, prefix, 4, scene.geometry);
+    VtkWriter vtk(dir, sys, prefix, 4, scene.geometry, scene.feBodies);
     const double c = shapeScale(sys, modes[k].shape.real());
     for (int f = 0; f < kShapeFrames; ++f) {
       const double phi = 2 * M_PI * f / kShapeFrames;

@@ -1,7 +1,11 @@
 #include "bodies/body_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
+
+#include "bodies/fe_body_data.hpp"
 
 #include "core/errors.hpp"
 
@@ -96,6 +100,51 @@ SurfaceMesh surfaceMesh(const SolidShape& s, int segments) {
   }
   const bool axial = s.type == SolidShape::Type::Cylinder || s.type == SolidShape::Type::Tube;
   for (Vec3& p : m.points) p = s.offset + s.orientation * (axial ? alongAxis(p, s.axis) : p);
+  return m;
+}
+
+namespace {
+
+/// The faces of a solid element as its corner nodes (0-based positions in its node list),
+/// counter-clockwise seen from outside for the codes' node order; empty for other types.
+const std::vector<std::vector<int>>& elementFaces(const std::string& type) {
+  static const std::vector<std::vector<int>> hex = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
+                                                    {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+  static const std::vector<std::vector<int>> tet = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
+  static const std::vector<std::vector<int>> wedge = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
+  static const std::vector<std::vector<int>> pyramid = {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  static const std::vector<std::vector<int>> none;
+  const auto starts = [&](const char* p) { return type.rfind(p, 0) == 0; };
+  if (starts("C3D8") || starts("C3D20") || starts("Hex")) return hex;
+  if (starts("C3D4") || starts("C3D10") || starts("Tet")) return tet;
+  if (starts("C3D6") || starts("C3D15") || starts("Wedge")) return wedge;
+  if (starts("Pyramid")) return pyramid;
+  return none;
+}
+
+}  // namespace
+
+SurfaceMesh outerSurface(const FeBodyData& d) {
+  SurfaceMesh m;
+  m.points = d.coordinates;
+  // a face shared by two elements is inside: count each face by its sorted nodes
+  std::map<std::vector<int>, std::pair<int, std::vector<int>>> faces;  // key -> (count, oriented face)
+  for (const FeElement& e : d.elements) {
+    for (const std::vector<int>& f : elementFaces(e.type)) {
+      std::vector<int> face;
+      for (int k : f) {
+        if (k < static_cast<int>(e.nodes.size())) face.push_back(e.nodes[k]);
+      }
+      if (face.size() != f.size()) continue;  // fewer nodes than the type has corners
+      std::vector<int> key = face;
+      std::sort(key.begin(), key.end());
+      auto& entry = faces[key];
+      if (entry.first++ == 0) entry.second = face;
+    }
+  }
+  for (const auto& [key, entry] : faces) {
+    if (entry.first == 1) m.faces.push_back(entry.second);
+  }
   return m;
 }
 

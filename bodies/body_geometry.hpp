@@ -22,6 +22,26 @@ struct SurfaceMesh {
   std::vector<std::vector<int>> faces;   ///< indices into points
 };
 
+struct FeBodyData;
+
+/// How a body imported from an FE code is drawn (scene "fe_body"): the outer surface of
+/// its mesh over its nodes (node a is the body's attachment point a, so the surface
+/// follows the deformation), and the nodes' stress shapes if the scene gave stress
+/// samples (von Mises in the frames; docs/fe-import.md, "Stresses").
+struct FeBodyDrawing {
+  BodyIndex body;
+  std::vector<int> nodeIds;  ///< the FE code's node numbers, in the body's point order
+  SurfaceMesh surface;       ///< points: the nodes' undeformed positions (FE axes)
+  MatX stressShapes;         ///< 6 N x nf: node a's (sxx, syy, szz, sxy, syz, szx) = rows 6 a .. 6 a + 5 times q_f; or empty
+};
+
+/// The outer surface of a solid mesh: the element faces (corner nodes only: quadrilaterals
+/// of hexahedra, wedges and pyramids, triangles of tetrahedra, wedges and pyramids) that
+/// belong to one element only, oriented outwards as the element orders its nodes
+/// (Abaqus/CalculiX C3D4/6/8/10/15/20, Ansys Tet/Wedge/Pyramid/Hex). Points: every node.
+/// Elements of other types are skipped.
+SurfaceMesh outerSurface(const FeBodyData& data);
+
 /// The surface of the shape: a box's 6 faces; a cylinder's or a tube's `segments` side
 /// facets (and a tube's inner ones) with their end faces; a sphere of `segments` meridians
 /// and segments / 2 bands. The points lie on the exact surface.

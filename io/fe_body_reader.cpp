@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "bodies/fe_stress.hpp"
 #include "io/fe_abaqus.hpp"
 #include "io/fe_ansys.hpp"
 #include "io/fe_calculix.hpp"
@@ -12,6 +13,7 @@
 namespace flexmbd::scenereaders {
 
 using jsonread::inQuotes;
+using jsonread::located;
 using jsonread::json;
 using jsonread::ObjectReader;
 
@@ -125,6 +127,25 @@ FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
     o.reference = r.nonEmptyString("reference");
   }
   return o;
+}
+
+MatX readFeStressShapes(const ObjectReader& r, const FeBodyData& data, const FeBodyModel& model,
+                        const std::string& baseDir, const std::string& owner) {
+  const ObjectReader st(r.object("stresses"), r.where() + ".stresses");
+  st.allowOnly(scenekeys::kFeStresses, " for stresses");
+  const json& files = st.requiredArray("calculix_frd");
+  if (files.empty()) st.fail("key \"calculix_frd\" must list at least one .frd file");
+  FeStressSamples samples;
+  for (std::size_t k = 0; k < files.size(); ++k) {
+    if (!files[k].is_string() || files[k].get<std::string>().empty()) {
+      st.fail("key \"calculix_frd\": entry " + std::to_string(k) + " must be a file path (a string)");
+    }
+    std::filesystem::path p(files[k].get<std::string>());
+    if (!p.is_absolute() && !baseDir.empty()) p = std::filesystem::path(baseDir) / p;
+    const FeStressSamples s = stressSamplesFromFrd(readCalculixFrd(p.string()), data, p.string(), owner);
+    samples = k == 0 ? s : joinedSamples(samples, s);
+  }
+  return located(st.where(), [&] { return stressShapes(model, samples, owner); });
 }
 
 }  // namespace flexmbd::scenereaders

@@ -24,4 +24,11 @@ FeBodyData readFeBodyFiles(const jsonread::ObjectReader& r, const std::string& b
 /// @throws InputError naming the key.
 FeBodyOptions readFeBodyOptions(const jsonread::ObjectReader& r, const FeBodyData& data);
 
+/// Key "stresses" of `r`: {"calculix_frd": [paths]}, the FE code's results (displacement
+/// and stress of modes or load cases) whose combinations give the stress shapes of the
+/// model's coordinates (6 N x nf; bodies/fe_stress.hpp).
+/// @throws InputError naming the key, a file, or the coordinate the results do not span.
+MatX readFeStressShapes(const jsonread::ObjectReader& r, const FeBodyData& data, const FeBodyModel& model,
+                        const std::string& baseDir, const std::string& owner);
+
 }  // namespace flexmbd::scenereaders

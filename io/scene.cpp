@@ -4,6 +4,7 @@
 // Errors are one line: "<location>: <what is wrong>, got <what was found>".
 #include "io/scene.hpp"
 
+#include "bodies/fe_stress.hpp"
 #include "io/json_reader.hpp"
 #include "io/flexible_body_reader.hpp"
 #include "io/scene_keys.hpp"
@@ -452,13 +453,34 @@ class PathTracker {
 
 }  // namespace
 
+/// The node and stress shape of a "stress" output on `out.body`.
+void readStressOutput(const ObjectReader& r, const std::vector<FeBodyDrawing>& feBodies, OutputRequest& out) {
+  const FeBodyDrawing* fe = nullptr;
+  for (const FeBodyDrawing& d : feBodies) {
+    if (d.body == out.body) fe = &d;
+  }
+  if (!fe || fe->stressShapes.size() == 0) {
+    r.fail("body " + inQuotes(out.bodyName) + (fe ? " has no \"stresses\"" : " is not an fe_body") +
+           "; a stress output needs an fe_body with the key \"stresses\"");
+  }
+  if (!r.has("node")) r.fail("missing required key \"node\" (the FE code's node number)");
+  out.node = static_cast<int>(r.integer("node", 0, std::numeric_limits<int>::min()));
+  const auto it = std::find(fe->nodeIds.begin(), fe->nodeIds.end(), out.node);
+  if (it == fe->nodeIds.end()) {
+    r.fail("key \"node\": body " + inQuotes(out.bodyName) + " has no node " + std::to_string(out.node));
+  }
+  out.spatial = true;
+  out.stressShape = fe->stressShapes.middleRows(6 * (it - fe->nodeIds.begin()), 6);
+}
+
 // ----- public API ------------------------------------------------------------------------------
 
 OutputRequest parseOutputRequest(const json& j, const std::string& where, const System& sys,
-                          const std::vector<OutputRequest>& earlier, bool spatial) {
+                                 const std::vector<OutputRequest>& earlier, bool spatial,
+                                 const std::vector<FeBodyDrawing>& feBodies) {
   ObjectReader r(j, where);
   r.peekName();
-  const std::string type = readType(r, "output", {"point", "energy", "deflection"});
+  const std::string type = readType(r, "output", {"point", "energy", "deflection", "stress"});
   OutputRequest out;
   if (type == "energy") {
     r.allowOnly(scenekeys::kEnergyOutput, " for an energy output");
@@ -468,8 +490,10 @@ OutputRequest parseOutputRequest(const json& j, const std::string& where, const 
     out.type = OutputRequest::Type::Energy;
     return out;
   }
-  r.allowOnly(scenekeys::kPointOutput, " for a " + type + " output");
-  out.type = type == "point" ? OutputRequest::Type::Point : OutputRequest::Type::Deflection;
+  r.allowOnly(type == "stress" ? scenekeys::kStressOutput : scenekeys::kPointOutput, " for a " + type + " output");
+  out.type = type == "point"    ? OutputRequest::Type::Point
+             : type == "stress" ? OutputRequest::Type::Stress
+                                : OutputRequest::Type::Deflection;
   out.name = r.name("name");
   // Column names must stay unique: "<name>.x" may not clash with "<body>.x" or
   // "<joint>.fx" or with another output's columns.
@@ -491,6 +515,10 @@ OutputRequest parseOutputRequest(const json& j, const std::string& where, const 
   }
   out.bodyName = r.name("body");
   out.body = lookupBody(sys, out.bodyName, r);
+  if (out.type == OutputRequest::Type::Stress) {
+    readStressOutput(r, feBodies, out);
+    return out;
+  }
   if (spatial) {
     out.spatial = true;
     out.point3 = r.has("point") ? Vec3(r.vector("point", 3)) : Vec3::Zero();
@@ -526,6 +554,9 @@ OutputRequest parseOutputRequest(const json& j, const std::string& where, const 
 
 std::vector<std::string> OutputRequest::columnNames() const {
   if (type == Type::Energy) return {"energy.kinetic", "energy.potential", "energy.total"};
+  if (type == Type::Stress) {
+    return {name + ".sxx", name + ".syy", name + ".szz", name + ".sxy", name + ".syz", name + ".szx", name + ".von_mises"};
+  }
   if (type == Type::Deflection && spatial) {
     return {name + ".ux", name + ".uy", name + ".uz", name + ".N",  name + ".Qy",
             name + ".Qz", name + ".Mx", name + ".My", name + ".Mz"};
@@ -543,6 +574,11 @@ std::vector<double> OutputRequest::evaluate(const System& sys, const VecX& q, co
   }
   const Body& b = sys.body(body);
   const int off = sys.coordinateOffset(body);
+  if (type == Type::Stress) {  // sigma = S q_f, the elastic coordinates after R and p
+    const int nf = static_cast<int>(stressShape.cols());
+    const Eigen::Matrix<double, 6, 1> sg = stressShape * q.segment(off + 7, nf);
+    return {sg[0], sg[1], sg[2], sg[3], sg[4], sg[5], vonMises(sg)};
+  }
   if (spatial && type == Type::Deflection) {
     const FfrBody3d::BeamDeflection d =
         static_cast<const FfrBody3d&>(b).beamDeflection(q.segment(off, b.numCoordinates()), element, xi);
@@ -609,7 +645,7 @@ Scene parseScene(const json& j, const std::string& baseDir) {
   if (bodies.empty()) top.fail("key \"bodies\" must list at least one body");
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     const std::string at = "bodies[" + std::to_string(i) + "]";
-    spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys, baseDir) : parseBody(bodies[i], at, sys);
+    spatial ? scenereaders::parseSpatialBody(bodies[i], at, sys, baseDir, &scene.feBodies) : parseBody(bodies[i], at, sys);
     if (bodies[i].contains("geometry")) {  // a rigid body's (the readers refuse the key elsewhere)
       const BodyIndex b(sys.numBodies() - 1);
       scene.geometry.push_back({b, scenereaders::parseGeometry(bodies[i]["geometry"],
@@ -646,7 +682,7 @@ Scene parseScene(const json& j, const std::string& baseDir) {
   const json& outputs = top.array("outputs");
   for (std::size_t i = 0; i < outputs.size(); ++i) {
     scene.outputs.push_back(
-        parseOutputRequest(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial));
+        parseOutputRequest(outputs[i], "outputs[" + std::to_string(i) + "]", sys, scene.outputs, spatial, scene.feBodies));
   }
 
   scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};

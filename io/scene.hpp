@@ -20,6 +20,7 @@ struct OutputRequest {
     Point,   ///< world position and velocity of a body point
     Energy,  ///< kinetic, potential and total energy of the system
     Deflection,  ///< elastic displacement (body frame) and section forces at a beam point
+    Stress,      ///< stress components and von Mises at a node of an fe_body with "stresses"
   };
   Type type = Type::Point;
   std::string name;            ///< Point: prefix of the columns
@@ -31,13 +32,16 @@ struct OutputRequest {
   int pointId = Body::kAnyPoint;  ///< Point: the body's identifier of the point (Body::resolvePoint)
   int element = 0;             ///< Deflection: element of the beam mesh holding the point
   double xi = 0.0;             ///< Deflection: its local coordinate in [0, 1]
+  int node = 0;                ///< Stress: the FE code's node number
+  MatX stressShape;            ///< Stress: the node's 6 x nf stress shape, sigma = stressShape q_f
 
   /// Point: "<name>.x", "<name>.y", "<name>.vx", "<name>.vy";
   /// Deflection: "<name>.ux", "<name>.uy" (elastic displacement in the body frame),
   /// "<name>.N", "<name>.M" (axial force and bending moment of the beam there); spatial:
   /// "<name>.x", ".y", ".z", ".vx", ".vy", ".vz" and "<name>.ux", ".uy", ".uz", ".N", ".Qy",
   /// ".Qz", ".Mx", ".My", ".Mz" (section forces and moments in element axes);
-  /// Energy: "energy.kinetic", "energy.potential", "energy.total".
+  /// Energy: "energy.kinetic", "energy.potential", "energy.total";
+  /// Stress: "<name>.sxx", ".syy", ".szz", ".sxy", ".syz", ".szx" (FE axes), ".von_mises".
   std::vector<std::string> columnNames() const;
   /// Values matching columnNames() at global coordinates q and velocities v (size nq).
   /// Point: r and Jr v_body from Body::pointKinematics; Energy: kineticEnergy,
@@ -53,6 +57,7 @@ struct Scene {
   SolverSettings solver;
   std::vector<OutputRequest> outputs;
   std::vector<BodyGeometry> geometry;  ///< the rigid bodies' "geometry" (viewing only)
+  std::vector<FeBodyDrawing> feBodies;  ///< the fe_bodies' surfaces and stress shapes
 };
 
 /// Reads and parses a scene file. Error messages start with the file path.
@@ -71,12 +76,14 @@ Scene parseSceneText(const std::string& text, const std::string& source = "<scen
 ///         `bodies[1] ("rod"): key "mass" must be > 0, got -1`) on any invalid input.
 Scene parseScene(const nlohmann::json& j, const std::string& baseDir = "");
 
-/// One output object of the scene format ("point", "deflection", "energy"; the keys of
-/// docs/scene-format.md, "Outputs") for `sys` (finalized or not); `earlier`: the outputs
-/// already requested (names must differ); `spatial`: a "dimension": 3 model.
+/// One output object of the scene format ("point", "deflection", "energy", "stress"; the
+/// keys of docs/scene-format.md, "Outputs") for `sys` (finalized or not); `earlier`: the
+/// outputs already requested (names must differ); `spatial`: a "dimension": 3 model;
+/// `feBodies`: the fe_bodies' drawings (a stress output needs its body's stress shapes).
 /// @throws InputError starting with `where`.
 OutputRequest parseOutputRequest(const nlohmann::json& j, const std::string& where, const System& sys,
-                                 const std::vector<OutputRequest>& earlier, bool spatial);
+                                 const std::vector<OutputRequest>& earlier, bool spatial,
+                                 const std::vector<FeBodyDrawing>& feBodies = {});
 
 /// Range checks of solver settings with the scene's key names (rtol > 0, t_end >
 /// t_start, ...), then SolverSettings::validate(). Used after command-line overrides.

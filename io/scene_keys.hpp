@@ -52,6 +52,7 @@ inline const Keys kRotationalSpringDamper = {"name", "type", "joint", "stiffness
 inline const Keys kAppliedLoad = {"name", "type", "body", "point", "force_x", "force_y", "torque"};
 inline const Keys kEnergyOutput = {"type"};
 inline const Keys kPointOutput = {"type", "name", "body", "point"};  ///< point, deflection
+inline const Keys kStressOutput = {"type", "name", "body", "node"};
 inline const Keys kSolver = {"formulation", "integrator", "rtol",        "atol",       "atol_angle",
                              "atol_elastic", "atol_velocity", "t_start",  "t_end",      "output_step",
                              "max_step",     "min_step",      "max_steps", "max_total_steps", "max_order", "initial_step",
@@ -92,11 +93,12 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference",
+                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses",
                                "elastic_coordinates", "elastic_velocities"};
 inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
+inline const Keys kFeStresses = {"calculix_frd"};
 inline const Keys kFePointMass = {"node", "mass"};
 inline const Keys kFeInterface = {"name", "kind", "nodes", "node_set", "point"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
@@ -167,6 +169,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"output.energy", &kEnergyOutput},
       {"output.point", &kPointOutput},
       {"output.deflection", &kPointOutput},
+      {"output.stress", &kStressOutput},
       {"solver", &kSolver},
       {"body.rigid.3d", &kRigidBody3d},
       {"shape.box", &kShapeBox},
@@ -189,6 +192,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"fe.files.ansys", &kFeFilesAnsys},
       {"fe.files.calculix", &kFeFilesCalculix},
       {"fe.point_mass", &kFePointMass},
+      {"fe.stresses", &kFeStresses},
       {"fe.interface", &kFeInterface},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},

@@ -236,18 +236,26 @@ void parseSpatialInvariantBody(const ObjectReader& r, const std::string& name, S
 }
 
 /// A body of "type": "fe_body": a solid mesh from an FE code's export, reduced to
-/// free-free modes on mean axes (FeBodyModel; docs/fe-import.md).
-void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const std::string& baseDir, System& sys) {
+/// free-free modes on mean axes or by Craig-Bampton (FeBodyModel; docs/fe-import.md); its
+/// drawing (outer surface, stress shapes of "stresses") into `drawings`.
+void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const std::string& baseDir, System& sys,
+                        std::vector<FeBodyDrawing>* drawings) {
   r.allowOnly(scenekeys::kFeBody3d, " for an fe_body in a spatial scene");
   const FeBodyData data = readFeBodyFiles(r, baseDir);
   const FeBodyOptions options = readFeBodyOptions(r, data);
-  FfrInvariants3d inv =
-      located(r.where(), [&] { return FeBodyModel(data, options, "body '" + name + "'").invariants(); });
+  const std::string owner = "body '" + name + "'";
+  const FeBodyModel model = located(r.where(), [&] { return FeBodyModel(data, options, owner); });
+  FeBodyDrawing drawing;
+  drawing.nodeIds = data.nodeIds;
+  drawing.surface = outerSurface(data);
+  if (r.has("stresses")) drawing.stressShapes = readFeStressShapes(r, data, model, baseDir, owner);
+  FfrInvariants3d inv = model.invariants();
   const int nf = inv.numElastic();
   const FrameState3d init = parseFrameState3d(r);
   const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
   const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
-  located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
+  drawing.body = located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
+  if (drawings) drawings->push_back(std::move(drawing));
 }
 
 /// The type, dimensions, "offset" and "orientation" of a shape (in "shape" and "geometry");
@@ -375,10 +383,11 @@ std::vector<SolidShape> parseGeometry(const json& j, const std::string& where) {
   });
 }
 
-void parseSpatialBody(const json& j, const std::string& where, System& sys, const std::string& baseDir) {
+void parseSpatialBody(const json& j, const std::string& where, System& sys, const std::string& baseDir,
+                      std::vector<FeBodyDrawing>* drawings) {
   ObjectReader r(j, where);
   const auto [type, name] = readBodyTypeAndName(r);
-  if (type == "fe_body") return parseSpatialFeBody(r, name, baseDir, sys);
+  if (type == "fe_body") return parseSpatialFeBody(r, name, baseDir, sys, drawings);
   if (type == "flexible") return parseSpatialFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseSpatialInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");

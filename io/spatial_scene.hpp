@@ -9,6 +9,7 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "bodies/body_geometry.hpp"
 #include "bodies/shape_inertia.hpp"
 #include "core/system.hpp"
 #include "io/json_reader.hpp"
@@ -34,8 +35,10 @@ SpringDamperLaw readSpringDamperLaw(const jsonread::ObjectReader& r, const std::
 /// orthonormal, determinant +1). Exactly one form.
 Mat3 parseOrientation(const nlohmann::json& j, const std::string& where);
 
-/// A body object; `baseDir`: the folder the files of an "fe_body" are relative to.
-void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys, const std::string& baseDir = "");
+/// A body object; `baseDir`: the folder the files of an "fe_body" are relative to; an
+/// fe_body's drawing (surface, stress shapes) goes to `drawings` if given.
+void parseSpatialBody(const nlohmann::json& j, const std::string& where, System& sys, const std::string& baseDir = "",
+                      std::vector<FeBodyDrawing>* drawings = nullptr);
 /// Key "geometry" of a rigid body (planar or spatial): one shape or an array of them,
 /// placed in the body frame, for viewing only. @throws InputError starting with `where`.
 std::vector<SolidShape> parseGeometry(const nlohmann::json& j, const std::string& where);

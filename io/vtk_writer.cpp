@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "bodies/fe_stress.hpp"
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_2d.hpp"
@@ -192,8 +193,13 @@ void VtkCollection::add(double t) {
 // ----- multibody systems ----------------------------------------------------------------------
 
 VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix, int subdivisions,
-                     const std::vector<BodyGeometry>& geometry)
-    : collection_(dir, std::move(prefix)), sys_(sys), subdivisions_(std::max(1, subdivisions)) {
+                     const std::vector<BodyGeometry>& geometry, const std::vector<FeBodyDrawing>& feBodies)
+    : collection_(dir, std::move(prefix)),
+      sys_(sys),
+      subdivisions_(std::max(1, subdivisions)),
+      feBodies_(feBodies),
+      feIndex_(sys.numBodies(), -1) {
+  for (std::size_t k = 0; k < feBodies_.size(); ++k) feIndex_.at(feBodies_[k].body.value) = static_cast<int>(k);
   surfaces_.resize(sys.numBodies());
   for (const BodyGeometry& g : geometry) {
     for (const SolidShape& shape : g.shapes) surfaces_.at(g.body.value).push_back(surfaceMesh(shape));
@@ -245,7 +251,7 @@ VtkWriter::VtkWriter(const std::filesystem::path& dir, const System& sys, std::s
 
 void VtkWriter::write(const OutputSample& s) {
   Grid g;
-  std::vector<double> axial, moment;
+  std::vector<double> axial, moment, vonMisesStress;
   std::vector<Eigen::Vector3d> displacement, sectionForce, sectionMoment;  // element axes
   std::vector<int> bodyIndex;
   std::vector<std::string> bodyNames;
@@ -290,6 +296,30 @@ void VtkWriter::write(const OutputSample& s) {
             sectionMoment.push_back(Vec3(f.Mx, f.My, f.Mz));
           }
           g.cells.push_back(line);
+        }
+      } else if (feIndex_[b] >= 0) {
+        // an fe_body: its outer surface through the deformed nodes (node a = point a)
+        const FeBodyDrawing& fe = feBodies_[feIndex_[b]];
+        const auto& pts = f3->invariants().points;
+        const Mat3 A = FfrBody3d::rotationOf(q);
+        const VecX qf = q.tail(f3->numElastic());
+        const int first = static_cast<int>(g.points.size());
+        for (std::size_t a = 0; a < fe.surface.points.size(); ++a) {
+          const Vec3 u = pts[a].shape * qf;
+          g.points.push_back(q.head<3>() + A * (pts[a].position + u));
+          displacement.push_back(A * u);
+          axial.push_back(0.0);
+          moment.push_back(0.0);
+          vonMisesStress.push_back(fe.stressShapes.size() == 0
+                                       ? 0.0
+                                       : vonMises(fe.stressShapes.middleRows<6>(6 * static_cast<int>(a)) * qf));
+        }
+        g.cellTypes.resize(g.cells.size(), g.cellType);
+        for (const std::vector<int>& f : fe.surface.faces) {
+          std::vector<int> cell(f.size());
+          for (std::size_t k = 0; k < f.size(); ++k) cell[k] = first + f[k];
+          g.cells.push_back(std::move(cell));
+          g.cellTypes.push_back(kVtkPolygon);
         }
       } else if (!f3->invariants().points.empty()) {
         // given invariants: the line through its attachment points
@@ -342,12 +372,15 @@ void VtkWriter::write(const OutputSample& s) {
     moment.resize(g.points.size(), 0.0);
     sectionForce.resize(g.points.size(), Vec3::Zero());
     sectionMoment.resize(g.points.size(), Vec3::Zero());
+    vonMisesStress.resize(g.points.size(), 0.0);
     if (static_cast<int>(g.cells.size()) > cellsBefore) {
       bodyIndex.resize(g.cells.size(), static_cast<int>(bodyNames.size()));
       bodyNames.push_back(body.name());
     }
   }
-  g.pointScalars = {{"axial_force", std::move(axial)}, {"bending_moment", std::move(moment)}};
+  g.pointScalars = {{"axial_force", std::move(axial)},
+                    {"bending_moment", std::move(moment)},
+                    {"von_mises", std::move(vonMisesStress)}};
   g.pointVectors = {{"elastic_displacement", std::move(displacement)},
                     {"section_force", std::move(sectionForce)},
                     {"section_moment", std::move(sectionMoment)}};

@@ -47,8 +47,11 @@ class VtkWriter {
  public:
   /// Creates `dir` and starts `dir/<prefix>.pvd`. @throws std::runtime_error.
   /// `geometry`: shapes drawn as surfaces (polygons) on rigid bodies (Scene::geometry).
+  /// `feBodies`: the fe_bodies drawn as their deformed outer surface (Scene::feBodies),
+  /// with point data "von_mises" where they have stress shapes (0 elsewhere).
   VtkWriter(const std::filesystem::path& dir, const System& sys, std::string prefix = "bodies",
-            int subdivisions = 4, const std::vector<BodyGeometry>& geometry = {});
+            int subdivisions = 4, const std::vector<BodyGeometry>& geometry = {},
+            const std::vector<FeBodyDrawing>& feBodies = {});
   /// Writes `<prefix>_<k>.vtu` for the sample and rewrites the .pvd collection.
   void write(const OutputSample& sample);
   long filesWritten() const { return collection_.frames(); }
@@ -67,6 +70,8 @@ class VtkWriter {
   std::vector<std::vector<Vec3>> spatialPoints_;
   double triad_ = 0.1;
   std::vector<std::vector<SurfaceMesh>> surfaces_;  // per body: its geometry, body axes
+  std::vector<FeBodyDrawing> feBodies_;
+  std::vector<int> feIndex_;  // per body: its entry in feBodies_, or -1
 };
 
 /// A tensegrity structure: its nodes as points (point data: velocity) and every member

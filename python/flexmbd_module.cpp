@@ -379,7 +379,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           [](Scene& s, const std::string& text, bool spatial) {
             const nlohmann::json j = nlohmann::json::parse(text);
             const std::string where = "outputs[" + std::to_string(s.outputs.size()) + "]";
-            s.outputs.push_back(parseOutputRequest(j, where, s.system, s.outputs, spatial));
+            s.outputs.push_back(parseOutputRequest(j, where, s.system, s.outputs, spatial, s.feBodies));
           },
           py::arg("json"), py::arg("spatial") = false)
       .def_property_readonly("output_columns", [](const Scene& s) {

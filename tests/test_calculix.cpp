@@ -34,6 +34,7 @@
 #include "core/errors.hpp"
 #include "io/fe_calculix.hpp"
 #include "io/scene.hpp"
+#include "io/vtk_writer.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
@@ -430,6 +431,88 @@ TEST_F(CalculixBar, StressOfAStaticTipLoadRecoveredFromStressShapesEqualsCcxs) {
     ADD_FAILURE() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("do not span elastic coordinate 1"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(CalculixBar, SceneStressOutputAndVtkSurfaceOfTheStaticTipLoad) {
+  // The same reduction as a scene's fe_body with "stresses", its elastic coordinates the
+  // static solution of the test above: a "stress" output at every root node gives ccx's
+  // static stress (1e-4 of the largest von Mises, as above), and the VTK frame draws the
+  // bar's outer surface (2 (10 x 2 + 10 x 2 + 2 x 2) = 88 quadrilaterals) with von Mises.
+  const FeBodyData d = bar();
+  json body = {{"type", "fe_body"},
+               {"name", "bar"},
+               {"calculix", {{"job", "matrices"}}},
+               {"modes", 4},
+               {"reduction", "craig_bampton"},
+               {"reference", "root"},
+               {"stresses", {{"calculix_frd", {"unit_cases.frd", "fixed_fixed.frd"}}}}};
+  body["interfaces"] = json::array(
+      {json{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}},
+       json{{"name", "tip"}, {"kind", "rigid"}, {"node_set", "TIP"}, {"point", {kTipPoint.x(), kTipPoint.y(), kTipPoint.z()}}}});
+  // the static solution in the body's coordinates, from the model of the same options
+  FeBodyOptions o;
+  o.modes = 4;
+  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
+  FeInterface tip{"tip", d.nodeSets.at("TIP"), FeInterfaceKind::Rigid};
+  tip.atCentroid = false;
+  tip.point = kTipPoint;
+  o.interfaces.push_back(tip);
+  o.reduction = FeReduction::CraigBampton;
+  o.reference = "root";
+  const FeBodyModel m(d, o, "bar");
+  const MatX K = MatX(m.nodalInvariants().kff);
+  const int n = static_cast<int>(K.rows());
+  VecX f = VecX::Zero(n);
+  f.segment<3>(n - 6) = kTipForce;
+  f.segment<3>(n - 3) = kTipMoment;
+  const MatX& B = m.basis();
+  const VecX qf = (B.transpose() * K * B).ldlt().solve(B.transpose() * f);
+  body["elastic_coordinates"] = std::vector<double>(qf.data(), qf.data() + qf.size());
+  json outputs = json::array();
+  for (int a : d.nodeSets.at("FIX")) {
+    outputs.push_back({{"type", "stress"}, {"name", "s" + std::to_string(d.nodeIds[a])}, {"body", "bar"},
+                       {"node", d.nodeIds[a]}});
+  }
+  const json scene = {{"dimension", 3}, {"bodies", {body}}, {"outputs", outputs}};
+  const Scene sc = parseSceneText(scene.dump(), job("scene.json"));
+  const VecX q0 = sc.system.initialCoordinates(), v0 = VecX::Zero(sc.system.numVelocities());
+  const FrdResults ccx = readCalculixFrd(job("static.frd"));
+  const FrdBlock& st = ccx.steps.at(0).blocks.at("STRESS");
+  double largest = 0.0, worst = 0.0;
+  for (const auto& [id, c] : st.values) {
+    largest = std::max(largest, vonMises(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(c.data())));
+  }
+  for (const OutputRequest& out : sc.outputs) {
+    const std::vector<double> v = out.evaluate(sc.system, q0, v0);
+    const std::vector<double>& c = st.values.at(out.node);
+    ASSERT_EQ(v.size(), 7u);
+    for (int k = 0; k < 6; ++k) worst = std::max(worst, std::abs(v[k] - c[k]));
+    EXPECT_NEAR(v[6], vonMises(Eigen::Map<const Eigen::Matrix<double, 6, 1>>(c.data())), 1e-4 * largest);
+  }
+  EXPECT_LT(worst, 1e-4 * largest);
+  EXPECT_EQ(sc.outputs[0].columnNames().back(), sc.outputs[0].name + ".von_mises");
+  // the VTK frame
+  {
+    VtkWriter vtk(dir_ / "vtk", sc.system, "bodies", 4, sc.geometry, sc.feBodies);
+    OutputSample sample;
+    sample.q = q0;
+    sample.v = v0;
+    vtk.write(sample);
+  }
+  std::ifstream in((dir_ / "vtk" / "bodies_000000.vtu").string());
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_NE(text.str().find("NumberOfCells=\"88\""), std::string::npos) << text.str().substr(0, 400);
+  EXPECT_NE(text.str().find("Name=\"von_mises\""), std::string::npos);
+  // a stress output on a body without stresses names the key
+  json plain = scene;
+  plain["bodies"][0].erase("stresses");
+  try {
+    parseSceneText(plain.dump(), job("scene.json"));
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no \"stresses\""), std::string::npos) << e.what();
   }
 }
 
