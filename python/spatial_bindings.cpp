@@ -573,7 +573,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                                                         "An FE body reduced to free-free modes on mean axes")
       .def(py::init([](const FeBodyData& data, const py::object& modes, const py::object& scale,
                        const py::object& damping, const std::vector<std::pair<int, double>>& pointMasses,
-                       const std::string& owner) {
+                       const std::vector<py::dict>& interfaces, const std::string& reduction,
+                       const std::string& reference, const std::string& owner) {
              constexpr const char* fn = "FeBodyModel";
              FeBodyOptions o;
              o.modes = intArg(modes, fn, "modes");
@@ -584,11 +585,61 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                if (a < 0) throw InputError(std::string(fn) + ": point_masses: no node " + std::to_string(id));
                o.pointMasses.push_back({a, mass});
              }
+             // interfaces: dicts as the scene's objects, {"name", "kind", "nodes" | "node_set", "point"}
+             for (const py::dict& d : interfaces) {
+               FeInterface f;
+               for (const auto& item : d) {
+                 const std::string key = py::str(item.first);
+                 if (key != "name" && key != "kind" && key != "nodes" && key != "node_set" && key != "point") {
+                   throw InputError(std::string(fn) + ": interfaces: unknown key '" + key +
+                                    "' (expected name, kind, nodes or node_set, point)");
+                 }
+               }
+               f.name = d.contains("name") ? py::str(d["name"]).cast<std::string>() : std::string("interface");
+               const std::string kind = d.contains("kind") ? d["kind"].cast<std::string>() : "averaging";
+               if (kind != "rigid" && kind != "averaging") {
+                 throw InputError(std::string(fn) + ": interface '" + f.name + "': kind must be 'rigid' or 'averaging'");
+               }
+               f.kind = kind == "rigid" ? FeInterfaceKind::Rigid : FeInterfaceKind::Averaging;
+               if (d.contains("node_set") == d.contains("nodes")) {
+                 throw InputError(std::string(fn) + ": interface '" + f.name + "': give exactly one of nodes or node_set");
+               }
+               if (d.contains("node_set")) {
+                 const std::string set = d["node_set"].cast<std::string>();
+                 const auto it = data.nodeSets.find(set);
+                 if (it == data.nodeSets.end()) {
+                   throw InputError(std::string(fn) + ": interface '" + f.name + "': no node set '" + set + "'");
+                 }
+                 f.nodes = it->second;
+               } else {
+                 for (int id : d["nodes"].cast<std::vector<int>>()) {
+                   const int a = data.nodeIndex(id);
+                   if (a < 0) throw InputError(std::string(fn) + ": interface '" + f.name + "': no node " + std::to_string(id));
+                   f.nodes.push_back(a);
+                 }
+               }
+               if (d.contains("point")) {
+                 f.atCentroid = false;
+                 f.point = vec3Arg(d["point"], fn, "interfaces[].point");
+               }
+               o.interfaces.push_back(std::move(f));
+             }
+             if (reduction != "free_free" && reduction != "craig_bampton") {
+               throw InputError(std::string(fn) + ": reduction must be 'free_free' or 'craig_bampton', got '" + reduction + "'");
+             }
+             if (reduction == "craig_bampton") {
+               o.reduction = FeReduction::CraigBampton;
+               o.reference = reference;
+             }
              return std::make_shared<FeBodyModel>(data, o, owner);
            }),
            py::arg("data"), py::arg("modes") = 8, py::arg("stiffness_scale") = 1.0, py::arg("damping_ratio") = 0.0,
-           py::arg("point_masses") = std::vector<std::pair<int, double>>{}, py::arg("owner") = "FE body",
-           "point_masses: [(FE node number, kg), ...]")
+           py::arg("point_masses") = std::vector<std::pair<int, double>>{},
+           py::arg("interfaces") = std::vector<py::dict>{}, py::arg("reduction") = "free_free",
+           py::arg("reference") = "", py::arg("owner") = "FE body",
+           "point_masses: [(FE node number, kg), ...]; interfaces: [{'name', 'kind': 'rigid' | 'averaging', "
+           "'nodes': [numbers] or 'node_set': name, 'point': (x, y, z)}, ...]; reduction 'free_free' or "
+           "'craig_bampton' with reference (a rigid interface's name)")
       .def_property_readonly(
           "invariants", [](const FeBodyModel& mdl) { return mdl.invariants(); },
           "A copy of the reduced invariants (FfrInvariants3d): add them with System.add_flexible_body_3d")

@@ -338,6 +338,21 @@ def test_an_fe_body_from_python_is_the_scene_body():
     scene.system.finalize()
     assert from_scene.system.coordinate_names() == scene.system.coordinate_names()
     assert len(scene.system.coordinate_names()) == 7 + 4
+    # Craig-Bampton on rigid interfaces over the shaft's end faces (the node numbers at
+    # z = 0 and z = 0.5): 6 constraint modes of the free end and 4 fixed-interface modes,
+    # the two frames appended to the 115 nodes as attachment points
+    ends = {0.0: [], 0.5: []}
+    for node, x in zip(data.node_ids, data.coordinates):
+        for z in ends:
+            if abs(x[2] - z) < 1e-6:
+                ends[z].append(node)
+    cb = flexmbd.FeBodyModel(data, modes=4, stiffness_scale=0.01, reduction="craig_bampton", reference="bottom",
+                             interfaces=[{"name": "bottom", "kind": "rigid", "nodes": ends[0.0]},
+                                         {"name": "top", "kind": "rigid", "nodes": ends[0.5]}])
+    assert cb.invariants.num_elastic == 6 + 4 and len(cb.invariants.points) == 115 + 2
+    assert len(cb.natural_frequencies) == 4
+    with pytest.raises(flexmbd.InputError, match="interface 'x'.*no node set 'nope'"):
+        flexmbd.FeBodyModel(data, interfaces=[{"name": "x", "kind": "rigid", "node_set": "nope"}])
     with pytest.raises(flexmbd.InputError, match="point_masses: no node 9999"):
         flexmbd.FeBodyModel(data, point_masses=[(9999, 1.0)])
     with pytest.raises(flexmbd.InputError, match="no_such.inp"):
