@@ -36,11 +36,14 @@
 #include "io/fe_calculix.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
+#include "fe_test_support.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::testsupport;
 namespace fs = std::filesystem;
+using flexmbd::fetest::errorOf;
+using flexmbd::fetest::expectMentions;
 using json = nlohmann::json;
 
 namespace {
@@ -398,6 +401,37 @@ TEST_F(CalculixBar, StaticTipLoadThroughARigidInterfaceEqualsCcxs) {
               worst / largest);
 }
 
+namespace {
+
+/// The bar reduced by Craig-Bampton: a rigid root (FIX) as the reference, a rigid tip
+/// interface (TIP, its point kTipPoint: 6 constraint modes), 4 fixed-interface modes.
+FeBodyOptions craigBamptonBar(const FeBodyData& d) {
+  FeBodyOptions o;
+  o.modes = 4;
+  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
+  FeInterface tip{"tip", d.nodeSets.at("TIP"), FeInterfaceKind::Rigid};
+  tip.atCentroid = false;
+  tip.point = kTipPoint;
+  o.interfaces.push_back(tip);
+  o.reduction = FeReduction::CraigBampton;
+  o.reference = "root";
+  return o;
+}
+
+/// The static tip load in the reduced coordinates: (B^T K B) q = B^T f, f at the tip
+/// frame's DOF (the last 6 of the nodal DOF).
+VecX staticTipSolution(const FeBodyModel& m) {
+  const MatX K = MatX(m.nodalInvariants().kff);
+  const int n = static_cast<int>(K.rows());
+  VecX f = VecX::Zero(n);
+  f.segment<3>(n - 6) = kTipForce;
+  f.segment<3>(n - 3) = kTipMoment;
+  const MatX& B = m.basis();
+  return (B.transpose() * K * B).ldlt().solve(B.transpose() * f);
+}
+
+}  // namespace
+
 TEST_F(CalculixBar, StressOfAStaticTipLoadRecoveredFromStressShapesEqualsCcxs) {
   // The bar reduced by Craig-Bampton on a rigid root (FIX) with a rigid tip interface (6
   // constraint modes) and 4 fixed-interface modes. Stress samples from ccx: the six unit
@@ -408,30 +442,14 @@ TEST_F(CalculixBar, StressOfAStaticTipLoadRecoveredFromStressShapesEqualsCcxs) {
   // digits (E12.5, 5e-6 of each value) and the unit cases combine with weights up to 1e3:
   // 1e-4 of the largest von Mises stress.
   const FeBodyData d = bar();
-  FeBodyOptions o;
-  o.modes = 4;
-  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
-  FeInterface tip{"tip", d.nodeSets.at("TIP"), FeInterfaceKind::Rigid};
-  tip.atCentroid = false;
-  tip.point = kTipPoint;
-  o.interfaces.push_back(tip);
-  o.reduction = FeReduction::CraigBampton;
-  o.reference = "root";
-  const FeBodyModel m(d, o, "bar");
+  const FeBodyModel m(d, craigBamptonBar(d), "bar");
   const FeStressSamples samples =
       joinedSamples(stressSamplesFromFrd(readCalculixFrd(job("unit_cases.frd")), d, "unit_cases.frd", "bar"),
                     stressSamplesFromFrd(readCalculixFrd(job("fixed_fixed.frd")), d, "fixed_fixed.frd", "bar"));
   ASSERT_EQ(samples.displacement.cols(), 6 + 10);
   const MatX S = stressShapes(m, samples, "bar");
   ASSERT_EQ(S.cols(), 6 + 4);
-  // static: (B^T K B) q = B^T f, f at the tip's frame DOF (the last 6 of the nodal DOF)
-  const MatX K = MatX(m.nodalInvariants().kff);
-  const int n = static_cast<int>(K.rows());
-  VecX f = VecX::Zero(n);
-  f.segment<3>(n - 6) = kTipForce;
-  f.segment<3>(n - 3) = kTipMoment;
-  const MatX& B = m.basis();
-  const VecX q = (B.transpose() * K * B).ldlt().solve(B.transpose() * f);
+  const VecX q = staticTipSolution(m);
   const VecX sigma = S * q;
   const FrdResults ccx = readCalculixFrd(job("static.frd"));
   ASSERT_EQ(ccx.steps.size(), 1u);
@@ -483,23 +501,8 @@ TEST_F(CalculixBar, SceneStressOutputAndVtkSurfaceOfTheStaticTipLoad) {
       {json{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}},
        json{{"name", "tip"}, {"kind", "rigid"}, {"node_set", "TIP"}, {"point", {kTipPoint.x(), kTipPoint.y(), kTipPoint.z()}}}});
   // the static solution in the body's coordinates, from the model of the same options
-  FeBodyOptions o;
-  o.modes = 4;
-  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
-  FeInterface tip{"tip", d.nodeSets.at("TIP"), FeInterfaceKind::Rigid};
-  tip.atCentroid = false;
-  tip.point = kTipPoint;
-  o.interfaces.push_back(tip);
-  o.reduction = FeReduction::CraigBampton;
-  o.reference = "root";
-  const FeBodyModel m(d, o, "bar");
-  const MatX K = MatX(m.nodalInvariants().kff);
-  const int n = static_cast<int>(K.rows());
-  VecX f = VecX::Zero(n);
-  f.segment<3>(n - 6) = kTipForce;
-  f.segment<3>(n - 3) = kTipMoment;
-  const MatX& B = m.basis();
-  const VecX qf = (B.transpose() * K * B).ldlt().solve(B.transpose() * f);
+  const FeBodyModel m(d, craigBamptonBar(d), "bar");
+  const VecX qf = staticTipSolution(m);
   body["elastic_coordinates"] = std::vector<double>(qf.data(), qf.data() + qf.size());
   json outputs = json::array();
   for (int a : d.nodeSets.at("FIX")) {
@@ -748,22 +751,9 @@ class CalculixFiles : public ::testing::Test {
                         const std::string& mas = matrixText(2.0)) {
     return {write("job.inp", deck()), write("job.sti", sti), write("job.mas", mas), write("job.dof", dof)};
   }
-  template <class F>
-  std::string errorOf(F f) {
-    try {
-      f();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "expected InputError";
-    return "";
-  }
   fs::path dir_;
 };
 
-void expectMentions(const std::string& msg, std::initializer_list<std::string> parts) {
-  for (const std::string& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
-}
 
 }  // namespace
 

@@ -31,11 +31,14 @@
 #include "io/fe_abaqus.hpp"
 #include "io/fe_ansys.hpp"
 #include "free_body_drift.hpp"
+#include "fe_test_support.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::testsupport;
 namespace fs = std::filesystem;
+using flexmbd::fetest::errorOf;
+using flexmbd::fetest::expectMentions;
 
 namespace {
 
@@ -371,23 +374,9 @@ class FeFiles : public ::testing::Test {
     for (int i = 1; i <= 12; ++i) s += std::to_string(i) + " " + std::to_string(i) + "  " + std::to_string(diag) + "\n";
     return write(name, s + extra);
   }
-  /// The message of the InputError `f` throws (fails if none).
-  template <class F>
-  std::string errorOf(F f) {
-    try {
-      f();
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    ADD_FAILURE() << "expected InputError";
-    return "";
-  }
   fs::path dir_;
 };
 
-void expectMentions(const std::string& msg, std::initializer_list<std::string> parts) {
-  for (const std::string& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
-}
 
 }  // namespace
 

@@ -18,12 +18,14 @@
 #include "integrators/simulation.hpp"
 #include "io/fe_abaqus.hpp"
 #include "io/scene.hpp"
+#include "fe_test_support.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::testsupport;
 using json = nlohmann::json;
 namespace fs = std::filesystem;
+using flexmbd::fetest::expectMentions;
 
 namespace {
 
@@ -48,17 +50,7 @@ json rotorScene(const json& extra = json::object()) {
 const FfrBody3d& rotorOf(const Scene& s) { return dynamic_cast<const FfrBody3d&>(s.system.body(BodyIndex(1))); }
 
 std::string errorOf(const json& scene, const std::string& source = kSceneInDataDir) {
-  try {
-    parseSceneText(scene.dump(), source);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected InputError";
-  return "";
-}
-
-void expectMentions(const std::string& msg, std::initializer_list<std::string> parts) {
-  for (const std::string& p : parts) EXPECT_NE(msg.find(p), std::string::npos) << "'" << p << "' not in: " << msg;
+  return fetest::errorOf([&] { parseSceneText(scene.dump(), source); });
 }
 
 FeBodyData abaqusRotor() {
