@@ -4,6 +4,7 @@
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
+//   flexmbd sid SCENE.json --body NAME --out FILE    (app/sid_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -21,6 +22,7 @@
 
 #include "app/command_line.hpp"
 #include "app/modes_command.hpp"
+#include "app/sid_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
 #include "core/errors.hpp"
@@ -56,6 +58,7 @@ const char* const kUsage =
     "                    [--labels L1,L2] [--title TEXT] [--deg]\n"
     "       flexmbd modes SCENE.json --out DIR [--at T] [--count N] [--steady]\n"
     "                     [--sweep NAME:FROM:TO:N] [--solver auto|dense|sparse]\n"
+    "       flexmbd sid SCENE.json --body NAME --out FILE.SID_FEM\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -110,6 +113,10 @@ const char* const kUsage =
     "--solver: dense (Eigen), sparse (Spectra shift-invert) or auto (dense up to 400\n"
     "independent coordinates).\n"
     "\n"
+    "sid writes the Standard Input Data (SID, Wallrapp 1994) of the spatial flexible body\n"
+    "NAME of SCENE.json to FILE: a reduced body for other multibody codes, or for a\n"
+    "\"sid_body\" of a flexmbd scene (see docs/fe-import.md, \"SID\").\n"
+    "\n"
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
@@ -153,7 +160,7 @@ Options parseCommandLine(int argc, char** argv) {
   }
   if (args[0] != "run") {
     throw UsageError("unknown command '" + args[0] +
-                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', '--help' or '--version')");
+                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', 'sid', '--help' or '--version')");
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
@@ -314,6 +321,12 @@ int mainImpl(int argc, char** argv) {
     bool help = false;
     for (const auto& a : rest) help = help || a == "--help" || a == "-h";
     if (!help) return runKinematicsCommand(rest);  // same exit statuses 0/1/2
+  }
+  if (argc >= 2 && std::string(argv[1]) == "sid") {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return runSidCommand(rest);
   }
   if (argc >= 2 && std::string(argv[1]) == "modes") {
     const std::vector<std::string> rest(argv + 2, argv + argc);

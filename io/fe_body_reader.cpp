@@ -17,16 +17,11 @@ using jsonread::located;
 using jsonread::json;
 using jsonread::ObjectReader;
 
-namespace {
-
-/// Key `key` of `files`: a file path, relative to `baseDir` unless absolute.
 std::string filePath(const ObjectReader& files, const std::string& key, const std::string& baseDir) {
   const std::filesystem::path p(files.nonEmptyString(key));
   if (p.is_absolute() || baseDir.empty()) return p.string();
   return (std::filesystem::path(baseDir) / p).string();
 }
-
-}  // namespace
 
 FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
   static const std::array<const char*, 3> kFormats = {"abaqus", "ansys", "calculix"};

@@ -11,6 +11,10 @@
 
 namespace flexmbd::scenereaders {
 
+/// Key `key` of `r`: a file path, relative to `baseDir` (the scene file's folder) unless
+/// absolute. @throws InputError naming the key if it is not a non-empty string.
+std::string filePath(const jsonread::ObjectReader& r, const std::string& key, const std::string& baseDir);
+
 /// The FE data of the body object `r` (exactly one of the keys "abaqus", "ansys",
 /// "calculix"), each
 /// file path relative to `baseDir` unless absolute.

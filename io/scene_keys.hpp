@@ -95,6 +95,9 @@ inline const Keys kFeBody3d = {"name",         "type",        "position",      "
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
                                "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses",
                                "elastic_coordinates", "elastic_velocities"};
+inline const Keys kSidBody3d = {"name",     "type",           "position",           "orientation",
+                                "velocity", "angular_velocity", "file", "elastic_coordinates",
+                                "elastic_velocities"};
 inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
@@ -188,6 +191,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"invariants.3d", &kInvariants3d},
       {"invariants.point.3d", &kInvariantsPoint3d},
       {"body.fe_body.3d", &kFeBody3d},
+      {"body.sid_body.3d", &kSidBody3d},
       {"fe.files.abaqus", &kFeFilesAbaqus},
       {"fe.files.ansys", &kFeFilesAnsys},
       {"fe.files.calculix", &kFeFilesCalculix},
