@@ -314,16 +314,53 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   } else {
     basis_ = freeFreeModes(nodal_.kff, nodal_.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
   }
+  if (options.inertiaModes) addInertiaModes(options, R);
   reduced_ = nodal_.transformed(basis_.sparseView());
-  if (options.dampingRatio > 0.0) {
-    // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes, the
-    // last `modes` coordinates; none on constraint modes (Geradin & Rixen, 2.3)
-    const int nm = static_cast<int>(omega_.size()), nb = static_cast<int>(basis_.cols()) - nm;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < nm; ++i) t.emplace_back(nb + i, nb + i, 2.0 * options.dampingRatio * omega_[i]);
-    reduced_.dff.resize(basis_.cols(), basis_.cols());
-    reduced_.dff.setFromTriplets(t.begin(), t.end());
+  if (options.dampingRatio > 0.0) addModalDamping(options.dampingRatio);
+}
+
+void FeBodyModel::addInertiaModes(const FeBodyOptions& options, const MatX& R) {
+  const MatX F = nodal_.inertiaLoads();
+  const SpMat& K = nodal_.kff;
+  if (options.reduction == FeReduction::FreeFree) {
+    basis_ = withStaticResponses(K, nodal_.mff, basis_, freeStaticResponses(K, nodal_.mff, R, F, owner_));
+    return;
   }
+  // Craig-Bampton: K y = F on the DOF other than the reference interface's (held: y = 0)
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> free(n, 0);
+  for (int i : held_) free[i] = -1;
+  int nFree = 0;
+  for (int i = 0; i < n; ++i) free[i] = free[i] < 0 ? -1 : nFree++;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(K, j); it; ++it) {
+      if (free[it.row()] >= 0 && free[j] >= 0) t.emplace_back(free[it.row()], free[j], it.value());
+    }
+  }
+  SpMat Kf(nFree, nFree);
+  Kf.setFromTriplets(t.begin(), t.end());
+  MatX Ff(nFree, F.cols());
+  for (int i = 0; i < n; ++i) {
+    if (free[i] >= 0) Ff.row(free[i]) = F.row(i);
+  }
+  const Eigen::SimplicialLDLT<SpMat> ldlt(Kf);
+  const MatX Yf = ldlt.solve(Ff);
+  MatX Y = MatX::Zero(n, F.cols());
+  for (int i = 0; i < n; ++i) {
+    if (free[i] >= 0) Y.row(i) = Yf.row(free[i]);
+  }
+  basis_ = withStaticResponses(K, nodal_.mff, basis_, Y);
+}
+
+void FeBodyModel::addModalDamping(double zeta) {
+  // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes; none on
+  // constraint or inertia modes (Geradin & Rixen, 2.3)
+  const int nm = static_cast<int>(omega_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < nm; ++i) t.emplace_back(firstNormal_ + i, firstNormal_ + i, 2.0 * zeta * omega_[i]);
+  reduced_.dff.resize(basis_.cols(), basis_.cols());
+  reduced_.dff.setFromTriplets(t.begin(), t.end());
 }
 
 void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
@@ -381,6 +418,8 @@ void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
   }
   basis_.resize(n, Psi.cols() + Phi.cols());
   basis_ << Psi, Phi;
+  held_ = held;
+  firstNormal_ = static_cast<int>(Psi.cols());
 }
 
 }  // namespace flexmbd

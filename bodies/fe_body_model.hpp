@@ -55,6 +55,12 @@ struct FeBodyOptions {
   std::vector<FeInterface> interfaces;  ///< their points follow the nodes' in the invariants
   FeReduction reduction = FeReduction::FreeFree;
   std::string reference;  ///< Craig-Bampton: the rigid interface the frame follows
+  /// Append the static responses to the inertia loads of the frame's rigid motion
+  /// (FfrInvariants3d::inertiaLoads: translation and the linear acceleration fields of
+  /// rotation), less what the modes hold: the quasi-static deformation by the body's own
+  /// inertia (a spinning rotor's stretch) is then held exactly. Free-free: with inertia
+  /// relief (freeStaticResponses); Craig-Bampton: with the reference interface held.
+  bool inertiaModes = false;
 };
 
 class FeBodyModel {
@@ -80,7 +86,8 @@ class FeBodyModel {
   /// The modes (nodal DOF x modes, columns M-normalised, M-orthogonal to the rigid motions).
   const MatX& basis() const { return basis_; }
   /// Their natural frequencies, rad/s (Craig-Bampton: of the fixed-interface modes, which
-  /// follow the 6 constraint modes of each boundary interface in the basis).
+  /// follow the 6 constraint modes of each boundary interface in the basis; inertia
+  /// modes, if any, come last).
   const VecX& naturalFrequencies() const { return omega_; }
   /// The six dropped rigid-body eigenvalues (rad^2/s^2; round-off of zero; free-free only).
   const VecX& rigidEigenvalues() const { return rigidEigenvalues_; }
@@ -95,12 +102,19 @@ class FeBodyModel {
   void addInterfaces(const FeBodyData& d, const FeBodyOptions& options, MatX& R);
   /// basis_ and omega_ of the Craig-Bampton reduction (FeReduction::CraigBampton).
   void reduceCraigBampton(const FeBodyOptions& options);
+  /// basis_ extended by the inertia modes (FeBodyOptions::inertiaModes); `R` the rigid
+  /// motions of the nodal DOF (free-free).
+  void addInertiaModes(const FeBodyOptions& options, const MatX& R);
+  /// D_ff = diag(2 zeta omega) on the normal modes (firstNormal_ ...), none elsewhere.
+  void addModalDamping(double zeta);
 
   std::string owner_;
   FfrInvariants3d nodal_, reduced_;
   SpMat map_;
   int firstInterface_ = 0;
   std::vector<int> masterColumn_;  // per interface: its first column in nodal_ (rigid), or -1
+  std::vector<int> held_;          // Craig-Bampton: the reference interface's DOF in nodal_
+  int firstNormal_ = 0;            // the first normal mode's column in basis_
   MatX basis_;
   VecX omega_, rigidEigenvalues_;
 };

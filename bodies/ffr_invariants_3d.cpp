@@ -107,6 +107,15 @@ void FfrInvariants3d::validateSectionRotation(const std::string& owner) const {
   }
 }
 
+MatX FfrInvariants3d::inertiaLoads() const {
+  MatX F(numElastic(), 12);
+  F.leftCols(3) = sBar.transpose();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) F.col(3 + 3 * k + l) = positionShape[k].row(l).transpose();
+  }
+  return F;
+}
+
 FfrInvariants3d FfrInvariants3d::transformed(const SpMat& P) const {
   FfrInvariants3d r;
   transformInto(P, r);

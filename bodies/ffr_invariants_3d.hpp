@@ -49,6 +49,12 @@ struct FfrInvariants3d : FfrInvariantsBase<3> {
   void validateSectionRotation(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
   FfrInvariants3d transformed(const SpMat& P) const;
+  /// The inertia loads of the frame's rigid accelerations (nf x 12): int rho N^T dV (the
+  /// columns of S-bar^T, a translation) and int rho N_l^T u0_k dV (row l of
+  /// positionShape[k], column 3 + 3 k + l: the linear fields W u0 of the rotation's
+  /// accelerations alpha x u0 + omega x (omega x u0)). Their static responses are the
+  /// inertia modes (withStaticModes, bodies/modal_reduction.hpp).
+  MatX inertiaLoads() const;
 
  private:
   /// S_lk = S_kl^T (k < l) to 1e-10 max |m_ff|.

@@ -58,6 +58,7 @@ FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
   o.stiffnessScale = r.positive("stiffness_scale", 1.0);
   o.dampingRatio = r.nonNegative("damping_ratio", 0.0);
   if (o.dampingRatio > 1.0) r.fail("key \"damping_ratio\" must be in [0, 1], got " + fmt(o.dampingRatio));
+  o.inertiaModes = r.boolean("inertia_modes", false);
   const json& masses = r.array("point_masses");
   for (std::size_t k = 0; k < masses.size(); ++k) {
     const ObjectReader p(masses[k], r.where() + ".point_masses[" + std::to_string(k) + "]");

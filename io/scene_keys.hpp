@@ -93,7 +93,7 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses",
+                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses", "inertia_modes",
                                "elastic_coordinates", "elastic_velocities"};
 inline const Keys kSidBody3d = {"name",     "type",           "position",           "orientation",
                                 "velocity", "angular_velocity", "file", "elastic_coordinates",

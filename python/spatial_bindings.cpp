@@ -574,7 +574,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def(py::init([](const FeBodyData& data, const py::object& modes, const py::object& scale,
                        const py::object& damping, const std::vector<std::pair<int, double>>& pointMasses,
                        const std::vector<py::dict>& interfaces, const std::string& reduction,
-                       const std::string& reference, const std::string& owner) {
+                       const std::string& reference, bool inertiaModes, const std::string& owner) {
              constexpr const char* fn = "FeBodyModel";
              FeBodyOptions o;
              o.modes = intArg(modes, fn, "modes");
@@ -631,15 +631,17 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                o.reduction = FeReduction::CraigBampton;
                o.reference = reference;
              }
+             o.inertiaModes = inertiaModes;
              return std::make_shared<FeBodyModel>(data, o, owner);
            }),
            py::arg("data"), py::arg("modes") = 8, py::arg("stiffness_scale") = 1.0, py::arg("damping_ratio") = 0.0,
            py::arg("point_masses") = std::vector<std::pair<int, double>>{},
            py::arg("interfaces") = std::vector<py::dict>{}, py::arg("reduction") = "free_free",
-           py::arg("reference") = "", py::arg("owner") = "FE body",
+           py::arg("reference") = "", py::arg("inertia_modes") = false, py::arg("owner") = "FE body",
            "point_masses: [(FE node number, kg), ...]; interfaces: [{'name', 'kind': 'rigid' | 'averaging', "
            "'nodes': [numbers] or 'node_set': name, 'point': (x, y, z)}, ...]; reduction 'free_free' or "
-           "'craig_bampton' with reference (a rigid interface's name)")
+           "'craig_bampton' with reference (a rigid interface's name); inertia_modes: append the static "
+           "responses to the frame's inertia loads")
       .def_property_readonly(
           "invariants", [](const FeBodyModel& mdl) { return mdl.invariants(); },
           "A copy of the reduced invariants (FfrInvariants3d): add them with System.add_flexible_body_3d")
