@@ -308,6 +308,7 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
     v.points.push_back(std::move(p));
   }
 
+  if (options.spinStiffening.preloadedStiffness.size()) addSpinStiffening(d, options);
   addInterfaces(d, options, R);
   if (options.reduction == FeReduction::CraigBampton) {
     reduceCraigBampton(options);
@@ -317,6 +318,54 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
   if (options.inertiaModes) addInertiaModes(options, R);
   reduced_ = nodal_.transformed(basis_.sparseView());
   if (options.dampingRatio > 0.0) addModalDamping(options.dampingRatio);
+}
+
+void FeBodyModel::addSpinStiffening(const FeBodyData& d, const FeBodyOptions& o) {
+  const FeSpinStiffening& st = o.spinStiffening;
+  const int nd = d.numDofs();
+  const double w2 = st.spin.squaredNorm();
+  if (!(w2 > 0.0) || !std::isfinite(w2)) {
+    throw InputError(owner_ + ": spin stiffening: the preload spin is " + fmt(std::sqrt(w2)) +
+                     " rad/s; expected the spin of the preloaded export, not zero");
+  }
+  if (st.preloadedStiffness.rows() != nd || st.preloadedStiffness.cols() != nd) {
+    throw InputError(owner_ + ": spin stiffening: the preloaded stiffness is " +
+                     std::to_string(st.preloadedStiffness.rows()) + " x " + std::to_string(st.preloadedStiffness.cols()) +
+                     "; expected the body's " + std::to_string(nd) + " DOF");
+  }
+  // the DOF the preload run held must be held by the body too: its Craig-Bampton reference
+  std::vector<char> reference(d.numNodes(), 0);
+  bool haveReference = false;
+  for (const FeInterface& f : o.interfaces) {
+    if (o.reduction == FeReduction::CraigBampton && f.name == o.reference && f.kind == FeInterfaceKind::Rigid) {
+      haveReference = true;
+      for (int a : f.nodes) reference[a] = 1;
+    }
+  }
+  if (!haveReference) {
+    throw InputError(owner_ + ": spin stiffening needs \"reduction\": \"craig_bampton\" with a rigid reference "
+                     "interface over the nodes the preload run held (a spinning body is held at its hub)");
+  }
+  std::vector<char> held(nd, 0);
+  for (int i : st.heldDofs) {
+    held[i] = 1;
+    if (!reference[d.dofs[i].node]) {
+      throw InputError(owner_ + ": spin stiffening: the preload run held node " + std::to_string(d.nodeIds[d.dofs[i].node]) +
+                       ", which the reference interface '" + o.reference + "' does not hold");
+    }
+  }
+  // K_sigma = K_pre - K + |w|^2 M_perp on the DOF the export has (the held ones: zero)
+  const Vec3 e = st.spin / std::sqrt(w2);
+  SpMat Mperp(nd, nd);
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) Mperp += ((k == l ? 1.0 : 0.0) - e[k] * e[l]) * nodal_.sKL[k][l];
+  SpMat Ksigma = st.preloadedStiffness - d.stiffness + w2 * Mperp;
+  Ksigma.prune([&](Eigen::Index r, Eigen::Index c, double) { return !held[r] && !held[c]; });
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      if (e[k] * e[l] != 0.0) nodal_.spinStiffness[k][l] = (e[k] * e[l] / w2) * Ksigma;
+    }
+  }
 }
 
 void FeBodyModel::addInertiaModes(const FeBodyOptions& options, const MatX& R) {

@@ -41,6 +41,9 @@ std::array<MatX, 3> crossShapeIntegrals(const Mat3Grid& S) {
   return {S[1][2] - S[2][1], S[2][0] - S[0][2], S[0][1] - S[1][0]};
 }
 
+/// The axes (a, b) of Oe's column c: w-bar_c = w_a w_b.
+constexpr std::array<std::pair<int, int>, 6> kOeColumn = {{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}}};
+
 /// The row of Oe for a change E = dJ/dq_j of the second moment: the centrifugal force
 /// Q_j = 1/2 w^T (dI/dq_j) w (Lagrange, T = 1/2 w^T I(q) w) with Oe w-bar = -Q_j, w-bar =
 /// (w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z).
@@ -171,6 +174,42 @@ void readSectionRotationMoment(const SidData& sid, const Mat3Grid& S, FfrInvaria
   }
 }
 
+/// G_ab from Oe's first-order term beyond the inertia (the spin softening and the
+/// centrifugal terms of the S_kl, R_kl): Oe.M1_k(j, c) - inertia = (1 or 2) G_ab(j, k).
+/// None when within kSidConsistency of Oe.M1's size.
+void readSpinStiffness(const SidData& sid, FfrInvariants3d& inv, const std::string& owner) {
+  if (sid.Oe.name.empty() || sid.Oe.order < 1) return;
+  const int n = sid.numElastic();
+  const SidTaylor inertia = sidFromInvariants(inv, sid.modeNames).Oe;
+  std::array<std::array<MatX, 3>, 3> G;
+  double scale = 0.0, largest = 0.0;
+  for (int c = 0; c < 6; ++c) {
+    const auto [a, b] = kOeColumn[c];
+    G[a][b] = MatX::Zero(n, n);
+    for (int k = 0; k < n; ++k) {
+      for (int j = 0; j < n; ++j) {
+        const double e = sid.Oe.m1[k](j, c) - inertia.m1[k](j, c);
+        G[a][b](j, k) = e / (a == b ? 1.0 : 2.0);
+        scale = std::max(scale, std::abs(sid.Oe.m1[k](j, c)));
+        largest = std::max(largest, std::abs(e));
+      }
+    }
+  }
+  if (largest <= kSidConsistency * scale) return;
+  for (int c = 0; c < 6; ++c) {
+    const auto [a, b] = kOeColumn[c];
+    const double asym = (G[a][b] - G[a][b].transpose()).cwiseAbs().maxCoeff();
+    if (asym > kSidConsistency * scale) {
+      std::ostringstream os;
+      os << "block Oe: its first-order terms beyond the inertia (the geometric stiffness per w-bar_" << c + 1
+         << ") are not symmetric in the elastic coordinates (by " << asym << "); expected a stiffness matrix";
+      fail(owner, os.str());
+    }
+    inv.spinStiffness[a][b] = sparse(0.5 * (G[a][b] + G[a][b].transpose()));
+    inv.spinStiffness[b][a] = inv.spinStiffness[a][b];
+  }
+}
+
 // ----- reading: the redundant blocks ---------------------------------------------
 
 /// Entry (i, j) of term `t` ("m0(i, j)", "m1(i, j, k)"; 1-based as in the file).
@@ -229,7 +268,7 @@ void checkRedundantBlocks(const SidData& sid, const FfrInvariants3d& inv, const 
   gr0.m1.clear();
   requireEqualBlock(gr0, want.Gr, sP, sM, owner, "Gr", "");
   requireEqualBlock(sid.Ge, want.Ge, sM, sM, owner, "Ge", "");
-  requireEqualBlock(sid.Oe, want.Oe, sP, sM, owner, "Oe", stiffening);
+  requireEqualBlock(sid.Oe, want.Oe, sP, sM, owner, "Oe", "");
   if (!sid.ksigma.name.empty()) {
     requireEqualBlock(sid.ksigma, SidTaylor::zero("ksigma", 0, sid.ksigma.nrow, 1, 0, SidTaylor::Zero), sM, sM,
                       owner, "ksigma",
@@ -328,6 +367,11 @@ SidData sidFromInvariants(const FfrInvariants3d& inv, std::vector<std::string> m
       s.Gr.m1[k].block<3, 3>(0, 3 * j) = -2.0 * G;
       C2 = 2.0 * quadraticSecondMoment(S, inv, j, k);
       s.Oe.m1[k].row(j) = centrifugalRow(C2);
+      for (int c = 0; c < 6; ++c) {  // spin stiffening: Q_j -= sum_ab w_a w_b G_ab(j, k) q_k
+        const auto [a, b] = kOeColumn[c];
+        const SpMat& G = inv.spinStiffness[a][b];
+        if (G.size()) s.Oe.m1[k](j, c) += (a == b ? 1.0 : 2.0) * G.coeff(j, k);
+      }
       for (int i = 0; i < 3; ++i) {
         s.Cr.m1[k](j, i) = W[i](k, j) + (inv.hI[i].size() ? inv.hI[i].coeff(k, j) : 0.0);  // int N_k~ N_j + H
         s.Ge.m0(k, 3 * j + i) = 2.0 * W[i](k, j);                                          // 2 int N^T N_j~
@@ -385,6 +429,7 @@ FfrInvariants3d invariantsFromSid(const SidData& sid, const std::string& owner) 
   }
   readSectionRotationCoupling(sid, crossShapeIntegrals(S), inv);
   readSectionRotationMoment(sid, S, inv, owner);
+  readSpinStiffness(sid, inv, owner);
   for (const SidNode& nd : sid.nodes) {
     FfrPoint3d p;
     p.position = nd.origin.m0.col(0);

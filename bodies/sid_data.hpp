@@ -55,7 +55,8 @@ struct SidData {
   SidTaylor Me;      ///< nq x nq: m_ff
   SidTaylor Gr;      ///< 3 x 3 nq: block j = -2 int rho u~ N_j~ dV (gyroscopic, rotation rows)
   SidTaylor Ge;      ///< nq x 3 nq: block j = 2 int rho N^T N_j~ dV (gyroscopic, elastic rows)
-  SidTaylor Oe;      ///< nq x 6: centrifugal, columns w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z
+  SidTaylor Oe;      ///< nq x 6: centrifugal, columns w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z;
+                     ///< its first-order term holds the spin softening and stiffening
   SidTaylor ksigma;  ///< nq x 1: generalised forces of reference stresses (flexmbd: none)
   SidTaylor Ke;      ///< nq x nq: K_ff
   SidTaylor De;      ///< nq x nq: D_ff
@@ -68,19 +69,22 @@ struct SidData {
 
 /// The SID of a spatial body's invariants: every block from m, the first and second
 /// moments, the position shapes, S-bar, the S_kl, m_ff, K_ff, D_ff, and the section
-/// rotation terms R_kl (J to second order) and H_i (in Cr's first-order term) where the
-/// invariants have them; nodes from the points. `modeNames` (nf of them; empty: "q1", ...).
+/// rotation terms R_kl (J to second order) and H_i (in Cr's first-order term) and the spin
+/// stiffness G_kl (in Oe's first-order term) where the invariants have them; nodes from
+/// the points. `modeNames` (nf of them; empty: "q1", ...).
 SidData sidFromInvariants(const FfrInvariants3d& inv, std::vector<std::string> modeNames = {});
 
 /// The invariants of a SID. Read from mass, mdCM, J, Cr (zeroth and first order), Me, Gr
-/// (first order: the S_kl), Ke, De and the nodes; the other blocks (Ct, Ge, Oe, the
-/// nodes' origin M1 and AP) are redundant and must equal what those give, to
-/// kSidConsistency of each Taylor term's largest entry, so a file written in other
-/// conventions is refused rather than misread.
+/// (first order: the S_kl), Ke, De, Oe's first-order terms beyond the inertia (the spin
+/// stiffness G_kl) and the nodes; the other blocks (Ct, Ge, Oe's inertia part, the nodes'
+/// origin M1 and AP) are redundant and must equal what those give, to kSidConsistency of
+/// each Taylor term's largest entry, so a file written in other conventions is refused
+/// rather than misread.
 /// @throws InputError naming `owner`, the block and the entry: sizes that do not match
-/// nelastq, a redundant block that differs (Oe's or a node's first-order terms beyond the
-/// inertia: geometric stiffening, not supported), reference stresses (ksigma not zero),
-/// Gr without its first-order term (the S_kl), or invariants that fail their checks.
+/// nelastq, a redundant block that differs (Ct's or a node's phi's first-order terms:
+/// stiffening by translational acceleration or by nodal forces, not supported), reference
+/// stresses (ksigma not zero), Gr without its first-order term (the S_kl), a spin
+/// stiffness that is not symmetric, or invariants that fail their checks.
 FfrInvariants3d invariantsFromSid(const SidData& sid, const std::string& owner);
 
 /// The redundant blocks agree when they differ by at most this fraction of the Taylor

@@ -93,7 +93,7 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses", "inertia_modes",
+                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses", "inertia_modes", "spin_stiffening",
                                "elastic_coordinates", "elastic_velocities"};
 inline const Keys kSidBody3d = {"name",     "type",           "position",           "orientation",
                                 "velocity", "angular_velocity", "file", "elastic_coordinates",
@@ -102,6 +102,7 @@ inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
 inline const Keys kFeStresses = {"calculix_frd"};
+inline const Keys kFeSpinStiffening = {"calculix", "spin"};
 inline const Keys kFePointMass = {"node", "mass"};
 inline const Keys kFeInterface = {"name", "kind", "nodes", "node_set", "point"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
@@ -197,6 +198,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"fe.files.calculix", &kFeFilesCalculix},
       {"fe.point_mass", &kFePointMass},
       {"fe.stresses", &kFeStresses},
+      {"fe.spin_stiffening", &kFeSpinStiffening},
       {"fe.interface", &kFeInterface},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},

@@ -243,7 +243,7 @@ void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const st
                         std::vector<FeBodyDrawing>* drawings) {
   r.allowOnly(scenekeys::kFeBody3d, " for an fe_body in a spatial scene");
   const FeBodyData data = readFeBodyFiles(r, baseDir);
-  const FeBodyOptions options = readFeBodyOptions(r, data);
+  const FeBodyOptions options = readFeBodyOptions(r, data, baseDir);
   const std::string owner = "body '" + name + "'";
   const FeBodyModel model = located(r.where(), [&] { return FeBodyModel(data, options, owner); });
   FeBodyDrawing drawing;

@@ -115,6 +115,20 @@ TEST(SidRoundTrip, ModalTimoshenkoBeamGivesItsInvariants) {
   EXPECT_TRUE(hasEntries(back.rKL[1][1]) && hasEntries(back.hI[0]));
 }
 
+TEST(SidRoundTrip, SpinStiffnessComesBack) {
+  FfrInvariants3d inv = beam(4, BeamTheory::EulerBernoulli)->invariants();
+  for (int k = 0; k < 3; ++k)
+    for (int l = k; l < 3; ++l) inv.spinStiffness[k][l] = inv.spinStiffness[l][k] = (1.0 + k - l) * 1e-2 * inv.kff;
+  const FfrInvariants3d back = roundTrip(inv, "spin.SID_FEM");
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) {
+      // through Oe's sum with the inertia terms: round-off of those (larger) entries
+      const MatX a(inv.spinStiffness[k][l]), b(back.spinStiffness[k][l]);
+      ASSERT_EQ(b.rows(), a.rows());
+      EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-12 * MatX(inv.kff).cwiseAbs().maxCoeff());
+    }
+}
+
 TEST(SidRoundTrip, NodalBeamGivesItsInvariantsAndKeepsTheirSparsity) {
   const auto model = beam(0, BeamTheory::EulerBernoulli);
   const FfrInvariants3d& inv = model->invariants();
@@ -143,10 +157,15 @@ TEST(SidConventions, InertiaAndCentreOfMassOfAUniformBeamAboutItsEnd) {
 
 TEST(SidConventions, OeIsMinusTheBodysCentrifugalForce) {
   // With R' = 0 and q_f' = 0 the velocity-dependent forces on q_f are the centrifugal
-  // forces 1/2 w^T dI/dq_f w (Lagrange); the SID puts them on the left: Oe(q) w-bar.
+  // forces 1/2 w^T dI/dq_f w (Lagrange) and the spin stiffening -sum w_k w_l G_kl q_f;
+  // the SID puts them on the left: Oe(q) w-bar.
+  // With a spin stiffness G_kl (here made up, symmetric) Oe's first-order term holds it too.
   const auto model = beam(6, BeamTheory::Timoshenko);
-  const FfrBody3d body("beam", model, FrameState3d{});
-  const SidData sid = sidFromInvariants(model->invariants());
+  FfrInvariants3d inv = model->invariants();
+  for (int k = 0; k < 3; ++k)
+    for (int l = k; l < 3; ++l) inv.spinStiffness[k][l] = inv.spinStiffness[l][k] = (1.0 + k + 3 * l) * 1e-2 * inv.kff;
+  const FfrBody3d body("beam", inv, FrameState3d{});
+  const SidData sid = sidFromInvariants(inv);
   const int nf = body.numElastic();
   VecX q = body.initialCoordinates(), v = VecX::Zero(6 + nf);
   for (int k = 0; k < nf; ++k) q[7 + k] = 0.01 * std::sin(1.0 + k);  // deformed: Oe's first order
@@ -351,11 +370,19 @@ TEST(SidReader, StructureAndDuplicatesAreChecked) {
 
 TEST(SidReader, BlocksThatDisagreeOrCarryStiffeningAreRefused) {
   const SidData sid = sidFromInvariants(beam(2, BeamTheory::EulerBernoulli)->invariants());
-  // Oe's first-order term beyond the inertia: geometric stiffening, not read
+  // Oe's first-order term beyond the inertia is the spin stiffness: read when symmetric
+  // in the elastic coordinates, refused when not
   SidData stiff = sid;
-  stiff.Oe.m1[0](0, 2) += 1e-3 * stiff.Oe.m1[0].cwiseAbs().maxCoeff() + 1.0;
-  expectMentions(errorOf([&] { invariantsFromSid(stiff, "body 'b'"); }),
-                 {"body 'b': SID block Oe, m1(1, 3, 1)", "geometric stiffening"});
+  const double g = 1e-2 * stiff.Oe.m1[0].cwiseAbs().maxCoeff();
+  stiff.Oe.m1[1](0, 2) += g;  // G_zz(0, 1)
+  SidData asym = stiff;
+  stiff.Oe.m1[0](1, 2) += g;  // G_zz(1, 0)
+  const FfrInvariants3d read = invariantsFromSid(stiff, "body 'b'");
+  ASSERT_EQ(read.spinStiffness[2][2].rows(), 2);
+  EXPECT_NEAR(read.spinStiffness[2][2].coeff(0, 1), g, 1e-12 * g);
+  EXPECT_NEAR(read.spinStiffness[0][1].coeff(0, 1), 0.0, 1e-12 * g);
+  expectMentions(errorOf([&] { invariantsFromSid(asym, "body 'b'"); }),
+                 {"body 'b': SID block Oe", "not symmetric", "expected a stiffness matrix"});
   // Ct in another convention (not S-bar^T)
   SidData ct = sid;
   ct.Ct.m0(1, 0) += 0.1;
