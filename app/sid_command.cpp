@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "app/command_line.hpp"
+#include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/sid_data.hpp"
 #include "core/errors.hpp"
@@ -46,13 +47,17 @@ int runSidCommand(const std::vector<std::string>& args) {
     const Scene scene = loadScene(scenePath);
     const FfrBody3d& body = flexibleBody(scene, a.values.at("--body"), scenePath);
     const std::string& out = a.values.at("--out");
-    writeSidFile(sidFromInvariants(body.invariants()), out);
+    FfrInvariants3d inv = body.invariants();
+    const bool stiffening = body.model() && body.model()->geometricStiffening();
+    if (stiffening) inv.spinStiffness = linearSpinStiffness(*body.model());
+    writeSidFile(sidFromInvariants(inv), out);
     std::cout << "flexmbd: sid: body '" << body.name() << "': " << body.invariants().points.size() << " nodes, "
               << body.numElastic() << " elastic coordinates, mass " << fmt(body.mass(), 6) << " kg; wrote "
               << out << std::endl;
-    if (body.model() && body.model()->geometricStiffening()) {
-      std::cout << "flexmbd: sid: note: the beam's geometric stiffening (its second-order strain energy) is not in "
-                   "the SID, which holds the linear stiffness K_ff"
+    if (stiffening) {
+      std::cout << "flexmbd: sid: note: the beam's geometric stiffening is written as its spin stiffness (Oe's "
+                   "first-order term), linearised about the undeformed beam; stiffening by other loads is not in "
+                   "the SID"
                 << std::endl;
     }
     return kExitOk;

@@ -9,8 +9,8 @@
 namespace flexmbd {
 
 /// `args` are the arguments after "sid". Writes FILE; prints what it wrote (nodes, elastic
-/// coordinates, mass) and, for a beam with geometric stiffening, that the SID holds its
-/// linear stiffness only. Returns 0; 2 on bad input (one line "flexmbd: error: ..." naming
+/// coordinates, mass) and, for a beam with geometric stiffening, that its stiffening is
+/// written as the spin stiffness linearised about the undeformed beam (linearSpinStiffness). Returns 0; 2 on bad input (one line "flexmbd: error: ..." naming
 /// the option, the body or the file).
 int runSidCommand(const std::vector<std::string>& args);
 

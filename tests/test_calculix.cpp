@@ -923,26 +923,6 @@ TEST(CalculixModes, ClampedModesRefuseAFreeBodyAndBadArguments) {
 
 // ----- spin stiffening from a prestressed export -----------------------------------
 
-namespace {
-
-/// The natural frequencies (Hz, ascending) of the body's elastic coordinates linearised
-/// about q_f = 0 with its frame spinning steadily at w about z (the frame's motion
-/// prescribed, Coriolis terms left out as ccx's perturbation frequencies leave them):
-/// K = -dQ_f/dq_f of the body's own internal forces, M = m_ff.
-VecX spinningFrequencies(const FfrInvariants3d& inv, double w) {
-  const FfrBody3d body("bar", inv, FrameState3d{});
-  const int nf = body.numElastic();
-  const VecX q = body.initialCoordinates();
-  VecX v = VecX::Zero(6 + nf);
-  v[5] = w;
-  MatX dQdq = MatX::Zero(6 + nf, 7 + nf), dQdv = MatX::Zero(6 + nf, 6 + nf);
-  body.addInternalForceJacobians(q, v, dQdq, dQdv);
-  const MatX K = -dQdq.block(6, 7, nf, nf);
-  const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> es(0.5 * (K + K.transpose()), MatX(inv.mff));
-  return es.eigenvalues().cwiseSqrt() / (2.0 * kPi);
-}
-
-}  // namespace
 
 TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) {
   // The bar clamped at its root (a rigid interface, the Craig-Bampton reference), spinning
@@ -967,7 +947,7 @@ TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) 
   o.spinStiffening.spin = Vec3(0.0, 0.0, 100.0);
   EXPECT_EQ(o.spinStiffening.heldDofs.size(), 3 * d.nodeSets.at("FIX").size());
   const FeBodyModel model(d, o, "bar");
-  const VecX f50 = spinningFrequencies(model.invariants(), 50.0);
+  const VecX f50 = fetest::spinningFrequencies(model.invariants(), 50.0);
   std::vector<double> ccx;
   for (const FrdStep& st : readCalculixFrd(job("spin_50.frd")).steps) {
     if (st.type == 2) ccx.push_back(st.value);
@@ -978,9 +958,9 @@ TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) 
     EXPECT_NEAR(f50[i] / ccx[i], 1.0, 1e-4) << "mode " << i + 1;
     worst = std::max(worst, std::abs(f50[i] / ccx[i] - 1.0));
   }
-  const VecX f0 = spinningFrequencies(model.invariants(), 0.0);
-  const double w = 50.0, southwell = 1.1933;  // first flapwise mode of a uniform cantilever, hub radius 0
-  const auto coefficient = [&](int i) { return (std::pow(2 * kPi * f50[i], 2) - std::pow(2 * kPi * f0[i], 2)) / (w * w); };
+  const VecX f0 = fetest::spinningFrequencies(model.invariants(), 0.0);
+  const double southwell = fetest::kSouthwellCantilever;
+  const auto coefficient = [&](int i) { return fetest::southwellCoefficient(f50[i], f0[i], 50.0); };
   EXPECT_NEAR(coefficient(0), southwell - 1.0, 0.02);  // in the plane of rotation: softened by w^2
   EXPECT_NEAR(coefficient(1), southwell, 0.02);        // out of it
   std::printf("[ figures ] spin stiffening (ccx prestressed export at 100 rad/s, scaled to 50): frequencies vs ccx "
