@@ -96,6 +96,16 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
+/// A shell snippet (ending in "; ") that waits until the text file `path` has at least
+/// `rows` lines, at most 60 s: a run has then installed its signal handlers and written its
+/// first rows. Signal tests send their signal after it, not after a fixed delay (too short
+/// on a loaded machine or under the sanitizers: a background job of a non-interactive
+/// shell ignores SIGINT until the program installs its handler).
+inline std::string waitForRows(const fs::path& path, int rows) {
+  return "for i in $(seq 600); do [ \"$(wc -l 2>/dev/null < " + shellQuote(path.string()) + " || echo 0)\" -ge " +
+         std::to_string(rows) + " ] && break; sleep 0.1; done; ";
+}
+
 /// One line starting with "flexmbd: error:".
 ::testing::AssertionResult IsOneErrorLine(const std::string& err) {
   if (err.rfind("flexmbd: error:", 0) != 0) return ::testing::AssertionFailure() << "stderr: " << err;

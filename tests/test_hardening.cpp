@@ -275,9 +275,13 @@ TEST_F(Hardening, FullDiskInKinematicsKeepsWholeRows) {
 TEST_F(Hardening, SignalsEndTheRunWithAnInterruptedSummary) {
   for (const auto& [signal, status] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
     const fs::path out = dir_ / ("out_" + signal);
-    // 1e4 s of the driven crank: about 10 s of computing; the signal comes after 1 s.
+    // 1e4 s of the driven crank: about 10 s of computing; the signal comes once the run
+    // has written its first row (its handlers are in place: a fixed delay is not enough on
+    // a slow machine or under the sanitizers, and a background job of a non-interactive
+    // shell ignores SIGINT until the program installs its handler).
     const CliResult r = runShell("\"$F\" run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) +
-                                 " --quiet --t-end 10000 & pid=$!; sleep 1; kill -" + signal + " $pid; wait $pid");
+                                 " --quiet --t-end 10000 & pid=$!; " + waitForRows(out / "results.csv", 2) +
+                                 "kill -" + signal + " $pid; wait $pid");
     EXPECT_EQ(r.status, status) << signal << ": " << r.err;
     EXPECT_TRUE(IsOneErrorLine(r.err));
     EXPECT_NE(r.err.find("interrupted by SIG" + signal), std::string::npos) << r.err;

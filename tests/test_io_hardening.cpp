@@ -150,7 +150,7 @@ TEST_F(IoHardening, ASecondRunIntoAFolderInUseIsRefusedAndTouchesNothing) {
   // run A: the driven crank for 1e4 s (seconds of computing); run B starts while A runs
   const CliResult r = runShell(
       "\"$F\" run " + shellQuote(kExample) + " --out " + shellQuote(out.string()) +
-      " --quiet --t-end 10000 & a=$!; sleep 1; \"$F\" run " +
+      " --quiet --t-end 10000 & a=$!; " + waitForRows(out / "results.csv", 2) + "\"$F\" run " +
       shellQuote((fs::path(kSourceDir) / "examples" / "tensegrity_two_masses.json").string()) + " --out " +
       shellQuote(out.string()) + "; echo \"B=$?\"; \"$F\" kinematics " +
       shellQuote(kSourceDir + "/examples/kinematics_slider_crank.json") + " --out " + shellQuote(out.string()) +
@@ -190,7 +190,8 @@ TEST_F(IoHardening, SigintStopsARunWithinItsStepNotAtTheNextOutput) {
   j["solver"]["output_step"] = 1e4;  // one output, at t_end (minutes of computing)
   const fs::path out = dir_ / "out";
   const CliResult r = runShell("\"$F\" run " + shellQuote(writeScene("sparse.json", j).string()) + " --out " +
-                               shellQuote(out.string()) + " --quiet & pid=$!; sleep 1; kill -INT $pid; "
+                               shellQuote(out.string()) + " --quiet & pid=$!; " +
+                               waitForRows(out / "results.csv", 2) + "kill -INT $pid; "
                                "start=$(date +%s%N); wait $pid; rc=$?; "
                                "echo \"waited_ms $(( ($(date +%s%N) - start) / 1000000 ))\"; exit $rc");
   EXPECT_EQ(r.status, 130) << r.err;
@@ -212,8 +213,8 @@ TEST_F(IoHardening, KinematicsHandlesSigintAndSigtermAsRunDoes) {
   for (const auto& [signal, status] : {std::pair<std::string, int>{"INT", 130}, {"TERM", 143}}) {
     const fs::path out = dir_ / ("out_" + signal);
     const CliResult r = runShell("\"$F\" kinematics " + shellQuote(writeScene("long.json", j).string()) +
-                                 " --out " + shellQuote(out.string()) + " & pid=$!; sleep 1; kill -" + signal +
-                                 " $pid; wait $pid");
+                                 " --out " + shellQuote(out.string()) + " & pid=$!; " +
+                                 waitForRows(out / "kinematics.csv", 2) + "kill -" + signal + " $pid; wait $pid");
     EXPECT_EQ(r.status, status) << r.err;  // before: killed by the signal
     EXPECT_TRUE(IsOneErrorLine(r.err));
     EXPECT_TRUE(Contains(r.err, "interrupted by SIG" + signal + " while computing t = "));
@@ -232,7 +233,8 @@ TEST_F(IoHardening, TensegrityRunStoppedBySigintCountsItsSteps) {
   j["solver"]["output_step"] = 1.0;
   const fs::path out = dir_ / "out";
   const CliResult r = runShell("\"$F\" run " + shellQuote(writeScene("long.json", j).string()) + " --out " +
-                               shellQuote(out.string()) + " --quiet & pid=$!; sleep 1; kill -INT $pid; wait $pid");
+                               shellQuote(out.string()) + " --quiet & pid=$!; " +
+                               waitForRows(out / "results.csv", 2) + "kill -INT $pid; wait $pid");
   EXPECT_EQ(r.status, 130) << r.err;
   const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
   EXPECT_EQ(summary.at("status"), "interrupted");
