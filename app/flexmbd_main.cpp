@@ -1,6 +1,7 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
-//   flexmbd kinematics SCENE.json --out DIR [...]   (linkage/kinematics_command.cpp)
+//     (scenes with "model": "tensegrity": app/tensegrity_command.cpp)
+//   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
@@ -20,9 +21,11 @@
 #include <vector>
 
 #include "app/command_line.hpp"
+#include "app/kinematics_command.hpp"
 #include "app/modes_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
+#include "app/tensegrity_command.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
@@ -30,8 +33,6 @@
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
-#include "linkage/kinematics_command.hpp"
-#include "tensegrity/tensegrity_command.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -204,7 +205,7 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
 }
 
 int runCommand(const Options& o) {
-  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (tensegrity/tensegrity_command.cpp)
+  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
     if (o.format != ResultsFormat::Csv) {
       printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
                  "events.csv)");
