@@ -116,9 +116,10 @@ const char* const kUsage =
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
-    "singular position (results up to there are kept), or plot could not draw (no\n"
-    "matplotlib); 2 invalid command line, scene or model (nothing is integrated), a\n"
-    "missing or malformed summary.json, an unknown results column.\n";
+    "singular position (results up to there are kept), or the eigensolver of modes did not\n"
+    "converge, or plot could not draw (no matplotlib); 2 invalid command line, scene or\n"
+    "model (nothing is integrated), a missing or malformed summary.json, an unknown\n"
+    "results column.\n";
 
 
 struct Options {
