@@ -1,6 +1,7 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
-//   flexmbd kinematics SCENE.json --out DIR [...]   (linkage/kinematics_command.cpp)
+//     (scenes with "model": "tensegrity": app/tensegrity_command.cpp)
+//   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
@@ -21,10 +22,12 @@
 #include <vector>
 
 #include "app/command_line.hpp"
+#include "app/kinematics_command.hpp"
 #include "app/modes_command.hpp"
 #include "app/sid_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
+#include "app/tensegrity_command.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
@@ -32,8 +35,6 @@
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
-#include "linkage/kinematics_command.hpp"
-#include "tensegrity/tensegrity_command.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -62,9 +63,11 @@ const char* const kUsage =
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
-    "Simulates the planar multibody model described by SCENE.json (see docs/scene-format.md)\n"
-    "and writes DIR/results.csv (one row per output time; results.h5 with --format hdf5)\n"
-    "and DIR/summary.json.\n"
+    "run simulates the model described by SCENE.json: a multibody model, planar or spatial\n"
+    "(\"dimension\": 3), of rigid and flexible bodies (see docs/scene-format.md), or a\n"
+    "tensegrity structure (\"model\": \"tensegrity\", docs/tensegrity.md); it writes\n"
+    "DIR/results.csv (one row per output time; results.h5 with --format hdf5) and\n"
+    "DIR/summary.json.\n"
     "\n"
     "options of run:\n"
     "  --out DIR    output directory (created if needed; required)\n"
@@ -120,9 +123,10 @@ const char* const kUsage =
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
-    "singular position (results up to there are kept), or plot could not draw (no\n"
-    "matplotlib); 2 invalid command line, scene or model (nothing is integrated), a\n"
-    "missing or malformed summary.json, an unknown results column.\n";
+    "singular position (results up to there are kept), or the eigensolver of modes did not\n"
+    "converge, or plot could not draw (no matplotlib); 2 invalid command line, scene or\n"
+    "model (nothing is integrated), a missing or malformed summary.json, an unknown\n"
+    "results column.\n";
 
 
 struct Options {
@@ -211,7 +215,7 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
 }
 
 int runCommand(const Options& o) {
-  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (tensegrity/tensegrity_command.cpp)
+  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
     if (o.format != ResultsFormat::Csv) {
       printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
                  "events.csv)");
