@@ -212,7 +212,7 @@ TEST(QuasiStaticStart, SpinningRodStartsStretchedByItsCentrifugalLoad) {
               qs.iterations, qs.residual);
   EXPECT_NEAR(ux / uTip, 1.0, kStretchTolerance);
   // steady rotation: the quasi-static rate is zero (the stretch does not change)
-  const BodyModes& m = elasticModes(sys).at(0);
+  const BodyModes m = elasticModes(sys).at(0);  // a copy: elasticModes returns a temporary
   EXPECT_LT(qs.state.v.segment(m.velocityOffset, m.size()).lpNorm<Eigen::Infinity>(), 1e-9 * omega * uTip);
 }
 
