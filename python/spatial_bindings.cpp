@@ -16,6 +16,8 @@
 
 #include "bindings_support.hpp"
 #include "bodies/fe_body_model.hpp"
+#include "bodies/sid_data.hpp"
+#include "io/sid_file.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
@@ -542,6 +544,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             if (x.size() != 3) throw InputError("FfrInvariants3d.h_i: expected 3 matrices (x, y, z), nf x nf each");
             for (int k = 0; k < 3; ++k) v.hI[k] = x[k].sparseView();
           })
+      .def_property(
+          "spin_stiffness", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.spinStiffness); },
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.spinStiffness, x, "spin_stiffness"); })
       .def_property_readonly("num_elastic", [](const FfrInvariants3d& v) { return v.mff.rows(); })
       .def(
           "validate", [](const FfrInvariants3d& v, const std::string& owner) {
@@ -549,6 +554,16 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             v.validateSectionRotation(owner);
           },
           py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
+
+  // ----- the SID of a body (bodies/sid_data.hpp, io/sid_file.hpp) ----------------------------
+  m.def(
+      "write_sid", [](const FfrInvariants3d& inv, const std::string& path) { writeSidFile(sidFromInvariants(inv), path); },
+      py::arg("invariants"), py::arg("path"),
+      "Writes the Standard Input Data (SID text file) of spatial invariants (docs/fe-import.md, \"SID\")");
+  m.def(
+      "read_sid", [](const std::string& path, const std::string& owner) { return invariantsFromSid(readSidFile(path), owner); },
+      py::arg("path"), py::arg("owner") = "SID body",
+      "The invariants of a SID text file; InputError names the file and line, or the block and entry");
 
   // ----- bodies from FE codes (bodies/fe_body_model.hpp, io/fe_abaqus.hpp, io/fe_ansys.hpp) ----
   py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
