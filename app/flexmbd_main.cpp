@@ -1,9 +1,11 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
-//   flexmbd kinematics SCENE.json --out DIR [...]   (linkage/kinematics_command.cpp)
+//     (scenes with "model": "tensegrity": app/tensegrity_command.cpp)
+//   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
+//   flexmbd sid SCENE.json --body NAME --out FILE    (app/sid_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -20,9 +22,12 @@
 #include <vector>
 
 #include "app/command_line.hpp"
+#include "app/kinematics_command.hpp"
 #include "app/modes_command.hpp"
+#include "app/sid_command.hpp"
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
+#include "app/tensegrity_command.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
@@ -30,8 +35,6 @@
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
-#include "linkage/kinematics_command.hpp"
-#include "tensegrity/tensegrity_command.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -56,12 +59,15 @@ const char* const kUsage =
     "                    [--labels L1,L2] [--title TEXT] [--deg]\n"
     "       flexmbd modes SCENE.json --out DIR [--at T] [--count N] [--steady]\n"
     "                     [--sweep NAME:FROM:TO:N] [--solver auto|dense|sparse]\n"
+    "       flexmbd sid SCENE.json --body NAME --out FILE.SID_FEM\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
-    "Simulates the planar multibody model described by SCENE.json (see docs/scene-format.md)\n"
-    "and writes DIR/results.csv (one row per output time; results.h5 with --format hdf5)\n"
-    "and DIR/summary.json.\n"
+    "run simulates the model described by SCENE.json: a multibody model, planar or spatial\n"
+    "(\"dimension\": 3), of rigid and flexible bodies (see docs/scene-format.md), or a\n"
+    "tensegrity structure (\"model\": \"tensegrity\", docs/tensegrity.md); it writes\n"
+    "DIR/results.csv (one row per output time; results.h5 with --format hdf5) and\n"
+    "DIR/summary.json.\n"
     "\n"
     "options of run:\n"
     "  --out DIR    output directory (created if needed; required)\n"
@@ -110,12 +116,17 @@ const char* const kUsage =
     "--solver: dense (Eigen), sparse (Spectra shift-invert) or auto (dense up to 400\n"
     "independent coordinates).\n"
     "\n"
+    "sid writes the Standard Input Data (SID, Wallrapp 1994) of the spatial flexible body\n"
+    "NAME of SCENE.json to FILE: a reduced body for other multibody codes, or for a\n"
+    "\"sid_body\" of a flexmbd scene (see docs/fe-import.md, \"SID\").\n"
+    "\n"
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
-    "singular position (results up to there are kept), or plot could not draw (no\n"
-    "matplotlib); 2 invalid command line, scene or model (nothing is integrated), a\n"
-    "missing or malformed summary.json, an unknown results column.\n";
+    "singular position (results up to there are kept), or the eigensolver of modes did not\n"
+    "converge, or plot could not draw (no matplotlib); 2 invalid command line, scene or\n"
+    "model (nothing is integrated), a missing or malformed summary.json, an unknown\n"
+    "results column.\n";
 
 
 struct Options {
@@ -153,7 +164,7 @@ Options parseCommandLine(int argc, char** argv) {
   }
   if (args[0] != "run") {
     throw UsageError("unknown command '" + args[0] +
-                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', '--help' or '--version')");
+                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', 'sid', '--help' or '--version')");
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
@@ -204,7 +215,7 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
 }
 
 int runCommand(const Options& o) {
-  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (tensegrity/tensegrity_command.cpp)
+  if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
     if (o.format != ResultsFormat::Csv) {
       printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
                  "events.csv)");
@@ -314,6 +325,12 @@ int mainImpl(int argc, char** argv) {
     bool help = false;
     for (const auto& a : rest) help = help || a == "--help" || a == "-h";
     if (!help) return runKinematicsCommand(rest);  // same exit statuses 0/1/2
+  }
+  if (argc >= 2 && std::string(argv[1]) == "sid") {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return runSidCommand(rest);
   }
   if (argc >= 2 && std::string(argv[1]) == "modes") {
     const std::vector<std::string> rest(argv + 2, argv + argc);

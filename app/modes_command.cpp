@@ -340,6 +340,12 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
                                               "--title", "Campbell diagram: " + sw.name});
 }
 
+/// The simulation of --at reports an interrupt as its failure: exit 128 + signal.
+int interrupted(int sig) {
+  cli::printError("modes: interrupted by " + cli::signalName(sig) + " (the modes were not written)");
+  return 128 + sig;
+}
+
 }  // namespace
 
 int runModesCommand(const std::vector<std::string>& args) {
@@ -396,11 +402,12 @@ int runModesCommand(const std::vector<std::string>& args) {
   } catch (const InputError& e) {  // ModelError included: no equilibrium, no degree of freedom
     cli::printError(o.scenePath + ": " + e.what());
     return kExitInputError;
+  } catch (const SolverError& e) {  // the simulation to --at failed, an eigensolver did not converge
+    if (const int sig = cli::gStopSignal) return interrupted(sig);
+    cli::printError(o.scenePath + ": " + e.what());
+    return kExitFailure;
   } catch (const std::exception& e) {
-    if (const int sig = cli::gStopSignal) {  // the simulation of --at reports the interrupt as its failure
-      cli::printError("modes: interrupted by " + cli::signalName(sig) + " (the modes were not written)");
-      return 128 + sig;
-    }
+    if (const int sig = cli::gStopSignal) return interrupted(sig);
     cli::printError(e.what());
     return kExitFailure;
   }

@@ -11,8 +11,9 @@ namespace flexmbd {
 /// `args` are the arguments after "modes". Writes DIR/modes.csv, DIR/mode_shapes.csv,
 /// DIR/vtk/mode_NN.pvd (+ .vtu frames), with --sweep DIR/campbell.csv and campbell.png;
 /// prints a table and the natural frequencies of every beam body's model. Returns 0;
-/// 1 if the simulation to --at T or the plot failed; 2 on bad input (one line
-/// "flexmbd: error: ..." naming the option, key, body or driver).
+/// 1 if a solver failed (the simulation to --at T, an eigensolver that did not converge:
+/// SolverError) or the plot failed; 2 on bad input (one line "flexmbd: error: ..."
+/// naming the option, key, body or driver).
 int runModesCommand(const std::vector<std::string>& args);
 
 }  // namespace flexmbd

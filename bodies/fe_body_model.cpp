@@ -308,22 +308,108 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
     v.points.push_back(std::move(p));
   }
 
+  if (options.spinStiffening.preloadedStiffness.size()) addSpinStiffening(d, options);
   addInterfaces(d, options, R);
   if (options.reduction == FeReduction::CraigBampton) {
     reduceCraigBampton(options);
   } else {
     basis_ = freeFreeModes(nodal_.kff, nodal_.mff, R, options.modes, owner_, &omega_, &rigidEigenvalues_);
   }
+  if (options.inertiaModes) addInertiaModes(options, R);
   reduced_ = nodal_.transformed(basis_.sparseView());
-  if (options.dampingRatio > 0.0) {
-    // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes, the
-    // last `modes` coordinates; none on constraint modes (Geradin & Rixen, 2.3)
-    const int nm = static_cast<int>(omega_.size()), nb = static_cast<int>(basis_.cols()) - nm;
-    std::vector<Eigen::Triplet<double>> t;
-    for (int i = 0; i < nm; ++i) t.emplace_back(nb + i, nb + i, 2.0 * options.dampingRatio * omega_[i]);
-    reduced_.dff.resize(basis_.cols(), basis_.cols());
-    reduced_.dff.setFromTriplets(t.begin(), t.end());
+  if (options.dampingRatio > 0.0) addModalDamping(options.dampingRatio);
+}
+
+void FeBodyModel::addSpinStiffening(const FeBodyData& d, const FeBodyOptions& o) {
+  const FeSpinStiffening& st = o.spinStiffening;
+  const int nd = d.numDofs();
+  const double w2 = st.spin.squaredNorm();
+  if (!(w2 > 0.0) || !std::isfinite(w2)) {
+    throw InputError(owner_ + ": spin stiffening: the preload spin is " + fmt(std::sqrt(w2)) +
+                     " rad/s; expected the spin of the preloaded export, not zero");
   }
+  if (st.preloadedStiffness.rows() != nd || st.preloadedStiffness.cols() != nd) {
+    throw InputError(owner_ + ": spin stiffening: the preloaded stiffness is " +
+                     std::to_string(st.preloadedStiffness.rows()) + " x " + std::to_string(st.preloadedStiffness.cols()) +
+                     "; expected the body's " + std::to_string(nd) + " DOF");
+  }
+  // the DOF the preload run held must be held by the body too: its Craig-Bampton reference
+  std::vector<char> reference(d.numNodes(), 0);
+  bool haveReference = false;
+  for (const FeInterface& f : o.interfaces) {
+    if (o.reduction == FeReduction::CraigBampton && f.name == o.reference && f.kind == FeInterfaceKind::Rigid) {
+      haveReference = true;
+      for (int a : f.nodes) reference[a] = 1;
+    }
+  }
+  if (!haveReference) {
+    throw InputError(owner_ + ": spin stiffening needs \"reduction\": \"craig_bampton\" with a rigid reference "
+                     "interface over the nodes the preload run held (a spinning body is held at its hub)");
+  }
+  std::vector<char> held(nd, 0);
+  for (int i : st.heldDofs) {
+    held[i] = 1;
+    if (!reference[d.dofs[i].node]) {
+      throw InputError(owner_ + ": spin stiffening: the preload run held node " + std::to_string(d.nodeIds[d.dofs[i].node]) +
+                       ", which the reference interface '" + o.reference + "' does not hold");
+    }
+  }
+  // K_sigma = K_pre - K + |w|^2 M_perp on the DOF the export has (the held ones: zero)
+  const Vec3 e = st.spin / std::sqrt(w2);
+  SpMat Mperp(nd, nd);
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) Mperp += ((k == l ? 1.0 : 0.0) - e[k] * e[l]) * nodal_.sKL[k][l];
+  SpMat Ksigma = st.preloadedStiffness - d.stiffness + w2 * Mperp;
+  Ksigma.prune([&](Eigen::Index r, Eigen::Index c, double) { return !held[r] && !held[c]; });
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      if (e[k] * e[l] != 0.0) nodal_.spinStiffness[k][l] = (e[k] * e[l] / w2) * Ksigma;
+    }
+  }
+}
+
+void FeBodyModel::addInertiaModes(const FeBodyOptions& options, const MatX& R) {
+  const MatX F = nodal_.inertiaLoads();
+  const SpMat& K = nodal_.kff;
+  if (options.reduction == FeReduction::FreeFree) {
+    basis_ = withStaticResponses(K, nodal_.mff, basis_, freeStaticResponses(K, nodal_.mff, R, F, owner_));
+    return;
+  }
+  // Craig-Bampton: K y = F on the DOF other than the reference interface's (held: y = 0)
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> free(n, 0);
+  for (int i : held_) free[i] = -1;
+  int nFree = 0;
+  for (int i = 0; i < n; ++i) free[i] = free[i] < 0 ? -1 : nFree++;
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(K, j); it; ++it) {
+      if (free[it.row()] >= 0 && free[j] >= 0) t.emplace_back(free[it.row()], free[j], it.value());
+    }
+  }
+  SpMat Kf(nFree, nFree);
+  Kf.setFromTriplets(t.begin(), t.end());
+  MatX Ff(nFree, F.cols());
+  for (int i = 0; i < n; ++i) {
+    if (free[i] >= 0) Ff.row(free[i]) = F.row(i);
+  }
+  const Eigen::SimplicialLDLT<SpMat> ldlt(Kf);
+  const MatX Yf = ldlt.solve(Ff);
+  MatX Y = MatX::Zero(n, F.cols());
+  for (int i = 0; i < n; ++i) {
+    if (free[i] >= 0) Y.row(i) = Yf.row(free[i]);
+  }
+  basis_ = withStaticResponses(K, nodal_.mff, basis_, Y);
+}
+
+void FeBodyModel::addModalDamping(double zeta) {
+  // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes; none on
+  // constraint or inertia modes (Geradin & Rixen, 2.3)
+  const int nm = static_cast<int>(omega_.size());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < nm; ++i) t.emplace_back(firstNormal_ + i, firstNormal_ + i, 2.0 * zeta * omega_[i]);
+  reduced_.dff.resize(basis_.cols(), basis_.cols());
+  reduced_.dff.setFromTriplets(t.begin(), t.end());
 }
 
 void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
@@ -381,6 +467,8 @@ void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
   }
   basis_.resize(n, Psi.cols() + Phi.cols());
   basis_ << Psi, Phi;
+  held_ = held;
+  firstNormal_ = static_cast<int>(Psi.cols());
 }
 
 }  // namespace flexmbd

@@ -47,6 +47,20 @@ struct FeInterface {
 ///    interface held; M never factored, clampedModes).
 enum class FeReduction { FreeFree, CraigBampton };
 
+/// Centrifugal stiffening from the FE code's prestressed stiffness (docs/fe-import.md,
+/// "Spin stiffening"): K_pre, exported with the body held at the Craig-Bampton reference
+/// interface and spinning at `spin` (rad/s, body axes, about an axis through the frame
+/// origin), includes the stress stiffness K_sigma and the spin softening -|spin|^2 M_perp
+/// (M_perp = sum_kl (delta_kl - e_k e_l) S_kl, e = spin / |spin|), which the FFR body
+/// has of its own through the S_kl. So K_sigma = K_pre - K + |spin|^2 M_perp, and the
+/// stresses of a spin w scale with (w . e)^2: G_kl = e_k e_l K_sigma / |spin|^2
+/// (FfrInvariants3d::spinStiffness).
+struct FeSpinStiffening {
+  SpMat preloadedStiffness;  ///< K_pre in the data's DOF order (n x n); empty: none
+  std::vector<int> heldDofs;  ///< the DOF the preload run held (no equation in its export)
+  Vec3 spin = Vec3::Zero();   ///< the spin of the preload run, rad/s, body axes
+};
+
 struct FeBodyOptions {
   int modes = 8;                ///< free-free elastic modes kept (the six rigid ones dropped)
   double stiffnessScale = 1.0;  ///< K multiplied by it (EXUDYN's ScaleStiffnessMatrix; > 0)
@@ -55,6 +69,13 @@ struct FeBodyOptions {
   std::vector<FeInterface> interfaces;  ///< their points follow the nodes' in the invariants
   FeReduction reduction = FeReduction::FreeFree;
   std::string reference;  ///< Craig-Bampton: the rigid interface the frame follows
+  /// Append the static responses to the inertia loads of the frame's rigid motion
+  /// (FfrInvariants3d::inertiaLoads: translation and the linear acceleration fields of
+  /// rotation), less what the modes hold: the quasi-static deformation by the body's own
+  /// inertia (a spinning rotor's stretch) is then held exactly. Free-free: with inertia
+  /// relief (freeStaticResponses); Craig-Bampton: with the reference interface held.
+  bool inertiaModes = false;
+  FeSpinStiffening spinStiffening;  ///< Craig-Bampton only
 };
 
 class FeBodyModel {
@@ -80,7 +101,8 @@ class FeBodyModel {
   /// The modes (nodal DOF x modes, columns M-normalised, M-orthogonal to the rigid motions).
   const MatX& basis() const { return basis_; }
   /// Their natural frequencies, rad/s (Craig-Bampton: of the fixed-interface modes, which
-  /// follow the 6 constraint modes of each boundary interface in the basis).
+  /// follow the 6 constraint modes of each boundary interface in the basis; inertia
+  /// modes, if any, come last).
   const VecX& naturalFrequencies() const { return omega_; }
   /// The six dropped rigid-body eigenvalues (rad^2/s^2; round-off of zero; free-free only).
   const VecX& rigidEigenvalues() const { return rigidEigenvalues_; }
@@ -95,12 +117,22 @@ class FeBodyModel {
   void addInterfaces(const FeBodyData& d, const FeBodyOptions& options, MatX& R);
   /// basis_ and omega_ of the Craig-Bampton reduction (FeReduction::CraigBampton).
   void reduceCraigBampton(const FeBodyOptions& options);
+  /// nodal_.spinStiffness from options.spinStiffening (matrix DOF order, before the
+  /// interfaces condense it).
+  void addSpinStiffening(const FeBodyData& d, const FeBodyOptions& options);
+  /// basis_ extended by the inertia modes (FeBodyOptions::inertiaModes); `R` the rigid
+  /// motions of the nodal DOF (free-free).
+  void addInertiaModes(const FeBodyOptions& options, const MatX& R);
+  /// D_ff = diag(2 zeta omega) on the normal modes (firstNormal_ ...), none elsewhere.
+  void addModalDamping(double zeta);
 
   std::string owner_;
   FfrInvariants3d nodal_, reduced_;
   SpMat map_;
   int firstInterface_ = 0;
   std::vector<int> masterColumn_;  // per interface: its first column in nodal_ (rigid), or -1
+  std::vector<int> held_;          // Craig-Bampton: the reference interface's DOF in nodal_
+  int firstNormal_ = 0;            // the first normal mode's column in basis_
   MatX basis_;
   VecX omega_, rigidEigenvalues_;
 };

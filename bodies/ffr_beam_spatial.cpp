@@ -135,15 +135,7 @@ void SpatialBeam::meanAxisRotationRows(const Invariants& nodal, MatX& C, std::ve
   for (const char* axis : {"x", "y", "z"}) names.push_back(std::string("mean-axis rotation ") + axis);
 }
 
-MatX SpatialBeam::inertiaLoads(const Invariants& reduced) {
-  // the columns int rho N_l^T u0_k = row l of positionShape[k]
-  MatX F(reduced.numElastic(), 12);
-  F.leftCols(3) = reduced.sBar.transpose();
-  for (int k = 0; k < 3; ++k) {
-    for (int l = 0; l < 3; ++l) F.col(3 + 3 * k + l) = reduced.positionShape[k].row(l).transpose();
-  }
-  return F;
-}
+MatX SpatialBeam::inertiaLoads(const Invariants& reduced) { return reduced.inertiaLoads(); }
 
 Eigen::Matrix<double, 3, SpatialBeam::kElementDofs> SpatialBeam::bodyShape(const Element& el, double xi) {
   return el.rotation() * BeamElement3d::shape(xi, el.length(), el.shear());

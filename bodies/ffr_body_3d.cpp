@@ -112,6 +112,13 @@ void FfrBody3d::setUp() {
     }
   }
   for (auto& t : sectionRotation_) t.R.makeCompressed();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      const SpMat& G = inv_.spinStiffness[k][l];
+      if (G.size() != 0 && G.nonZeros() > 0) spinStiffening_.push_back({k, l, G});
+    }
+  }
+  for (auto& t : spinStiffening_) t.R.makeCompressed();
   for (int i = 0; i < 3; ++i) {
     if (inv_.hI[i].size() != 0 && inv_.hI[i].nonZeros() > 0) {
       h_[i] = inv_.hI[i];
@@ -247,7 +254,7 @@ Mat3 FfrBody3d::secondMomentAt(const ConstVecRef& qf) const {
 }
 
 void FfrBody3d::addSectionRotationMoment(const ConstVecRef& qf, Mat3& quadratic) const {
-  for (const SectionRotationTerm& t : sectionRotation_) quadratic(t.k, t.l) += bilinear(t.R, qf, qf);
+  for (const PairTerm& t : sectionRotation_) quadratic(t.k, t.l) += bilinear(t.R, qf, qf);
 }
 
 Mat3 FfrBody3d::secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const {
@@ -272,7 +279,7 @@ Mat3 FfrBody3d::secondMomentDerivative(const ConstVecRef& qf, int c) const {
     }
   }
   // d(qf^T R_kl qf)/dqf_c = 2 (R_kl qf)_c (R_kl symmetric), at (k, l) and (l, k)
-  for (const SectionRotationTerm& t : sectionRotation_) {
+  for (const PairTerm& t : sectionRotation_) {
     const double d = 2.0 * columnDot(t.R, c, qf);
     D(t.k, t.l) += d;
     if (t.k != t.l) D(t.l, t.k) += d;
@@ -473,7 +480,7 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   // The sections' second-order rotation: J_kl = J_lk gains qf^T R_kl qf, so G_kl = G_lk
   // gains qf'^T R_kl qf, and Q_f -sum_kl Om_kl R_kl qf (the term dT/dqf of
   // T = -(1/2) sum_kl Om_kl J_kl, as for S_kl)
-  for (const SectionRotationTerm& t : sectionRotation_) {
+  for (const PairTerm& t : sectionRotation_) {
     const double om = (t.k == t.l ? 1.0 : 2.0) * Om(t.k, t.l);
     double jq = 0.0, g = 0.0;
     for (int j = 0; j < t.R.outerSize(); ++j) {
@@ -513,6 +520,9 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
     addProduct(inv_.kff, qf, -1.0, Qf);
   }
   addProduct(inv_.dff, pf, -1.0, Qf);
+  for (const PairTerm& t : spinStiffening_) {  // centrifugal stiffening: -w_k w_l G_kl qf
+    addProduct(t.R, qf, -(t.k == t.l ? 1.0 : 2.0) * w[t.k] * w[t.l], Qf);
+  }
 }
 
 void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRef& v, const MatrixSink& dQdq,
@@ -529,7 +539,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) G(k, l) = inv_.positionShape[l].row(k).dot(pf) + bilinear(inv_.sKL[k][l], pf, qf);
   }
-  for (const SectionRotationTerm& t : sectionRotation_) {
+  for (const PairTerm& t : sectionRotation_) {
     const double g = bilinear(t.R, pf, qf);
     G(t.k, t.l) += g;
     if (t.k != t.l) G(t.l, t.k) += g;
@@ -558,7 +568,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
         Gp(a, b) = inv_.positionShape[b](a, k) + columnDot(inv_.sKL[b][a], k, qf);
       }
     }
-    for (const SectionRotationTerm& t : sectionRotation_) {
+    for (const PairTerm& t : sectionRotation_) {
       const double gq = columnDot(t.R, k, pf), gp = columnDot(t.R, k, qf);  // R symmetric
       Gq(t.k, t.l) += gq;
       Gp(t.k, t.l) += gp;
@@ -584,13 +594,16 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) dQdq.addSparse(6, 7, inv_.sKL[k][l], -Om(k, l));
   }
-  for (const SectionRotationTerm& t : sectionRotation_) {
+  for (const PairTerm& t : sectionRotation_) {
     dQdq.addSparse(6, 7, t.R, -(t.k == t.l ? 1.0 : 2.0) * Om(t.k, t.l));
   }
   if (model_) {
     model_->addStrainEnergyHessian(qf, -1.0, dQdq, 6, 7);
   } else {
     dQdq.addSparse(6, 7, inv_.kff, -1.0);
+  }
+  for (const PairTerm& t : spinStiffening_) {
+    dQdq.addSparse(6, 7, t.R, -(t.k == t.l ? 1.0 : 2.0) * w[t.k] * w[t.l]);
   }
   // dOm_kl/dw_j = d_kj w_l + w_k d_lj - 2 d_kl w_j
   for (int j = 0; j < 3; ++j) {
@@ -605,8 +618,12 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
           sum -= dOm(k, l) * (inv_.positionShape[l](k, m) + columnDot(inv_.sKL[l][k], m, qf));
         }
       }
-      for (const SectionRotationTerm& t : sectionRotation_) {
+      for (const PairTerm& t : sectionRotation_) {
         sum -= (t.k == t.l ? 1.0 : 2.0) * dOm(t.k, t.l) * columnDot(t.R, m, qf);
+      }
+      for (const PairTerm& t : spinStiffening_) {  // d(w_k w_l)/dw_j = d_jk w_l + w_k d_jl
+        const double dww = (j == t.k ? w[t.l] : 0.0) + (j == t.l ? w[t.k] : 0.0);
+        sum -= (t.k == t.l ? 1.0 : 2.0) * dww * columnDot(t.R, m, qf);
       }
       return sum - 2.0 * columnDot(w_[j], m, pf);  // (W_j qf')_m = -(W_j^T qf')_m
     });

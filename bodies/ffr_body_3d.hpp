@@ -160,13 +160,17 @@ class FfrBody3d final : public Body {
   std::vector<std::vector<int>> nodeSupport_;  // per node: the elastic coordinates its shapes use
   std::array<SpMat, 3> w_;   // W_x = S_yz - S_zy, W_y = S_zx - S_xz, W_z = S_xy - S_yx (skew):
                              // int rho (N a) x (N b) dV = (a^T W_i b)_i
-  /// R_kl (k <= l) of the invariants that are present and not zero: J gains qf^T R_kl qf
-  /// at (k, l) and (l, k) (FfrInvariants3d::rKL, the cross-sections' second-order rotation).
-  struct SectionRotationTerm {
+  /// A symmetric matrix R of a pair k <= l of body axes (the pairs' arrays of the invariants,
+  /// those present and not zero).
+  struct PairTerm {
     int k, l;
     SpMat R;
   };
-  std::vector<SectionRotationTerm> sectionRotation_;
+  /// R_kl: J gains qf^T R_kl qf at (k, l) and (l, k) (FfrInvariants3d::rKL, the
+  /// cross-sections' second-order rotation).
+  std::vector<PairTerm> sectionRotation_;
+  /// G_kl: Q_f gains -(1 or 2) w_k w_l G_kl qf (FfrInvariants3d::spinStiffness; 2 for k < l).
+  std::vector<PairTerm> spinStiffening_;
   /// H_i of the invariants (FfrInvariants3d::hI), or empty matrices (nf x nf, no entries)
   /// when absent: Y = int rho u~ N dV gains (qf^T H_i)_i, Q_theta -(qf'^T H_i qf')_i -
   /// w x (qf^T H_i qf')_i.

@@ -18,6 +18,7 @@ const char* kAxis[3] = {"x", "y", "z"};
 std::string sklName(int k, int l) { return std::string("s_") + kAxis[k] + kAxis[l]; }
 std::string rklName(int k, int l) { return std::string("r_") + kAxis[k] + kAxis[l]; }
 std::string hName(int i) { return std::string("h_") + kAxis[i]; }
+std::string gklName(int k, int l) { return std::string("spin_stiffness_") + kAxis[k] + kAxis[l]; }
 
 /// An optional invariant: absent (0 x 0) or n x n, finite and symmetric.
 void requireOptionalSymmetric(const SpMat& A, int n, const std::string& owner, const std::string& name) {
@@ -94,17 +95,32 @@ void FfrInvariants3d::validateSecondMoment(const std::string& owner) const {
 void FfrInvariants3d::validateSectionRotation(const std::string& owner) const {
   const int n = numElastic();
   for (int i = 0; i < 3; ++i) requireOptionalSymmetric(hI[i], n, owner, hName(i));
+  validateSymmetricPairs(rKL, rklName, owner);
+  validateSymmetricPairs(spinStiffness, gklName, owner);
+}
+
+void FfrInvariants3d::validateSymmetricPairs(const std::array<std::array<SpMat, 3>, 3>& pairs,
+                                             std::string (*name)(int, int), const std::string& owner) const {
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) {
-      const SpMat& R = rKL[k][l];
+      const SpMat& R = pairs[k][l];
       if (R.size() == 0) continue;  // none
-      requireOptionalSymmetric(R, n, owner, rklName(k, l));
-      if (l != k && (rKL[l][k].size() == 0 || maxAbs(SpMat(rKL[l][k] - R)) > 0.0)) {
-        throw InputError(owner + ": invariant " + rklName(l, k) + " differs from " + rklName(k, l) +
-                         "; expected R_lk = R_kl");
+      requireOptionalSymmetric(R, numElastic(), owner, name(k, l));
+      if (l != k && (pairs[l][k].size() == 0 || maxAbs(SpMat(pairs[l][k] - R)) > 0.0)) {
+        throw InputError(owner + ": invariant " + name(l, k) + " differs from " + name(k, l) + "; expected the " +
+                         "two to be equal");
       }
     }
   }
+}
+
+MatX FfrInvariants3d::inertiaLoads() const {
+  MatX F(numElastic(), 12);
+  F.leftCols(3) = sBar.transpose();
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) F.col(3 + 3 * k + l) = positionShape[k].row(l).transpose();
+  }
+  return F;
 }
 
 FfrInvariants3d FfrInvariants3d::transformed(const SpMat& P) const {
@@ -117,6 +133,7 @@ FfrInvariants3d FfrInvariants3d::transformed(const SpMat& P) const {
     for (int l = 0; l < 3; ++l) {
       r.sKL[k][l] = Pt * sKL[k][l] * P;
       if (rKL[k][l].size() != 0) r.rKL[k][l] = Pt * rKL[k][l] * P;
+      if (spinStiffness[k][l].size() != 0) r.spinStiffness[k][l] = Pt * spinStiffness[k][l] * P;
     }
     if (hI[k].size() != 0) r.hI[k] = Pt * hI[k] * P;
   }

@@ -39,20 +39,38 @@ struct FfrInvariants3d : FfrInvariantsBase<3> {
   /// sections' second-order displacement (BeamElement3d::sectionRotationCoupling): the
   /// kinetic energy gains w . (qf^T H_i qf')_i. Empty: none (zero under Euler-Bernoulli).
   std::array<SpMat, 3> hI;
+  /// spinStiffness[k][l] = G_kl (nf x nf, symmetric, G_lk = G_kl): the geometric stiffness
+  /// of the stresses a steady spin causes, per unit w_k w_l: Q_f gains -sum_kl w_k w_l G_kl
+  /// q_f (centrifugal stiffening of imported bodies: from an FE code's prestressed
+  /// stiffness, FeSpinStiffening, or a SID's Oe; docs/fe-import.md). Not the spin
+  /// softening, which the S_kl give. Empty (0 x 0): none (beams stiffen through their
+  /// strain energy instead).
+  std::array<std::array<SpMat, 3>, 3> spinStiffness;
 
   /// Sizes; symmetry of m_ff, K_ff, D_ff, S_kk; S_lk = S_kl^T; positive definiteness of
   /// m_ff and K_ff; D_ff positive semi-definite; the second moment symmetric positive
   /// semi-definite with |first moment|^2 <= m tr(second moment); finite entries.
   /// @throws InputError naming `owner` and the offending invariant.
   void validate(const std::string& owner) const;
-  /// rKL, hI: each absent or nf x nf, finite, symmetric; R_lk = R_kl.
+  /// rKL, hI, spinStiffness: each absent or nf x nf, finite, symmetric; R_lk = R_kl,
+  /// G_lk = G_kl.
   void validateSectionRotation(const std::string& owner) const;
   /// The invariants for q_f = P eta (modal reduction, change of coordinates).
   FfrInvariants3d transformed(const SpMat& P) const;
+  /// The inertia loads of the frame's rigid accelerations (nf x 12): int rho N^T dV (the
+  /// columns of S-bar^T, a translation) and int rho N_l^T u0_k dV (row l of
+  /// positionShape[k], column 3 + 3 k + l: the linear fields W u0 of the rotation's
+  /// accelerations alpha x u0 + omega x (omega x u0)). Their static responses are the
+  /// inertia modes (withStaticModes, bodies/modal_reduction.hpp).
+  MatX inertiaLoads() const;
 
  private:
   /// S_lk = S_kl^T (k < l) to 1e-10 max |m_ff|.
   void validateTransposedPairs(const std::string& owner) const;
+  /// Each of `pairs` absent or nf x nf, finite, symmetric, and pairs[l][k] = pairs[k][l]
+  /// (`name`: the invariant's name for the message).
+  void validateSymmetricPairs(const std::array<std::array<SpMat, 3>, 3>& pairs, std::string (*name)(int, int),
+                              const std::string& owner) const;
   /// The second moment symmetric positive semi-definite, m tr(J) >= |first moment|^2.
   void validateSecondMoment(const std::string& owner) const;
 };

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
 // GCC 12 warns -Wuse-after-free inside Spectra (Eigen temporaries freed and reallocated
 // by resize): a false positive of its inlining analysis (as integrators/linearization.cpp).
 #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
@@ -264,7 +265,10 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
 
 MatX withStaticModes(const SpMat& K, const SpMat& M, const MatX& basis, const MatX& F) {
   const Eigen::SimplicialLDLT<SpMat> ldlt(K);
-  MatX Y = ldlt.solve(F);  // static responses K y = f
+  return withStaticResponses(K, M, basis, ldlt.solve(F));  // static responses K y = f
+}
+
+MatX withStaticResponses(const SpMat& K, const SpMat& M, const MatX& basis, MatX Y) {
   double largest = 0.0;    // strain energy scale y^T K y of the largest static response
   for (int j = 0; j < Y.cols(); ++j) largest = std::max(largest, Y.col(j).dot(K * Y.col(j)));
   if (!(largest > 0.0)) return basis;
@@ -288,6 +292,35 @@ MatX withStaticModes(const SpMat& K, const SpMat& M, const MatX& basis, const Ma
     out.col(basis.cols() + static_cast<Eigen::Index>(k)) = y;
   }
   return out;
+}
+
+MatX freeStaticResponses(const SpMat& K, const SpMat& M, const MatX& R, const MatX& F, const std::string& owner) {
+  const int n = static_cast<int>(K.rows()), r = static_cast<int>(R.cols());
+  const MatX MR = M * R;
+  const MatX relieved = F - MR * (R.transpose() * MR).ldlt().solve(R.transpose() * F);  // inertia relief
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(K, j); it; ++it) t.emplace_back(it.row(), j, it.value());
+  }
+  for (int j = 0; j < r; ++j) {
+    for (int i = 0; i < n; ++i) {
+      if (MR(i, j) == 0.0) continue;
+      t.emplace_back(i, n + j, MR(i, j));
+      t.emplace_back(n + j, i, MR(i, j));
+    }
+  }
+  SpMat A(n + r, n + r);
+  A.setFromTriplets(t.begin(), t.end());
+  Eigen::SparseLU<SpMat> lu;
+  lu.compute(A);
+  if (lu.info() != Eigen::Success) {
+    throw InputError(owner + ": the stiffness has a zero-energy motion besides the six rigid ones (a mechanism); "
+                     "the static responses to the inertia loads are undefined");
+  }
+  MatX rhs = MatX::Zero(n + r, F.cols());
+  rhs.topRows(n) = relieved;
+  const MatX y = lu.solve(rhs);
+  return y.topRows(n);
 }
 
 }  // namespace flexmbd

@@ -115,4 +115,18 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
 /// (already held, or a zero load); the new columns are mass-normalised.
 MatX withStaticModes(const SpMat& K, const SpMat& M, const MatX& basis, const MatX& F);
 
+/// withStaticModes given the static responses Y (K Y = F) themselves: for a free body,
+/// whose K is singular (freeStaticResponses), or a clamped one solved on its free DOF.
+MatX withStaticResponses(const SpMat& K, const SpMat& M, const MatX& basis, MatX Y);
+
+/// The static responses of a free body (K R = 0 on its rigid motions R, n x 6) to the
+/// loads F with inertia relief: the part of F that accelerates the body rigidly removed,
+/// F' = F - M R (R^T M R)^-1 R^T F, and K y = F' solved with R^T M y = 0 (mean axes) as the
+/// saddle-point system [K  M R; R^T M  0] (y, lambda) = (F', 0) (sparse LU; lambda = 0
+/// since R^T F' = 0). Geradin & Rixen, Mechanical Vibrations, the section on inertia relief
+/// and the pseudo-inverse of a floating structure.
+/// @throws InputError naming `owner` if the system is singular (a mechanism besides the
+/// six rigid motions).
+MatX freeStaticResponses(const SpMat& K, const SpMat& M, const MatX& R, const MatX& F, const std::string& owner);
+
 }  // namespace flexmbd

@@ -2,6 +2,7 @@
 // that is wrong, what was found and what was expected.
 #pragma once
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -21,12 +22,16 @@ class ModelError : public InputError {
   explicit ModelError(const std::string& message) : InputError(message) {}
 };
 
-/// The time integrator failed during a run. Carries the time reached and the last
-/// step size; the message holds the solver's reason. Exit status 1.
+/// A solver failed on well-formed input: the time integrator during a run (carries the
+/// time reached and the last step size), or a solver outside a run that did not converge
+/// (an eigensolver: time and step size NaN). The message holds the solver's reason.
+/// Exit status 1.
 class SolverError : public std::runtime_error {
  public:
   SolverError(const std::string& message, double time, double stepSize)
       : std::runtime_error(message), time_(time), stepSize_(stepSize) {}
+  /// A solver outside a time integration (no time, no step size).
+  explicit SolverError(const std::string& message) : SolverError(message, std::nan(""), std::nan("")) {}
   double time() const { return time_; }
   double stepSize() const { return stepSize_; }
 

@@ -123,7 +123,8 @@ struct ModesOptions {
 
 /// The `count` lowest modes: eigenvalues with Im s >= 0 (one of each complex pair), by
 /// increasing |s|, then increasing Im s.
-/// @throws ModelError if the reduced mass matrix is singular or Spectra does not converge.
+/// @throws ModelError if the reduced mass matrix is singular; SolverError if an eigensolver
+/// does not converge (or the sparse one's shift is an eigenvalue).
 std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& options = {});
 
 /// Linearisation, reduction and modes in one call.

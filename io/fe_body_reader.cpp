@@ -17,16 +17,11 @@ using jsonread::located;
 using jsonread::json;
 using jsonread::ObjectReader;
 
-namespace {
-
-/// Key `key` of `files`: a file path, relative to `baseDir` unless absolute.
 std::string filePath(const ObjectReader& files, const std::string& key, const std::string& baseDir) {
   const std::filesystem::path p(files.nonEmptyString(key));
   if (p.is_absolute() || baseDir.empty()) return p.string();
   return (std::filesystem::path(baseDir) / p).string();
 }
-
-}  // namespace
 
 FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
   static const std::array<const char*, 3> kFormats = {"abaqus", "ansys", "calculix"};
@@ -57,12 +52,33 @@ FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
   return readAnsysFe(files);
 }
 
-FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data) {
+/// Key "spin_stiffening" of `r`: {"calculix": {"job"}, "spin": [wx, wy, wz]}.
+FeSpinStiffening readSpinStiffening(const ObjectReader& r, const FeBodyData& data, const std::string& baseDir) {
+  const ObjectReader st(r.object("spin_stiffening"), r.where() + ".spin_stiffening");
+  st.allowOnly(scenekeys::kFeSpinStiffening, " for spin_stiffening");
+  if (!st.has("calculix")) {
+    st.fail("missing required key \"calculix\" {\"job\"}: the preloaded stiffness exported by ccx (docs/fe-import.md, "
+            "\"Spin stiffening\")");
+  }
+  const ObjectReader f(st.object("calculix"), st.where() + ".calculix");
+  f.allowOnly(scenekeys::kFeFilesCalculix, " for CalculiX files");
+  FeSpinStiffening out;
+  out.spin = st.vector("spin", 3);
+  if (!(out.spin.norm() > 0.0)) st.fail("key \"spin\" must be the spin of the preload run (rad/s), not zero");
+  const std::string job = filePath(f, "job", baseDir);
+  out.preloadedStiffness =
+      located(f.where(), [&] { return readCalculixPreloadedStiffness(CalculixFeFiles::ofJob(job), data, out.heldDofs); });
+  return out;
+}
+
+FeBodyOptions readFeBodyOptions(const ObjectReader& r, const FeBodyData& data, const std::string& baseDir) {
   FeBodyOptions o;
   o.modes = static_cast<int>(r.integer("modes", o.modes, 1));
   o.stiffnessScale = r.positive("stiffness_scale", 1.0);
   o.dampingRatio = r.nonNegative("damping_ratio", 0.0);
   if (o.dampingRatio > 1.0) r.fail("key \"damping_ratio\" must be in [0, 1], got " + fmt(o.dampingRatio));
+  o.inertiaModes = r.boolean("inertia_modes", false);
+  if (r.has("spin_stiffening")) o.spinStiffening = readSpinStiffening(r, data, baseDir);
   const json& masses = r.array("point_masses");
   for (std::size_t k = 0; k < masses.size(); ++k) {
     const ObjectReader p(masses[k], r.where() + ".point_masses[" + std::to_string(k) + "]");

@@ -11,6 +11,10 @@
 
 namespace flexmbd::scenereaders {
 
+/// Key `key` of `r`: a file path, relative to `baseDir` (the scene file's folder) unless
+/// absolute. @throws InputError naming the key if it is not a non-empty string.
+std::string filePath(const jsonread::ObjectReader& r, const std::string& key, const std::string& baseDir);
+
 /// The FE data of the body object `r` (exactly one of the keys "abaqus", "ansys",
 /// "calculix"), each
 /// file path relative to `baseDir` unless absolute.
@@ -20,9 +24,11 @@ FeBodyData readFeBodyFiles(const jsonread::ObjectReader& r, const std::string& b
 /// The options of `r`: "modes", "stiffness_scale", "damping_ratio", "point_masses"
 /// [{"node": FE node number, "mass": kg}, ...], "interfaces" [{"name", "kind": "rigid" |
 /// "averaging", "nodes": [numbers] or "node_set": name, "point"}, ...] (nodes of `data`),
-/// "reduction" ("free_free" or "craig_bampton") with "reference" (a rigid interface).
-/// @throws InputError naming the key.
-FeBodyOptions readFeBodyOptions(const jsonread::ObjectReader& r, const FeBodyData& data);
+/// "reduction" ("free_free" or "craig_bampton") with "reference" (a rigid interface),
+/// "inertia_modes", "spin_stiffening" {"calculix": {"job"}, "spin"} (the files relative to
+/// `baseDir`).
+/// @throws InputError naming the key, or the file and line.
+FeBodyOptions readFeBodyOptions(const jsonread::ObjectReader& r, const FeBodyData& data, const std::string& baseDir);
 
 /// Key "stresses" of `r`: {"calculix_frd": [paths]}, the FE code's results (displacement
 /// and stress of modes or load cases) whose combinations give the stress shapes of the

@@ -22,7 +22,8 @@ namespace {
 
 /// The .dof file: equation i (line i) moves node `node` (index into d.nodeIds) in
 /// direction `direction` (0, 1, 2), written "label.direction" with direction 1, 2, 3.
-std::vector<FeDof> readDofFile(const std::string& path, const FeBodyData& d, const std::string& inpPath) {
+std::vector<FeDof> readDofFile(const std::string& path, const FeBodyData& d, const std::string& inpPath,
+                               bool requireAll = true) {
   TextFile f(path);
   std::map<long, int> index;
   for (int a = 0; a < d.numNodes(); ++a) index[d.nodeIds[a]] = a;
@@ -51,7 +52,7 @@ std::vector<FeDof> readDofFile(const std::string& path, const FeBodyData& d, con
     }
     dofs.push_back(dof);
   }
-  for (int a = 0; a < d.numNodes(); ++a) {
+  for (int a = 0; a < d.numNodes() && requireAll; ++a) {
     for (int k = 0; k < 3; ++k) {
       if (!lineOf.count({a, k})) {
         throw InputError(path + ": node " + std::to_string(d.nodeIds[a]) + " direction " + std::to_string(k + 1) +
@@ -75,6 +76,43 @@ FeBodyData readCalculixFe(const CalculixFeFiles& files) {
   d.mass = readRowColumnMatrix(files.mass, d.numDofs(), SymmetricStorage::Upper, dofWhat);
   checkBodyData(d, files.mass, files.stiffness);
   return d;
+}
+
+SpMat readCalculixPreloadedStiffness(const CalculixFeFiles& files, const FeBodyData& body, std::vector<int>& held) {
+  const FeBodyData mesh = readInpMesh(files.inp);
+  if (mesh.nodeIds != body.nodeIds) {
+    throw InputError(files.inp + ": its nodes are not those of " + body.source +
+                     "; expected the deck of the body with the preload steps added");
+  }
+  for (int a = 0; a < body.numNodes(); ++a) {
+    if ((mesh.coordinates[a] - body.coordinates[a]).norm() > 1e-9 * (1.0 + body.coordinates[a].norm())) {
+      throw InputError(files.inp + ": node " + std::to_string(body.nodeIds[a]) + " is not where " + body.source +
+                       " has it; expected the same mesh");
+    }
+  }
+  const std::vector<FeDof> dofs = readDofFile(files.dofs, body, files.inp, false);
+  const SpMat K = readRowColumnMatrix(files.stiffness, static_cast<int>(dofs.size()), SymmetricStorage::Upper,
+                                      "of " + files.dofs);
+  // equation i of the export -> the body's DOF index
+  std::vector<int> bodyIndex(body.numNodes() * 3, -1);
+  for (int i = 0; i < body.numDofs(); ++i) bodyIndex[3 * body.dofs[i].node + body.dofs[i].direction] = i;
+  std::vector<int> map(dofs.size());
+  std::vector<char> present(body.numDofs(), 0);
+  for (std::size_t i = 0; i < dofs.size(); ++i) {
+    map[i] = bodyIndex[3 * dofs[i].node + dofs[i].direction];
+    present[map[i]] = 1;
+  }
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < K.outerSize(); ++j) {
+    for (SpMat::InnerIterator it(K, j); it; ++it) t.emplace_back(map[it.row()], map[j], it.value());
+  }
+  SpMat out(body.numDofs(), body.numDofs());
+  out.setFromTriplets(t.begin(), t.end());
+  held.clear();
+  for (int i = 0; i < body.numDofs(); ++i) {
+    if (!present[i]) held.push_back(i);
+  }
+  return out;
 }
 
 // ----- .frd ------------------------------------------------------------------------------

@@ -40,6 +40,16 @@ struct CalculixFeFiles {
 /// non-positive total mass (feread::checkBodyData).
 FeBodyData readCalculixFe(const CalculixFeFiles& files);
 
+/// A prestressed stiffness of `body` exported by ccx (docs/fe-import.md, "Spin
+/// stiffening"): the deck of the body (the same nodes at the same places) with a *STATIC
+/// preload step (e.g. *DLOAD CENTRIF) and a *STEP, PERTURBATION with *FREQUENCY,
+/// SOLVER=MATRIXSTORAGE: jobname.sti over the equations of jobname.dof, returned in the
+/// body's DOF order (n x n). `held` receives the body's DOF that have no equation (held by
+/// *BOUNDARY in the preload run; their rows and columns are zero).
+/// @throws InputError naming the file: another mesh, and the .dof and matrix errors of
+/// readCalculixFe.
+SpMat readCalculixPreloadedStiffness(const CalculixFeFiles& files, const FeBodyData& body, std::vector<int>& held);
+
 /// One result block of a .frd step ("-4  DISP  4  1" and its data lines).
 struct FrdBlock {
   std::string name;                           ///< "DISP", "STRESS", "ERROR", ...

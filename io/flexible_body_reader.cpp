@@ -40,7 +40,7 @@ BeamMesh3d straightMesh(double length, int n, const BeamMesh3d::Element& element
 
 std::pair<std::string, std::string> readBodyTypeAndName(ObjectReader& r) {
   r.peekName();
-  std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants", "fe_body"});
+  std::string type = readType(r, "body", {"rigid", "flexible", "flexible_invariants", "fe_body", "sid_body"});
   std::string name = r.name("name");
   if (name == "ground") {
     r.fail("the name \"ground\" is reserved for the fixed ground body (it exists in every scene; refer to it "

@@ -210,6 +210,7 @@ void parseBody(const json& j, const std::string& where, System& sys) {
   if (type == "flexible") return parseFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
   if (type == "fe_body") r.fail("an fe_body (a solid FE mesh) is spatial: give the scene \"dimension\": 3");
+  if (type == "sid_body") r.fail("a sid_body (a SID file's body) is spatial: give the scene \"dimension\": 3");
   r.allowOnly(scenekeys::kRigidBody, " for a rigid body");
   RigidBodyProperties props;
   props.mass = r.positive("mass");

@@ -93,12 +93,16 @@ inline const Keys kInvariants3d = {"mass",  "first_moment", "second_moment", "s_
 inline const Keys kInvariantsPoint3d = {"position", "shape", "rotation_shape"};
 inline const Keys kFeBody3d = {"name",         "type",        "position",      "orientation",     "velocity",
                                "angular_velocity", "abaqus",  "ansys", "calculix",         "modes",           "stiffness_scale",
-                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses",
+                               "damping_ratio", "point_masses", "interfaces", "reduction", "reference", "stresses", "inertia_modes", "spin_stiffening",
                                "elastic_coordinates", "elastic_velocities"};
+inline const Keys kSidBody3d = {"name",     "type",           "position",           "orientation",
+                                "velocity", "angular_velocity", "file", "elastic_coordinates",
+                                "elastic_velocities"};
 inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
 inline const Keys kFeStresses = {"calculix_frd"};
+inline const Keys kFeSpinStiffening = {"calculix", "spin"};
 inline const Keys kFePointMass = {"node", "mass"};
 inline const Keys kFeInterface = {"name", "kind", "nodes", "node_set", "point"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
@@ -188,11 +192,13 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"invariants.3d", &kInvariants3d},
       {"invariants.point.3d", &kInvariantsPoint3d},
       {"body.fe_body.3d", &kFeBody3d},
+      {"body.sid_body.3d", &kSidBody3d},
       {"fe.files.abaqus", &kFeFilesAbaqus},
       {"fe.files.ansys", &kFeFilesAnsys},
       {"fe.files.calculix", &kFeFilesCalculix},
       {"fe.point_mass", &kFePointMass},
       {"fe.stresses", &kFeStresses},
+      {"fe.spin_stiffening", &kFeSpinStiffening},
       {"fe.interface", &kFeInterface},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},

@@ -17,6 +17,7 @@
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
 #include "io/fe_body_reader.hpp"
+#include "io/sid_file.hpp"
 #include "io/scene_keys.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
@@ -242,7 +243,7 @@ void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const st
                         std::vector<FeBodyDrawing>* drawings) {
   r.allowOnly(scenekeys::kFeBody3d, " for an fe_body in a spatial scene");
   const FeBodyData data = readFeBodyFiles(r, baseDir);
-  const FeBodyOptions options = readFeBodyOptions(r, data);
+  const FeBodyOptions options = readFeBodyOptions(r, data, baseDir);
   const std::string owner = "body '" + name + "'";
   const FeBodyModel model = located(r.where(), [&] { return FeBodyModel(data, options, owner); });
   FeBodyDrawing drawing;
@@ -256,6 +257,19 @@ void parseSpatialFeBody(const ObjectReader& r, const std::string& name, const st
   const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
   drawing.body = located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
   if (drawings) drawings->push_back(std::move(drawing));
+}
+
+/// A body of "type": "sid_body": the reduced body of a SID file (bodies/sid_data.hpp,
+/// io/sid_file.hpp; docs/fe-import.md, "SID"), the path relative to the scene file's folder.
+void parseSpatialSidBody(const ObjectReader& r, const std::string& name, const std::string& baseDir, System& sys) {
+  r.allowOnly(scenekeys::kSidBody3d, " for a sid_body in a spatial scene");
+  const std::string path = filePath(r, "file", baseDir);
+  FfrInvariants3d inv = located(r.where(), [&] { return invariantsFromSid(readSidFile(path), "body '" + name + "'"); });
+  const int nf = inv.numElastic();
+  const FrameState3d init = parseFrameState3d(r);
+  const VecX qf0 = readElasticState(r, "elastic_coordinates", nf);
+  const VecX qf0dot = readElasticState(r, "elastic_velocities", nf);
+  located(r.where(), [&] { return addFlexibleBody3d(sys, name, std::move(inv), init, qf0, qf0dot); });
 }
 
 /// The type, dimensions, "offset" and "orientation" of a shape (in "shape" and "geometry");
@@ -388,6 +402,7 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys, cons
   ObjectReader r(j, where);
   const auto [type, name] = readBodyTypeAndName(r);
   if (type == "fe_body") return parseSpatialFeBody(r, name, baseDir, sys, drawings);
+  if (type == "sid_body") return parseSpatialSidBody(r, name, baseDir, sys);
   if (type == "flexible") return parseSpatialFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseSpatialInvariantBody(r, name, sys);
   r.allowOnly(scenekeys::kRigidBody3d, " for a rigid body in a spatial scene");

@@ -16,6 +16,8 @@
 
 #include "bindings_support.hpp"
 #include "bodies/fe_body_model.hpp"
+#include "bodies/sid_data.hpp"
+#include "io/sid_file.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
@@ -542,6 +544,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             if (x.size() != 3) throw InputError("FfrInvariants3d.h_i: expected 3 matrices (x, y, z), nf x nf each");
             for (int k = 0; k < 3; ++k) v.hI[k] = x[k].sparseView();
           })
+      .def_property(
+          "spin_stiffness", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.spinStiffness); },
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.spinStiffness, x, "spin_stiffness"); })
       .def_property_readonly("num_elastic", [](const FfrInvariants3d& v) { return v.mff.rows(); })
       .def(
           "validate", [](const FfrInvariants3d& v, const std::string& owner) {
@@ -549,6 +554,16 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             v.validateSectionRotation(owner);
           },
           py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
+
+  // ----- the SID of a body (bodies/sid_data.hpp, io/sid_file.hpp) ----------------------------
+  m.def(
+      "write_sid", [](const FfrInvariants3d& inv, const std::string& path) { writeSidFile(sidFromInvariants(inv), path); },
+      py::arg("invariants"), py::arg("path"),
+      "Writes the Standard Input Data (SID text file) of spatial invariants (docs/fe-import.md, \"SID\")");
+  m.def(
+      "read_sid", [](const std::string& path, const std::string& owner) { return invariantsFromSid(readSidFile(path), owner); },
+      py::arg("path"), py::arg("owner") = "SID body",
+      "The invariants of a SID text file; InputError names the file and line, or the block and entry");
 
   // ----- bodies from FE codes (bodies/fe_body_model.hpp, io/fe_abaqus.hpp, io/fe_ansys.hpp) ----
   py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
@@ -574,7 +589,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def(py::init([](const FeBodyData& data, const py::object& modes, const py::object& scale,
                        const py::object& damping, const std::vector<std::pair<int, double>>& pointMasses,
                        const std::vector<py::dict>& interfaces, const std::string& reduction,
-                       const std::string& reference, const std::string& owner) {
+                       const std::string& reference, bool inertiaModes, const std::string& owner) {
              constexpr const char* fn = "FeBodyModel";
              FeBodyOptions o;
              o.modes = intArg(modes, fn, "modes");
@@ -631,15 +646,17 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                o.reduction = FeReduction::CraigBampton;
                o.reference = reference;
              }
+             o.inertiaModes = inertiaModes;
              return std::make_shared<FeBodyModel>(data, o, owner);
            }),
            py::arg("data"), py::arg("modes") = 8, py::arg("stiffness_scale") = 1.0, py::arg("damping_ratio") = 0.0,
            py::arg("point_masses") = std::vector<std::pair<int, double>>{},
            py::arg("interfaces") = std::vector<py::dict>{}, py::arg("reduction") = "free_free",
-           py::arg("reference") = "", py::arg("owner") = "FE body",
+           py::arg("reference") = "", py::arg("inertia_modes") = false, py::arg("owner") = "FE body",
            "point_masses: [(FE node number, kg), ...]; interfaces: [{'name', 'kind': 'rigid' | 'averaging', "
            "'nodes': [numbers] or 'node_set': name, 'point': (x, y, z)}, ...]; reduction 'free_free' or "
-           "'craig_bampton' with reference (a rigid interface's name)")
+           "'craig_bampton' with reference (a rigid interface's name); inertia_modes: append the static "
+           "responses to the frame's inertia loads")
       .def_property_readonly(
           "invariants", [](const FeBodyModel& mdl) { return mdl.invariants(); },
           "A copy of the reduced invariants (FfrInvariants3d): add them with System.add_flexible_body_3d")

@@ -12,6 +12,7 @@
 // Then every strictness check of the readers on small broken files written here.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <array>
 #include <chrono>
@@ -194,6 +195,25 @@ BarSpec rodSpec() {
   return b;
 }
 
+/// The bar centred on the x axis: a spin about z through the origin turns it about its
+/// root face's centre (the spin-stiffening test).
+BarSpec spinSpec() {
+  BarSpec b;
+  b.y0 = -kWidth / 2;
+  b.z0 = -kHeight / 2;
+  return b;
+}
+
+/// The spinning bar's preload run: clamped at FIX, a steady spin of w rad/s about z through
+/// the origin (*DLOAD CENTRIF, w^2), then `perturbation` (a *FREQUENCY step) about it.
+std::string spinPreload(double w, const std::string& perturbation) {
+  std::ostringstream s;
+  s.precision(17);
+  s << barMesh(spinSpec()) << "*BOUNDARY\nFIX, 1, 3\n*STEP, NLGEOM\n*STATIC\n*DLOAD\nEall, CENTRIF, " << w * w
+    << ", 0., 0., 0., 0., 0., 1.\n*END STEP\n*STEP, PERTURBATION\n" << perturbation << "*END STEP\n";
+  return s.str();
+}
+
 /// The folder of the ccx runs, made once for all tests of the suite.
 class CalculixBar : public ::testing::Test {
  protected:
@@ -216,8 +236,12 @@ class CalculixBar : public ::testing::Test {
         {"unit_cases", unitTipLoadCases()},
         {"fixed_fixed", "*BOUNDARY\nFIX, 1, 3\nTIP, 1, 3\n*STEP\n*FREQUENCY\n10\n*NODE FILE\nU\n*EL FILE\nS\n*END STEP\n"}};
     steps["rod"] = "";  // written above
+    std::ofstream((dir_ / "spin_matrices.inp").string()) << barMesh(spinSpec()) << matrixStep;
+    std::ofstream((dir_ / "spin_pre.inp").string()) << spinPreload(100.0, "*FREQUENCY, SOLVER=MATRIXSTORAGE\n");
+    std::ofstream((dir_ / "spin_50.inp").string()) << spinPreload(50.0, "*FREQUENCY\n6\n*NODE FILE\nU\n");
+    for (const char* written : {"spin_matrices", "spin_pre", "spin_50"}) steps[written] = "";
     for (const auto& [job, step] : steps) {
-      if (job != "rod") std::ofstream((dir_ / (job + ".inp")).string()) << mesh << step;
+      if (!step.empty()) std::ofstream((dir_ / (job + ".inp")).string()) << mesh << step;
       const std::string cmd =
           "cd '" + dir_.string() + "' && OMP_NUM_THREADS=1 ccx -i " + job + " > " + job + ".log 2>&1";
       if (std::system(cmd.c_str()) != 0) {
@@ -895,4 +919,72 @@ TEST(CalculixModes, ClampedModesRefuseAFreeBodyAndBadArguments) {
   EXPECT_THROW(clampedModes(K, M, {3}, 1, "chain"), InputError);
   EXPECT_THROW(clampedModes(K, M, {0, 0}, 1, "chain"), InputError);
   EXPECT_THROW(clampedModes(K, M, {0}, 2, "chain"), InputError);
+}
+
+// ----- spin stiffening from a prestressed export -----------------------------------
+
+
+TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) {
+  // The bar clamped at its root (a rigid interface, the Craig-Bampton reference), spinning
+  // about z through the root's centre. Its stress stiffness comes from ccx's export of the
+  // stiffness prestressed by a 100 rad/s spin (FeSpinStiffening), scaled by w^2:
+  //  - at 50 rad/s the body's frequencies equal ccx's prestressed frequency analysis at
+  //    50 rad/s to 1e-4 (ccx runs with NLGEOM: its stress stiffness is not exactly linear
+  //    in w^2, by the strain of the preload, ~1e-4, times the stiffening's share of
+  //    omega^2, a few %; the 10 fixed-interface modes' truncation is below that);
+  //  - the Southwell coefficients (omega^2 - omega0^2) / w^2 of the first bending pair
+  //    equal the uniform cantilever's, 1.193 out of the plane of rotation and 1.193 - 1 in
+  //    it (the spin softening, from the S_kl) to 0.02 (solid against Euler-Bernoulli beam
+  //    at L / h = 10; without the stiffening the first would be ~0 and the test fails).
+  const FeBodyData d = readCalculixFe(CalculixFeFiles::ofJob(job("spin_matrices")));
+  FeBodyOptions o;
+  o.modes = 10;
+  o.interfaces.push_back({"root", d.nodeSets.at("FIX"), FeInterfaceKind::Rigid});
+  o.reduction = FeReduction::CraigBampton;
+  o.reference = "root";
+  o.spinStiffening.preloadedStiffness =
+      readCalculixPreloadedStiffness(CalculixFeFiles::ofJob(job("spin_pre")), d, o.spinStiffening.heldDofs);
+  o.spinStiffening.spin = Vec3(0.0, 0.0, 100.0);
+  EXPECT_EQ(o.spinStiffening.heldDofs.size(), 3 * d.nodeSets.at("FIX").size());
+  const FeBodyModel model(d, o, "bar");
+  const VecX f50 = fetest::spinningFrequencies(model.invariants(), 50.0);
+  std::vector<double> ccx;
+  for (const FrdStep& st : readCalculixFrd(job("spin_50.frd")).steps) {
+    if (st.type == 2) ccx.push_back(st.value);
+  }
+  ASSERT_GE(ccx.size(), 4u);
+  double worst = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(f50[i] / ccx[i], 1.0, 1e-4) << "mode " << i + 1;
+    worst = std::max(worst, std::abs(f50[i] / ccx[i] - 1.0));
+  }
+  const VecX f0 = fetest::spinningFrequencies(model.invariants(), 0.0);
+  const double southwell = fetest::kSouthwellCantilever;
+  const auto coefficient = [&](int i) { return fetest::southwellCoefficient(f50[i], f0[i], 50.0); };
+  EXPECT_NEAR(coefficient(0), southwell - 1.0, 0.02);  // in the plane of rotation: softened by w^2
+  EXPECT_NEAR(coefficient(1), southwell, 0.02);        // out of it
+  std::printf("[ figures ] spin stiffening (ccx prestressed export at 100 rad/s, scaled to 50): frequencies vs ccx "
+              "worst %.1e; Southwell coefficients %.4f (in plane, beam %.4f), %.4f (out of plane, beam %.4f)\n",
+              worst, coefficient(0), southwell - 1.0, coefficient(1), southwell);
+  // the scene key gives the same body
+  const nlohmann::json scene = {
+      {"dimension", 3},
+      {"bodies",
+       {{{"name", "bar"},
+         {"type", "fe_body"},
+         {"calculix", {{"job", "spin_matrices"}}},
+         {"modes", 10},
+         {"reduction", "craig_bampton"},
+         {"reference", "root"},
+         {"interfaces", {{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}}}},
+         {"spin_stiffening", {{"calculix", {{"job", "spin_pre"}}}, {"spin", {0, 0, 100}}}}}}}};
+  const Scene sc = parseSceneText(scene.dump(), job("scene.json"));
+  const auto& body = dynamic_cast<const FfrBody3d&>(sc.system.body(BodyIndex(1)));
+  EXPECT_EQ(MatX(body.invariants().spinStiffness[2][2] - model.invariants().spinStiffness[2][2]).norm(), 0.0);
+  // without Craig-Bampton (no held hub): refused, naming the key
+  nlohmann::json free = scene;
+  free["bodies"][0].erase("reduction");
+  free["bodies"][0].erase("reference");
+  fetest::expectMentions(fetest::errorOf([&] { parseSceneText(free.dump(), job("scene.json")); }),
+                         {"spin stiffening needs \"reduction\": \"craig_bampton\""});
 }

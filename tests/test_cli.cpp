@@ -35,6 +35,22 @@ TEST_F(Cli, HelpAndVersion) {
   EXPECT_EQ(r.out.rfind("flexmbd ", 0), 0u) << r.out;
 }
 
+// Issue 28: `run` simulates planar and spatial multibody models and tensegrity
+// structures; its paragraph of the help (also `run --help`) must say so, not "planar".
+TEST_F(Cli, HelpDescribesRunAsPlanarAndSpatial) {
+  for (const std::string& command : {"--help", "run --help"}) {
+    const CliResult r = run(command);
+    ASSERT_EQ(r.status, 0) << command;
+    const auto start = r.out.find("run simulates");
+    ASSERT_NE(start, std::string::npos) << command << ":\n" << r.out;
+    const std::string paragraph = r.out.substr(start, r.out.find("\n\n", start) - start);
+    for (const char* word : {"planar", "spatial", "flexible", "tensegrity"}) {
+      EXPECT_NE(paragraph.find(word), std::string::npos) << command << ": no \"" << word << "\" in\n" << paragraph;
+    }
+    EXPECT_EQ(r.out.find("planar multibody model"), std::string::npos) << command << ":\n" << r.out;  // the old wording
+  }
+}
+
 TEST_F(Cli, UnknownKeyInSceneExitsWith2AndNoResults) {
   nlohmann::json j = example();
   j["bodies"][1]["masss"] = 1.0;

@@ -254,9 +254,12 @@ TEST(FfrBody3d, AnalyticDerivativesMatchCentralDifferences) {
   for (BeamTheory theory : kTheories) {
   SCOPED_TRACE(theoryName(theory));
   Fixture f(theory);
-  // with damping, so that D_ff enters the velocity Jacobian
+  // with damping, so that D_ff enters the velocity Jacobian, and spin stiffening G_kl
+  // (symmetric, G_lk = G_kl) so that it enters both
   FfrInvariants3d inv = f.chain.inv;
   inv.dff = 1e-4 * inv.kff;
+  for (int k = 0; k < 3; ++k)
+    for (int l = k; l < 3; ++l) inv.spinStiffness[k][l] = inv.spinStiffness[l][k] = (0.3 + k + 2 * l) * 1e-3 * inv.mff;
   const FfrBody3d body("damped", inv, someFrame());
   const int nq = 7 + f.nf, nv = 6 + f.nf;
   Random rnd(13);

@@ -269,6 +269,37 @@ TEST(Linearization, RejectsAStateOfTheWrongSize) {
   EXPECT_THROW(linearize(s.system, r), InputError);
 }
 
+// Issue 28: a sparse eigensolver that cannot do its work is a SolverError (the command
+// line's exit 1), not an InputError or ModelError (exit 2, bad input): the model is well
+// formed and the dense solver finds its modes. Forced by a shift at an eigenvalue: four
+// free planar bodies have only s = 0, and a shift of 0 makes the shifted pencil singular.
+TEST(Linearization, ASparseSolverFailureIsASolverErrorNotBadInput) {
+  json scene = {{"name", "free bodies"}, {"bodies", json::array()}, {"solver", {{"t_end", 1}}}};
+  for (int i = 0; i < 4; ++i) {
+    scene["bodies"].push_back({{"name", "b" + std::to_string(i)}, {"type", "rigid"}, {"mass", 1.0}, {"inertia", 0.1},
+                               {"position", {1.0 * i, 0.0}}});
+  }
+  const Scene s = parseScene(scene);
+  ModesOptions o;
+  o.count = 2;
+  o.solver = EigenSolverKind::Sparse;
+  o.shift = 0.0;
+  try {
+    modesAbout(s.system, initialReference(s.system), o, BasisKind::CoordinatePartitioning);
+    ADD_FAILURE() << "no exception";
+  } catch (const SolverError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("sparse eigensolver"), std::string::npos) << m;
+    EXPECT_NE(m.find("dense"), std::string::npos) << m;  // the way out
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "not a SolverError: " << e.what();
+  }
+  o.solver = EigenSolverKind::Dense;  // the same model: 12 free coordinates, s = 0 only
+  const std::vector<Mode> modes = modesAbout(s.system, initialReference(s.system), o);
+  ASSERT_EQ(modes.size(), 2u);
+  for (const Mode& m : modes) EXPECT_EQ(m.omega, 0.0);
+}
+
 TEST(Linearization, RotatingBladeStiffensWithTheSouthwellCoefficientAboutItsSteadyStretchedState) {
   // a uniform cantilever blade (clamped at the hub, no hub radius) turned in its plane at
   // Omega: in-plane bending omega^2 = omega_0^2 + (K1 - 1) Omega^2, Southwell coefficient

@@ -1,6 +1,4 @@
-#include "linkage/kinematics_command.hpp"
-
-#include "app/command_line.hpp"
+#include "app/kinematics_command.hpp"
 
 #include <cmath>
 #include <cstdlib>
@@ -13,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "io/output_lock.hpp"

@@ -1,6 +1,4 @@
-#include "tensegrity/tensegrity_command.hpp"
-
-#include "app/command_line.hpp"
+#include "app/tensegrity_command.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -11,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/command_line.hpp"
 #include "core/errors.hpp"
 #include "io/output_lock.hpp"
 #include "io/results_writer.hpp"

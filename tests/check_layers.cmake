@@ -1,0 +1,21 @@
+# Issue 28, item 5: the command line is app/, and no folder outside it includes app/
+# (the library's layers, the Python module and the benchmarks build without it; tests may).
+# cmake -DSOURCE_DIR=<root> -DDIRS=core,bodies,... -P check_layers.cmake
+string(REPLACE "," ";" dirs "${DIRS}")
+set(offending "")
+foreach(dir IN LISTS dirs)
+  file(GLOB_RECURSE sources "${SOURCE_DIR}/${dir}/*.cpp" "${SOURCE_DIR}/${dir}/*.hpp")
+  foreach(source IN LISTS sources)
+    file(STRINGS "${source}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]app/")
+    if(lines)
+      file(RELATIVE_PATH rel "${SOURCE_DIR}" "${source}")
+      list(APPEND offending "${rel}: ${lines}")
+    endif()
+  endforeach()
+endforeach()
+if(offending)
+  list(JOIN offending "\n  " text)
+  message(FATAL_ERROR "files outside app/ include the command line (move the code into app/):\n  ${text}")
+endif()
+list(LENGTH dirs count)
+message(STATUS "layers: no file of the ${count} folders includes app/")
