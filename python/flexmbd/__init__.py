@@ -61,6 +61,7 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     rectangular_section,
     read_abaqus_fe,
     read_ansys_fe,
+    read_sid,
     rectangular_section_3d,
     rotation_from_axis_angle,
     rotation_from_quaternion,
@@ -68,6 +69,7 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     shape_properties,
     shape_volume,
     spin_up_law,
+    write_sid,
     tabulated_law,
     world_joint_frame,
 )
