@@ -66,6 +66,31 @@ TEST_F(Cli, ModesPrintsTheBeamModelsNaturalFrequenciesAndSweepsADriver) {
   EXPECT_TRUE(fs::exists(out / "campbell.png"));
 }
 
+TEST_F(Cli, ModesOfTheShippedBladeGiveTheTableOfDocsModes) {
+  // docs/modes.md shows this command on examples/modes_blade.json and its Campbell table;
+  // the table is printed to 5 significant digits, so each frequency is checked to 5e-5
+  // relative (the doc's rounding).
+  const fs::path out = dir_ / "out";
+  const CliResult r = run("modes " + shellQuote(std::string(FLEXMBD_SOURCE_DIR) + "/examples/modes_blade.json") + " --out " +
+                          shellQuote(out.string()) + " --count 3 --steady --sweep motor:0:60:4");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::vector<std::vector<double>> doc = {{8.1799, 51.267, 143.62},
+                                                {8.2996, 51.813, 144.23},
+                                                {8.6339, 53.418, 146.01},
+                                                {9.1235, 55.993, 148.94}};
+  const std::vector<std::string> rows = lines(readFile(out / "campbell.csv"));
+  ASSERT_EQ(rows.size(), 5u);
+  for (int i = 0; i < 4; ++i) {
+    std::istringstream in(rows[i + 1]);
+    std::string field;
+    std::getline(in, field, ',');  // speed
+    for (int k = 0; k < 3; ++k) {
+      std::getline(in, field, ',');
+      EXPECT_NEAR(std::stod(field) / doc[i][k], 1.0, 5e-5) << "speed row " << i << ", mode " << k + 1;
+    }
+  }
+}
+
 TEST_F(Cli, ModesBadInputExitsWith2NamingTheKey) {
   nlohmann::json j = rodPendulum();
   j["bodies"][0]["masss"] = 1.0;
