@@ -204,9 +204,34 @@ void parseInvariantBody(const ObjectReader& r, const std::string& name, System& 
   addFlexibleBody(r, nf, sys, [&] { return std::make_unique<FfrBody2d>(name, std::move(inv), init); });
 }
 
+/// A body of a planar scene written with spatial keys: the hint that the scene lacks
+/// "dimension": 3 (otherwise the first key read says only that it is not planar).
+void failIfWrittenAsSpatial(const ObjectReader& r) {
+  std::string why;
+  if (r.has("inertia") && r.required("inertia").is_array()) {
+    why = "its \"inertia\" is a list (spatial: principal moments or a tensor)";
+  } else if (r.has("angular_velocity") && r.required("angular_velocity").is_array()) {
+    why = "its \"angular_velocity\" is a vector (planar: a number, rad/s)";
+  } else {
+    for (const char* key : {"position", "velocity"}) {
+      if (why.empty() && r.has(key) && r.required(key).is_array() && r.required(key).size() == 3) {
+        why = std::string("its \"") + key + "\" has 3 components";
+      }
+    }
+    for (const char* key : {"orientation", "shape"}) {
+      if (why.empty() && r.has(key)) why = std::string("it has the spatial key \"") + key + "\"";
+    }
+  }
+  if (!why.empty()) {
+    r.fail("this body looks spatial (" + why + ") but the scene is planar; give the scene \"dimension\": 3 "
+           "(docs/scene-format.md, \"Spatial scenes\")");
+  }
+}
+
 void parseBody(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
   const auto [type, name] = scenereaders::readBodyTypeAndName(r);
+  failIfWrittenAsSpatial(r);
   if (type == "flexible") return parseFlexibleBody(r, name, sys);
   if (type == "flexible_invariants") return parseInvariantBody(r, name, sys);
   if (type == "fe_body") r.fail("an fe_body (a solid FE mesh) is spatial: give the scene \"dimension\": 3");

@@ -419,7 +419,13 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys, cons
   RigidBody3dProperties props;
   props.mass = r.positive("mass");
   const json& inertia = r.required("inertia");
-  if (inertia.is_array() && inertia.size() == 3 && !inertia[0].is_array()) {
+  const bool numbers = inertia.is_array() && !inertia.empty() && !inertia[0].is_array();
+  if (!inertia.is_array() || (numbers && inertia.size() != 3)) {
+    r.fail("key \"inertia\" must be 3 principal moments [Ixx, Iyy, Izz] or a 3 x 3 tensor [[...], [...], [...]] "
+           "(kg m^2, about the centre of mass), got " +
+           (inertia.is_array() ? std::to_string(inertia.size()) + " numbers" : std::string("a ") + inertia.type_name()));
+  }
+  if (numbers) {
     const Vec3 I = r.vector("inertia", 3);
     for (int k = 0; k < 3; ++k) r.checkPositive(I[k], "inertia[" + std::to_string(k) + "]");
     props.inertia = I.asDiagonal();

@@ -93,6 +93,25 @@ TEST(SceneErrors, BaseSceneIsValid) {
   EXPECT_TRUE(s.system.isFinalized());
 }
 
+TEST(SceneErrors, ASpatialBodyInAPlanarSceneSaysTheDimensionIsMissing) {
+  // a newcomer's spatial scene without "dimension": 3: the message names the reason
+  for (const char* body : {R"({"name": "b", "type": "rigid", "mass": 1, "inertia": [1, 2, 3]})",
+                           R"({"name": "b", "type": "rigid", "mass": 1, "inertia": 1, "position": [0, 0, 1]})",
+                           R"({"name": "b", "type": "rigid", "mass": 1, "inertia": 1, "orientation": {"axis": [0, 0, 1], "angle": 1}})"}) {
+    json j = baseScene();
+    j["bodies"].push_back(json::parse(body));
+    EXPECT_TRUE(Mentions(errorOf(j), {"bodies[3] (\"b\")", "looks spatial", "\"dimension\": 3"})) << body;
+  }
+}
+
+TEST(SceneErrors, ASpatialInertiaOfTwoNumbersSaysWhatItMustBe) {
+  json j = {{"dimension", 3},
+            {"bodies", {{{"name", "b"}, {"type", "rigid"}, {"mass", 1.0}, {"inertia", {1.0, 2.0}}}}}};
+  EXPECT_TRUE(Mentions(errorOf(j), {"key \"inertia\" must be 3 principal moments", "got 2 numbers"}));
+  j["bodies"][0]["inertia"] = 5.0;
+  EXPECT_TRUE(Mentions(errorOf(j), {"key \"inertia\" must be 3 principal moments", "got a number"}));
+}
+
 // ----- names ---------------------------------------------------------------------
 
 TEST(SceneErrors, UnknownBodyInJointNamesItAndListsKnownBodies) {
