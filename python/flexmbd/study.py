@@ -422,6 +422,7 @@ def run_study(study, out_dir, scheduler=None, workers=None, progress=True):
     todo = [i for i in range(len(study.points)) if i not in table.done]
     prog = Progress(len(study.points), len(study.points) - len(todo), sys.stderr if progress else open(os.devnull, "w"))
     failed = 0
+    input_errors = []  # the messages of the points that failed on input
 
     def write(record):
         nonlocal failed
@@ -430,6 +431,8 @@ def run_study(study, out_dir, scheduler=None, workers=None, progress=True):
         row += [record["status"], record["message"], record["t_reached"], record["wall_seconds"]] + record["values"]
         table.write(row)
         failed += record["status"] != "ok"
+        if record["status"] == "input_error":
+            input_errors.append(record["message"])
         prog.update(record["status"])
 
     args = lambda i: (i, study.scene, study.overrides_of(study.points[i]), study.outputs, study.output_names)  # noqa: E731
@@ -464,6 +467,11 @@ def run_study(study, out_dir, scheduler=None, workers=None, progress=True):
     finally:
         prog.finish()
         table.close()
+    if todo and len(input_errors) == len(todo):
+        # every point refused its input: the study itself is wrong (an axis key that names
+        # nothing, a value of the wrong kind), not one point's value
+        raise InputError(f"{study.path}: every point failed on input ({len(todo)} of {len(todo)}; their rows are in "
+                         f"study.csv), e.g. {input_errors[0]}")
     return len(todo), failed
 
 

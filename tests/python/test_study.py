@@ -95,6 +95,21 @@ def test_study_input_errors_name_the_key(tmp_path):
         st.run_study(study, str(tmp_path / "other"), workers=0, progress=False)
 
 
+def test_a_study_whose_every_point_fails_on_input_is_an_input_error(tmp_path, capsys):
+    # an axis key with a typo: every point refuses its override; the study says so (exit 2
+    # from the command, naming the key) instead of reporting a finished study
+    axes = [{"name": "modulus", "key": "bodies[1].section.youngs_modulus", "values": [5e10, 2e11]},
+            {"name": "speed", "key": "drivers[0].law.sped", "values": [100.0]}]
+    study = write_study(tmp_path, axes)
+    with pytest.raises(InputError, match="every point failed on input \\(2 of 2.*sped"):
+        st.run_study(study, str(tmp_path / "out"), workers=0, progress=False)
+    assert len(table(tmp_path / "out")[1]) == 2  # the rows are kept
+    spec = write_spec(tmp_path, axes, name="typo.json")
+    assert st.main([spec, "--out", str(tmp_path / "cli"), "--workers", "0", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("flexmbd-study: error:") and "sped" in err
+
+
 def write_spec(tmp_path, axes, plot=None, name="study.json"):
     spec = {
         "scene": os.path.join(SOURCE, "examples", "slider_crank_elastic_demo_modal.json"),
