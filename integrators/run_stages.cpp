@@ -119,6 +119,35 @@ std::vector<InitialCorrection> initialCorrections(const System& sys, double t0, 
   return out;
 }
 
+/// One warning per body whose given initial velocities, not all zero, were changed by
+/// more than kWarnFraction of the velocity scale to satisfy the joints (a body given at
+/// rest takes its drivers' and joints' velocities without a word: that is how driven
+/// models start). Scale: the largest given speed, angular rates times the model size.
+void velocityCorrectionWarnings(const System& sys, const VecX& given, const VecX& corrected, double modelSize,
+                                std::vector<std::string>& warnings) {
+  const std::vector<CoordinateKind> kinds = sys.velocityKinds();
+  const auto speed = [&](int k, double x) { return std::fabs(x) * (kinds[k] == CoordinateKind::Angle ? modelSize : 1.0); };
+  double scale = 0.0;
+  for (int k = 0; k < given.size(); ++k) scale = std::max(scale, speed(k, given[k]));
+  if (!(scale > 0.0)) return;
+  const std::vector<std::string> names = sys.velocityNames();
+  for (int b = 1; b < sys.numBodies(); ++b) {
+    const Body& body = sys.body(BodyIndex(b));
+    const int off = sys.velocityOffset(BodyIndex(b)), n = body.numVelocities();
+    if (given.segment(off, n).cwiseAbs().maxCoeff() == 0.0) continue;  // given at rest
+    int worst = -1;
+    double change = 0.0;
+    for (int k = off; k < off + n; ++k) {
+      const double d = speed(k, corrected[k] - given[k]);
+      if (d > change) change = d, worst = k;
+    }
+    if (worst < 0 || change <= kWarnFraction * scale) continue;
+    warnings.push_back("initial velocity of body '" + body.name() + "' corrected: " + names[worst] + " given " +
+                       formatValue(given[worst]) + ", now " + formatValue(corrected[worst]) +
+                       " to satisfy the joints and drivers (velocities that violate them are projected onto them)");
+  }
+}
+
 RunStart startRun(const DaeSystem& dae, const ConsistentState& init, double t0) {
   const System& sys = dae.system();
   RunStart start;
@@ -131,6 +160,7 @@ RunStart startRun(const DaeSystem& dae, const ConsistentState& init, double t0) 
       start.warnings.push_back(initialCorrectionWarning(c));
     }
   }
+  velocityCorrectionWarnings(sys, sys.initialVelocities(), init.v, start.modelSize, start.warnings);
   if (!dae.releasedEquations().empty()) {
     // one line at the start naming what was released (the summary lists them too)
     std::string names;

@@ -221,6 +221,24 @@ TEST_F(Hardening, LargeInitialCorrectionIsRecordedAndWarned) {
   EXPECT_EQ(summary.at("warnings").size(), 1u) << summary.at("warnings").dump();
 }
 
+TEST_F(Hardening, InitialVelocitiesThatViolateTheJointsAreWarned) {
+  // The slider given 3 m/s while the crank starts on its driver: the joints fix the
+  // slider's speed, and the projection changes it; said as for positions. Bodies given at
+  // rest take their joints' velocities without a warning (the example's other bodies).
+  const fs::path out = dir_ / "out";
+  nlohmann::json j = example();
+  for (auto& b : j["bodies"]) {
+    if (b["name"] == "slider") b["velocity"] = {3.0, 0.0};
+  }
+  const CliResult r = runScene("run", writeScene("fast.json", j), out);
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("flexmbd: warning: initial velocity of body 'slider' corrected: slider.x_dot given 3, now"),
+            std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("initial velocity of body 'crank'"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("initial velocity of body 'rod'"), std::string::npos) << r.err;
+}
+
 // ----- item 6: output failures, signals, stale frames ---------------------------------
 
 /// Every line of a CSV file is complete: ends in a newline, as many fields as the header.
