@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/system.hpp"
@@ -19,6 +20,11 @@ inline constexpr double kDivergedSize = 100.0;
 /// the model size (false for NaN).
 inline bool hasDiverged(double largest, double modelSize) { return largest > kDivergedSize * modelSize; }
 
+/// A flexible body whose RMS elastic displacement exceeds this fraction of the model size
+/// has left the small deformations the floating frame formulation assumes (its tip moves
+/// some 2 to 3 times the RMS: 10 to 15 % of the size): warned, and named in a failure.
+inline constexpr double kLargeElasticFraction = 0.05;
+
 /// What the outputs of a run showed so far.
 struct RecordedOutputs {
   double tReached = 0.0;    ///< time of the last output passed to the callback
@@ -31,6 +37,16 @@ struct RecordedOutputs {
   double maxVelocityViolation = 0.0;  ///< max over outputs of max |G v + g_t|
   std::optional<double> energyStart, energyEnd;  ///< only if the model is conservative
   double maxKineticEnergy = 0.0;  ///< largest kinetic energy at an output (conservative models)
+  /// The small-deformation check of the floating frame: the largest RMS elastic
+  /// displacement of a flexible body over its mass, sqrt(q_f^T m_ff q_f / m) (int rho
+  /// |u_f|^2 dV = q_f^T m_ff q_f), the body's index and the output's time.
+  double largestElasticRms = 0.0;
+  int elasticBody = -1;
+  std::string elasticBodyName;
+  double elasticTime = 0.0;
+  /// The note of a large elastic displacement (largestElasticRms above kLargeElasticFraction
+  /// of `modelSize`), naming the body and the ratio; empty if none.
+  std::string largeDeformationNote(double modelSize) const;
 
   /// A coordinate output so far exceeds kDivergedSize times the model size.
   bool diverged(double modelSize) const { return hasDiverged(largestCoordinate, modelSize); }
@@ -60,6 +76,9 @@ class OutputRecorder {
   const RecordedOutputs& recorded() const { return recorded_; }
 
  private:
+  /// RecordedOutputs::largestElasticRms and its body at the output (t, q).
+  void recordElasticDisplacement(double t, const VecX& q);
+
   const System& sys_;
   const double modelSize_;
   const std::vector<int> released_;

@@ -59,6 +59,9 @@ RunFailure writeFailedAt(const OutputWriteError& e, double t) { return {e.what()
 /// singularity diagnosis at tDiagnosis. Each part is optional: if one cannot be computed,
 /// the message keeps what came before it.
 std::string withDiagnosis(std::string message, const FailureContext& ctx, double tDiagnosis) {
+  if (const std::string note = ctx.outputs.largeDeformationNote(ctx.modelSize); !note.empty()) {
+    message += "; " + note;
+  }
   try {
     message += divergenceReport(ctx.outputs.largestCoordinate, ctx.modelSize, ctx.outputs.tEvaluating);
     if (!ctx.outputs.diverged(ctx.modelSize)) {
@@ -433,6 +436,7 @@ SimulationSummary finishSummary(const RunStart& start, const RecordedOutputs& ou
                          ", more than 1e-3 of the model size " + formatValue(modelSize) +
                          ": the results are not accurate (tighten atol and rtol)");
   }
+  if (const std::string note = outputs.largeDeformationNote(modelSize); !note.empty()) s.warnings.push_back(note);
   if (s.maxVelocityViolation > kWarnFraction * velocityScale) {
     s.warnings.push_back("velocity constraints violated by up to " + formatValue(s.maxVelocityViolation) +
                          ", more than 1e-3 of the velocity scale " + formatValue(velocityScale) +
