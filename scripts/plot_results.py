@@ -118,13 +118,24 @@ COORD_UNITS = {"x": "m", "y": "m", "z": "m", "theta": "rad", "vx": "m/s", "vy": 
                "slack": "-",
                # spatial joint outputs (docs/scene-format.md, "Results files", item 7)
                "angle": "rad", "angle1": "rad", "angle2": "rad", "displacement": "m", "dx": "m", "dy": "m",
-               "rx": "rad", "ry": "rad", "rz": "rad", "omega_x": "rad/s", "omega_y": "rad/s", "omega_z": "rad/s"}
+               "rx": "rad", "ry": "rad", "rz": "rad", "omega_x": "rad/s", "omega_y": "rad/s", "omega_z": "rad/s",
+               # spatial bodies, reactions, beam section forces and FE stresses
+               "uz": "m", "Qy": "N", "Qz": "N", "Mx": "N m", "My": "N m", "Mz": "N m", "fz": "N",
+               "mx": "N m", "my": "N m", "mz": "N m", "wx": "rad/s", "wy": "rad/s", "wz": "rad/s",
+               "e0": "-", "e1": "-", "e2": "-", "e3": "-",
+               "sxx": "Pa", "syy": "Pa", "szz": "Pa", "sxy": "Pa", "syz": "Pa", "szx": "Pa", "von_mises": "Pa"}
 DESCRIPTIONS = {"ux": "elastic displacement x", "uy": "elastic displacement y", "N": "axial force",
                 "M": "bending moment", "fx": "reaction x", "fy": "reaction y", "m": "reaction moment",
                 "effort": "driver effort", "theta": "angle", "theta_dot": "angular velocity",
                 "theta_ddot": "angular acceleration", "kinetic": "kinetic energy",
                 "potential": "potential energy", "total": "total energy",
-                "angle": "joint angle", "displacement": "joint displacement"}
+                "angle": "joint angle", "displacement": "joint displacement",
+                "uz": "elastic displacement z", "Qy": "shear force y", "Qz": "shear force z",
+                "Mx": "torsional moment", "My": "bending moment y", "Mz": "bending moment z",
+                "fz": "reaction z", "mx": "reaction moment x", "my": "reaction moment y", "mz": "reaction moment z",
+                "wx": "angular velocity x (body axes)", "wy": "angular velocity y (body axes)",
+                "wz": "angular velocity z (body axes)", "e0": "Euler parameter e0", "e1": "Euler parameter e1",
+                "e2": "Euler parameter e2", "e3": "Euler parameter e3", "von_mises": "von Mises stress"}
 
 
 def unit_of(name, kinematics):
@@ -148,9 +159,21 @@ def unit_of(name, kinematics):
     if re.fullmatch(r"q\d+", coord):
         return None  # an elastic coordinate: a displacement, a slope or a modal amplitude
     unit = COORD_UNITS.get(coord)
+    if unit == "rad/s" and per == "/s":  # wx_dot: an angular acceleration
+        return "rad/s²"
     if unit is None or (per and unit not in ("m", "rad")):
         return None
     return unit + per
+
+
+# Columns of one unit share a panel while their largest values lie within this factor.
+PANEL_MAGNITUDES = 30.0
+
+
+def same_magnitude(a, others):
+    """True when a column of size a (its largest |value|) can share a panel with columns of
+    these sizes: within PANEL_MAGNITUDES of each (zero goes with anything)."""
+    return all(a == 0.0 or b == 0.0 or max(a, b) <= PANEL_MAGNITUDES * min(a, b) for b in others)
 
 
 def describe(name):
@@ -184,6 +207,11 @@ def display_unit(unit, data, deg):
 
 def axis_label(names, unit):
     text = ", ".join(describe(n) for n in names)
+    if len(names) > 3:  # the legend names them; the label says what they are
+        kinds = {DESCRIPTIONS.get(n.rpartition(".")[2], n.rpartition(".")[2]) for n in names}
+        text = next(iter(kinds)) if len(kinds) == 1 else f"{len(names)} columns (see the legend)"
+        if kinds <= {"x", "y", "z"}:
+            text = "positions"
     if len(names) == 1:
         d = DESCRIPTIONS.get(names[0].rpartition(".")[2])
         if d and names[0] != "t":
@@ -222,6 +250,11 @@ def main(argv):
         header = runs[0][2]
         columns = [h for h in header if re.fullmatch(r"[^,]+\.(x|y|theta)", h) and
                    h.rpartition(".")[0] + ".theta" in header]
+        if not columns:  # a spatial run: the bodies' positions (x, y, z of those with Euler parameters)
+            bodies = [h.rpartition(".")[0] for h in header if h.endswith(".e0")]
+            columns = [f"{b}.{c}" for b in bodies[:3] for c in ("x", "y", "z") if f"{b}.{c}" in header]
+            # and the deflection outputs' elastic displacements (their own panel: other magnitudes)
+            columns += [h for h in header if re.fullmatch(r"[^,]+\.(ux|uy|uz)", h)][:3]
         if kinematics:
             columns = [h for h in header if h.endswith(".x") or h.endswith(".y")][:6]
         if not columns:
@@ -263,13 +296,23 @@ def main(argv):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    # Panels: one per unit, in the order the columns first name them.
+    # Panels: one per unit, in the order the columns first name them; within a unit, columns
+    # whose sizes differ by more than PANEL_MAGNITUDES (0.2 mm of deflection and 0.3 m of
+    # position) go to panels of their own, so that none is drawn as a flat line.
+    size = {c: max((abs(v) for _, _, h, rows, _ in runs for v in values(h, rows, c) if math.isfinite(v)),
+                   default=0.0) for c in columns}
+    largest = {}
+    for c in columns:
+        largest[unit_of(c, kinematics)] = max(largest.get(unit_of(c, kinematics), 0.0), size[c])
+    for c in columns:  # round-off of zero (a planar motion's z) is zero: it joins any panel
+        if size[c] <= 1e-9 * largest[unit_of(c, kinematics)]:
+            size[c] = 0.0
     panels = []
     for c in columns:
         u = unit_of(c, kinematics)
         key = u if u is not None else f"?{c}"
         for panel in panels:
-            if panel[0] == key:
+            if panel[0] == key and same_magnitude(size[c], [size[n] for n in panel[1]]):
                 panel[1].append(c)
                 break
         else:
