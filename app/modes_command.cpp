@@ -313,24 +313,32 @@ int runSweep(const ModesCommandOptions& o, const nlohmann::json& base, const fs:
   for (int k = 1; k <= o.count; ++k) csv << ",f" << k << "_hz";
   for (int k = 1; k <= o.count; ++k) csv << ",zeta" << k;
   csv << '\n';
+  // The columns are branches followed by shape (followBranches: modal assurance with the
+  // previous speed's modes), not ranks: where modes cross, a line stays on its mode. Two
+  // more modes than shown are followed, so that one coming down from above is caught.
   ModesOptions mo;
-  mo.count = o.count;
+  mo.count = o.count + 2;
   mo.solver = o.solver;
-  std::printf("Campbell sweep of \"%s\": %d speeds from %g to %g rad/s\n", cli::oneLine(sw.name).c_str(), sw.points,
-              sw.from, sw.to);
+  std::printf("Campbell sweep of \"%s\": %d speeds from %g to %g rad/s (modes followed by shape)\n",
+              cli::oneLine(sw.name).c_str(), sw.points, sw.from, sw.to);
+  std::vector<Mode> previous;
   for (int i = 0; i < sw.points; ++i) {
     const double speed = sw.points == 1 ? sw.from : sw.from + (sw.to - sw.from) * i / (sw.points - 1);
     cli::stopIfSignalledInStep(0.0);  // between the speeds of the sweep
     const Scene scene = parseSceneText(withSpeed(base, sw.name, speed).dump(), o.scenePath);
     const System& sys = scene.system;
-    const std::vector<Mode> modes = modesAbout(sys, initialReference(scene, o.steady), mo, basisFor(sys, o.solver));
+    const std::vector<Mode> found = modesAbout(sys, initialReference(scene, o.steady), mo, basisFor(sys, o.solver));
+    std::vector<Mode> modes;
+    for (int j : followBranches(previous, found)) modes.push_back(found[j]);
+    previous = modes;
     csv << number(speed);
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].frequencyHz) : "");
     for (int k = 0; k < o.count; ++k) csv << ',' << (k < static_cast<int>(modes.size()) ? number(modes[k].dampingRatio) : "");
     csv << '\n';
     std::printf("  speed %10.6g rad/s:", speed);
-    for (size_t k = 0; k < std::min<size_t>(modes.size(), 6); ++k) std::printf(" %.5g", modes[k].frequencyHz);
-    std::printf(" Hz%s\n", modes.size() > 6 ? " ..." : "");
+    const size_t shown = std::min<size_t>(modes.size(), static_cast<size_t>(o.count));
+    for (size_t k = 0; k < std::min<size_t>(shown, 6); ++k) std::printf(" %.5g", modes[k].frequencyHz);
+    std::printf(" Hz%s\n", shown > 6 ? " ..." : "");
   }
   csv.close();
   if (!csv) throw writeFailure(out / "campbell.csv");

@@ -1,5 +1,7 @@
 #include "integrators/linearization.hpp"
 
+#include <tuple>
+
 #include <Eigen/Dense>
 #include <Eigen/SparseLU>
 // GCC 12 warns -Wuse-after-free inside Spectra's UpperHessenbergEigen (Eigen temporaries
@@ -576,6 +578,37 @@ std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& opt
 std::vector<Mode> modesAbout(const System& sys, const ReferenceState& state, const ModesOptions& options,
                              BasisKind basis) {
   return computeModes(reduce(linearize(sys, state), basis), options);
+}
+
+double modalAssurance(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b) {
+  const double aa = a.squaredNorm(), bb = b.squaredNorm();
+  if (!(aa > 0.0) || !(bb > 0.0) || a.size() != b.size()) return 0.0;
+  return std::norm(a.dot(b)) / (aa * bb);  // a.dot(b) = a^H b
+}
+
+std::vector<int> followBranches(const std::vector<Mode>& previous, const std::vector<Mode>& current) {
+  const int np = static_cast<int>(previous.size()), nc = static_cast<int>(current.size());
+  std::vector<std::tuple<double, int, int>> pairs;  // (MAC, previous, current)
+  for (int i = 0; i < np; ++i)
+    for (int j = 0; j < nc; ++j) pairs.emplace_back(modalAssurance(previous[i].shape, current[j].shape), i, j);
+  std::stable_sort(pairs.begin(), pairs.end(),
+                   [](const auto& x, const auto& y) { return std::get<0>(x) > std::get<0>(y); });
+  std::vector<int> of(np, -1);
+  std::vector<char> used(nc, 0);
+  for (const auto& [mac, i, j] : pairs) {
+    if (of[i] < 0 && !used[j]) {
+      of[i] = j;
+      used[j] = 1;
+    }
+  }
+  std::vector<int> order;
+  for (int i = 0; i < np; ++i) {
+    if (of[i] >= 0) order.push_back(of[i]);
+  }
+  for (int j = 0; j < nc; ++j) {  // modes of no earlier branch: by frequency (current's order)
+    if (!used[j]) order.push_back(j);
+  }
+  return order;
 }
 
 }  // namespace flexmbd

@@ -127,6 +127,17 @@ struct ModesOptions {
 /// does not converge (or the sparse one's shift is an eigenvalue).
 std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& options = {});
 
+/// The modal assurance criterion of two mode shapes: |a^H b|^2 / ((a^H a) (b^H b)), 1 for
+/// the same shape, 0 for orthogonal ones (Allemang & Brown 1982).
+double modalAssurance(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b);
+
+/// The branches of a sweep followed by shape, not by rank (a Campbell diagram whose modes
+/// cross): for each mode of `previous` (in its order) the index of the mode of `current`
+/// with the same shape, the pairs taken greedily by decreasing modal assurance (each mode of
+/// `current` used once); the modes of `current` left over follow, by frequency. Returns a
+/// permutation of 0 .. current.size() - 1.
+std::vector<int> followBranches(const std::vector<Mode>& previous, const std::vector<Mode>& current);
+
 /// Linearisation, reduction and modes in one call.
 std::vector<Mode> modesAbout(const System& sys, const ReferenceState& state, const ModesOptions& options = {},
                              BasisKind basis = BasisKind::Svd);
