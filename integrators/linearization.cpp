@@ -596,9 +596,21 @@ std::vector<int> followBranches(const std::vector<Mode>& previous, const std::ve
   std::vector<int> of(np, -1);
   std::vector<char> used(nc, 0);
   for (const auto& [mac, i, j] : pairs) {
+    if (mac < kBranchAssurance) break;  // not the same shape: left to the frequency order
     if (of[i] < 0 && !used[j]) {
       of[i] = j;
       used[j] = 1;
+    }
+  }
+  // branches without a confident match (a degenerate pair splitting, a shape that changed
+  // too much between two speeds) take the modes left over in frequency order
+  int next = 0;
+  for (int i = 0; i < np; ++i) {
+    if (of[i] >= 0) continue;
+    while (next < nc && used[next]) ++next;
+    if (next < nc) {
+      of[i] = next;
+      used[next] = 1;
     }
   }
   std::vector<int> order;

@@ -131,10 +131,16 @@ std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& opt
 /// the same shape, 0 for orthogonal ones (Allemang & Brown 1982).
 double modalAssurance(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b);
 
+/// Two modes are taken for the same branch when their modal assurance is at least this
+/// (a shape that changed more between two speeds, or a degenerate pair that splits, whose
+/// members match the split modes at about 0.5 each, is left to the frequency order).
+inline constexpr double kBranchAssurance = 0.8;
+
 /// The branches of a sweep followed by shape, not by rank (a Campbell diagram whose modes
 /// cross): for each mode of `previous` (in its order) the index of the mode of `current`
 /// with the same shape, the pairs taken greedily by decreasing modal assurance (each mode of
-/// `current` used once); the modes of `current` left over follow, by frequency. Returns a
+/// `current` used once, none below kBranchAssurance); the branches left take the modes left
+/// in frequency order, and the modes of `current` left over follow, by frequency. Returns a
 /// permutation of 0 .. current.size() - 1.
 std::vector<int> followBranches(const std::vector<Mode>& previous, const std::vector<Mode>& current);
 
