@@ -211,6 +211,38 @@ TEST(FeInterfaces, StaticLoadOnARigidInterfaceEqualsTheLagrangeMultiplierSolutio
               (frameCondensed - frameKkt).norm() / frameKkt.norm());
 }
 
+namespace {
+
+/// The shaft of the rotor on a rigid interface at z = 0 (the Craig-Bampton reference) and
+/// one at z = 0.5: 6 constraint modes and 8 fixed-interface modes.
+FeBodyOptions craigBamptonShaft(const FeBodyData& d) {
+  FeBodyOptions o = options({rigid("bottom", nodesAt(d, 0.0)), rigid("top", nodesAt(d, 0.5))});
+  o.reduction = FeReduction::CraigBampton;
+  o.reference = "bottom";
+  return o;
+}
+
+/// The unreduced static solution K x = f with the six DOF from `held` held (x = 0 there).
+VecX heldStaticSolution(const MatX& K, const VecX& f, int held) {
+  const int n = static_cast<int>(K.rows());
+  std::vector<int> free;
+  for (int i = 0; i < n; ++i) {
+    if (i < held || i >= held + 6) free.push_back(i);
+  }
+  MatX Kf(free.size(), free.size());
+  VecX ff(free.size());
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    ff[i] = f[free[i]];
+    for (std::size_t j = 0; j < free.size(); ++j) Kf(i, j) = K(free[i], free[j]);
+  }
+  const VecX uf = Kf.ldlt().solve(ff);
+  VecX x = VecX::Zero(n);
+  for (std::size_t i = 0; i < free.size(); ++i) x[free[i]] = uf[i];
+  return x;
+}
+
+}  // namespace
+
 TEST(FeInterfaces, CraigBamptonIsExactForStaticLoadsAtItsInterfaces) {
   // The shaft on a rigid interface at z = 0 (the reference, held) with a rigid one at
   // z = 0.5 (6 constraint modes) and 8 fixed-interface modes: a static force and moment at
@@ -221,10 +253,7 @@ TEST(FeInterfaces, CraigBamptonIsExactForStaticLoadsAtItsInterfaces) {
   // held to 2e-3 so that a worse basis fails).
   SKIP_WITHOUT_ROTOR_DATA();
   const FeBodyData& d = rotor();
-  FeBodyOptions o = options({rigid("bottom", nodesAt(d, 0.0)), rigid("top", nodesAt(d, 0.5))});
-  o.reduction = FeReduction::CraigBampton;
-  o.reference = "bottom";
-  const FeBodyModel cb(d, o, "rotor");
+  const FeBodyModel cb(d, craigBamptonShaft(d), "rotor");
   ASSERT_EQ(cb.invariants().numElastic(), 6 + 8);
   const MatX K = MatX(cb.nodalInvariants().kff), M = MatX(cb.nodalInvariants().mff);
   const int n = static_cast<int>(K.rows());
@@ -232,19 +261,7 @@ TEST(FeInterfaces, CraigBamptonIsExactForStaticLoadsAtItsInterfaces) {
   const int bottom = n - 12, top = n - 6;
   VecX f = VecX::Zero(n);
   f.segment<6>(top) << 1e3, -2e3, 5e2, 30.0, 10.0, -20.0;
-  std::vector<int> free;
-  for (int i = 0; i < n; ++i) {
-    if (i < bottom || i >= bottom + 6) free.push_back(i);
-  }
-  MatX Kf(free.size(), free.size());
-  VecX ff(free.size());
-  for (std::size_t i = 0; i < free.size(); ++i) {
-    ff[i] = f[free[i]];
-    for (std::size_t j = 0; j < free.size(); ++j) Kf(i, j) = K(free[i], free[j]);
-  }
-  const VecX uf = Kf.ldlt().solve(ff);
-  VecX full = VecX::Zero(n);
-  for (std::size_t i = 0; i < free.size(); ++i) full[free[i]] = uf[i];
+  const VecX full = heldStaticSolution(K, f, bottom);
   const MatX& B = cb.basis();
   const MatX Kr = B.transpose() * K * B;
   const VecX x = Kr.ldlt().solve(B.transpose() * f);
@@ -391,9 +408,7 @@ TEST(FeInertiaModes, CraigBamptonShaftHoldsItsSpinStretchExactly) {
   // as above.
   SKIP_WITHOUT_ROTOR_DATA();
   const FeBodyData& d = rotor();
-  FeBodyOptions o = options({rigid("bottom", nodesAt(d, 0.0)), rigid("top", nodesAt(d, 0.5))});
-  o.reduction = FeReduction::CraigBampton;
-  o.reference = "bottom";
+  FeBodyOptions o = craigBamptonShaft(d);
   const FeBodyModel plain(d, o, "rotor");
   o.inertiaModes = true;
   o.dampingRatio = 0.01;
@@ -401,20 +416,7 @@ TEST(FeInertiaModes, CraigBamptonShaftHoldsItsSpinStretchExactly) {
   const FfrInvariants3d& nodal = with.nodalInvariants();
   const int n = static_cast<int>(nodal.kff.rows()), bottom = n - 12;
   const VecX f = spinLoad(nodal, 2.0 * M_PI * 50.0);
-  std::vector<int> free;
-  for (int i = 0; i < n; ++i) {
-    if (i < bottom || i >= bottom + 6) free.push_back(i);
-  }
-  const MatX K = MatX(nodal.kff);
-  MatX Kf(free.size(), free.size());
-  VecX ff(free.size());
-  for (std::size_t i = 0; i < free.size(); ++i) {
-    ff[i] = f[free[i]];
-    for (std::size_t j = 0; j < free.size(); ++j) Kf(i, j) = K(free[i], free[j]);
-  }
-  const VecX uf = Kf.ldlt().solve(ff);
-  VecX exact = VecX::Zero(n);
-  for (std::size_t i = 0; i < free.size(); ++i) exact[free[i]] = uf[i];
+  const VecX exact = heldStaticSolution(MatX(nodal.kff), f, bottom);
   const double errWith = (reducedStatic(with.basis(), nodal.kff, f) - exact).norm() / exact.norm();
   const double errPlain = (reducedStatic(plain.basis(), nodal.kff, f) - exact).norm() / exact.norm();
   EXPECT_LT(errWith, 1e-8);
