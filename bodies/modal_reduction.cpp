@@ -73,14 +73,18 @@ void largestOfPencil(const SpMat& A, const SpMat& C, int nev, const std::string&
   Spectra::SparseCholesky<double> cop(C);
   if (cop.info() != Spectra::CompInfo::Successful) throw InputError(owner + ": " + notDefinite);
   Spectra::SparseSymMatProd<double> mop(A);
-  const int ncv = std::min(n, std::max(2 * nev + 1, 20));
+  // an even Krylov subspace of 2 nev + 2 (at least 20): the odd 2 nev + 1 stalled the same
+  // Lanczos in the linearisation's modes (integrators/linearization.cpp) at 9 of 10 values
+  const int ncv = std::min(n, std::max(2 * nev + 2, 20));
   Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>,
                           Spectra::GEigsMode::Cholesky>
       eigs(mop, cop, nev, ncv);
   eigs.init();
   eigs.compute(Spectra::SortRule::LargestAlge, 1000, 1e-13);
   if (eigs.info() != Spectra::CompInfo::Successful) {
-    throw InputError(owner + ": the " + solver + " eigensolver (Spectra, shift-invert) did not converge");
+    throw InputError(owner + ": the " + solver + " eigensolver (Spectra's Lanczos on the pencil, Cholesky mode, " +
+                     std::to_string(ncv) + " Krylov vectors) did not find " + std::to_string(nev) +
+                     " eigenvalues in 1000 restarts; ask for fewer modes");
   }
   nu = eigs.eigenvalues();
   X = eigs.eigenvectors();
