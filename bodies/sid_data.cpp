@@ -98,9 +98,11 @@ SidNode nodeOf(const FfrPoint3d& p, int index, int n) {
   throw InputError(owner + ": SID " + what);
 }
 
-/// A block's shape and order (`minOrder`: the first-order term is needed).
-void requireShape(const SidTaylor& t, int nrow, int ncol, int n, int minOrder, const std::string& owner) {
-  if (t.name.empty()) fail(owner, "has no block of the required kind (expected one named as in docs/fe-import.md)");
+/// A block's shape and order (`minOrder`: the first-order term is needed); `block` names it
+/// when it is missing.
+void requireShape(const SidTaylor& t, const char* block, int nrow, int ncol, int n, int minOrder,
+                  const std::string& owner) {
+  if (t.name.empty()) fail(owner, std::string("has no block ") + block + " (required; docs/fe-import.md, \"SID\")");
   if (t.nrow != nrow || t.ncol != ncol) {
     fail(owner, "block " + t.name + " is " + std::to_string(t.nrow) + " x " + std::to_string(t.ncol) + "; expected " +
                     std::to_string(nrow) + " x " + std::to_string(ncol) + " (nelastq = " + std::to_string(n) + ")");
@@ -384,22 +386,22 @@ SidData sidFromInvariants(const FfrInvariants3d& inv, std::vector<std::string> m
 
 FfrInvariants3d invariantsFromSid(const SidData& sid, const std::string& owner) {
   const int n = sid.numElastic();
-  requireShape(sid.mdCM, 3, 1, n, 0, owner);
-  requireShape(sid.J, 3, 3, n, 0, owner);
-  requireShape(sid.Cr, n, 3, n, 0, owner);
-  requireShape(sid.Me, n, n, n, 0, owner);
-  requireShape(sid.Gr, 3, 3 * n, n, 1, owner);
-  requireShape(sid.Ke, n, n, n, 0, owner);
-  if (!sid.De.name.empty()) requireShape(sid.De, n, n, n, 0, owner);
-  if (!sid.Ct.name.empty()) requireShape(sid.Ct, n, 3, n, 0, owner);
-  if (!sid.Ge.name.empty()) requireShape(sid.Ge, n, 3 * n, n, 0, owner);
-  if (!sid.Oe.name.empty()) requireShape(sid.Oe, n, 6, n, 0, owner);
-  if (!sid.ksigma.name.empty()) requireShape(sid.ksigma, n, 1, n, 0, owner);
+  requireShape(sid.mdCM, "mdCM", 3, 1, n, 0, owner);
+  requireShape(sid.J, "J", 3, 3, n, 0, owner);
+  requireShape(sid.Cr, "Cr", n, 3, n, 0, owner);
+  requireShape(sid.Me, "Me", n, n, n, 0, owner);
+  requireShape(sid.Gr, "Gr", 3, 3 * n, n, 1, owner);
+  requireShape(sid.Ke, "Ke", n, n, n, 0, owner);
+  if (!sid.De.name.empty()) requireShape(sid.De, "De", n, n, n, 0, owner);
+  if (!sid.Ct.name.empty()) requireShape(sid.Ct, "Ct", n, 3, n, 0, owner);
+  if (!sid.Ge.name.empty()) requireShape(sid.Ge, "Ge", n, 3 * n, n, 0, owner);
+  if (!sid.Oe.name.empty()) requireShape(sid.Oe, "Oe", n, 6, n, 0, owner);
+  if (!sid.ksigma.name.empty()) requireShape(sid.ksigma, "ksigma", n, 1, n, 0, owner);
   for (const SidNode& nd : sid.nodes) {
-    requireShape(nd.origin, 3, 1, n, 0, owner + ", node " + nd.name);
-    requireShape(nd.phi, 3, n, n, 0, owner + ", node " + nd.name);
-    requireShape(nd.psi, 3, n, n, 0, owner + ", node " + nd.name);
-    if (!nd.ap.name.empty()) requireShape(nd.ap, 3, 3, n, 0, owner + ", node " + nd.name);
+    requireShape(nd.origin, "origin", 3, 1, n, 0, owner + ", node " + nd.name);
+    requireShape(nd.phi, "phi", 3, n, n, 0, owner + ", node " + nd.name);
+    requireShape(nd.psi, "psi", 3, n, n, 0, owner + ", node " + nd.name);
+    if (!nd.ap.name.empty()) requireShape(nd.ap, "AP", 3, 3, n, 0, owner + ", node " + nd.name);
   }
 
   FfrInvariants3d inv;

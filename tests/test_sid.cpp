@@ -459,6 +459,10 @@ TEST(SidReader, BlocksThatDisagreeOrCarryStiffeningAreRefused) {
   SidData nq = sid;
   nq.modeNames.push_back("q3");
   expectMentions(errorOf([&] { invariantsFromSid(nq, "body 'b'"); }), {"block mdCM", "nq = 2", "nelastq = 3"});
+  // a required block missing from data built in code (the file reader refuses it earlier)
+  SidData noKe = sid;
+  noKe.Ke = SidTaylor{};
+  expectMentions(errorOf([&] { invariantsFromSid(noKe, "body 'b'"); }), {"body 'b': SID has no block Ke"});
   // a node's psi (the joints' rotation) that disagrees with its AP
   SidData ap = sid;
   ap.nodes[3].psi.m0(2, 1) += 0.5;
