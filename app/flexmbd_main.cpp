@@ -6,6 +6,7 @@
 //   flexmbd plot DIR [DIR ...] [--columns A,B] [...] (app/plot_command.cpp)
 //   flexmbd modes SCENE.json --out DIR [...]         (app/modes_command.cpp)
 //   flexmbd sid SCENE.json --body NAME --out FILE    (app/sid_command.cpp)
+//   flexmbd view DIR [--out FILE.html] [...]         (app/view_command.cpp)
 //   flexmbd --help | --version
 // Exit status: 0 ok; 1 the solver failed during the run (the rows up to the failure are
 // kept in DIR/results.csv or results.h5, DIR/summary.json says "failed"); 2 bad input (command line,
@@ -28,6 +29,7 @@
 #include "app/plot_command.hpp"
 #include "app/summary_command.hpp"
 #include "app/tensegrity_command.hpp"
+#include "app/view_command.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
@@ -60,6 +62,8 @@ const char* const kUsage =
     "       flexmbd modes SCENE.json --out DIR [--at T] [--count N] [--steady]\n"
     "                     [--sweep NAME:FROM:TO:N] [--solver auto|dense|sparse]\n"
     "       flexmbd sid SCENE.json --body NAME --out FILE.SID_FEM\n"
+    "       flexmbd view DIR [--out FILE.html] [--columns A,B] [--scene SCENE.json]\n"
+    "                    [--max-frames N]\n"
     "       flexmbd --help\n"
     "       flexmbd --version\n"
     "\n"
@@ -120,6 +124,14 @@ const char* const kUsage =
     "NAME of SCENE.json to FILE: a reduced body for other multibody codes, or for a\n"
     "\"sid_body\" of a flexmbd scene (see docs/fe-import.md, \"SID\").\n"
     "\n"
+    "view writes one HTML page (DIR/view.html, or --out) that animates the run in DIR in\n"
+    "a browser, offline (three.js inside): bodies, joints and the ground, a colour map\n"
+    "of deflection or section forces, play/pause, speed, a time slider, plots of results\n"
+    "columns with a cursor (--columns, default the scene's outputs or body positions).\n"
+    "For a folder of flexmbd modes it animates each mode shape. The scene is the one the\n"
+    "run recorded in summary.json (--scene to give another); --max-frames N draws at\n"
+    "most N of the output times (default 1000). See docs/viewer.md.\n"
+    "\n"
     "A scene of the other command is refused with a message naming the command it is for.\n"
     "\n"
     "exit status: 0 success; 1 solver failure during the run, or kinematics stopped at a\n"
@@ -164,7 +176,7 @@ Options parseCommandLine(int argc, char** argv) {
   }
   if (args[0] != "run") {
     throw UsageError("unknown command '" + args[0] +
-                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', 'sid', '--help' or '--version')");
+                     "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', 'sid', 'view', '--help' or '--version')");
   }
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
@@ -299,7 +311,7 @@ int runCommand(const Options& o) {
   const std::string what = summary.interruptedBySignal || summary.outputFailed ? summary.message
                                                                                : "solver failure: " + summary.message;
   try {
-    writeSummary(outDir, summary, *scene);
+    writeSummary(outDir, summary, *scene, o.scenePath);
   } catch (const std::exception& e) {
     printError((summary.ok ? std::string() : what + " (" + kept + "); ") + "cannot write the summary: " + e.what());
     return summary.ok ? kExitSolverFailure : failureStatus;
@@ -331,6 +343,12 @@ int mainImpl(int argc, char** argv) {
     bool help = false;
     for (const auto& a : rest) help = help || a == "--help" || a == "-h";
     if (!help) return runSidCommand(rest);
+  }
+  if (argc >= 2 && std::string(argv[1]) == "view") {
+    const std::vector<std::string> rest(argv + 2, argv + argc);
+    bool help = false;
+    for (const auto& a : rest) help = help || a == "--help" || a == "-h";
+    if (!help) return runViewCommand(rest);
   }
   if (argc >= 2 && std::string(argv[1]) == "modes") {
     const std::vector<std::string> rest(argv + 2, argv + argc);

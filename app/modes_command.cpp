@@ -218,26 +218,61 @@ double shapeScale(const System& sys, const VecX& shape) {
   return angles > 0.0 ? kShapeAngle / angles : 0.0;
 }
 
-/// DIR/vtk/mode_NN.pvd: one period of each mode shape, q = q_ref (+) c Re(shape e^{i phi}).
-void writeShapesVtk(const fs::path& dir, const Scene& scene, const ReferenceState& ref, const std::vector<Mode>& modes) {
+/// The states drawn for mode k: one period of its shape, kShapeFrames of them,
+/// q = q_ref (+) c Re(shape e^{i phi}).
+std::vector<VecX> shapeStates(const System& sys, const ReferenceState& ref, const Mode& mode) {
+  std::vector<VecX> states;
+  const double c = shapeScale(sys, mode.shape.real());
+  for (int f = 0; f < kShapeFrames; ++f) {
+    const double phi = 2 * M_PI * f / kShapeFrames;
+    states.push_back(sys.applyIncrement(ref.q, c * (mode.shape * std::exp(std::complex<double>(0.0, phi))).real()));
+  }
+  return states;
+}
+
+/// DIR/vtk/mode_NN.pvd (one period of each mode shape) and DIR/mode_states.csv (the same
+/// states: mode, phase as a fraction of the period, then the coordinates; `flexmbd view`
+/// animates them).
+void writeShapeStates(const fs::path& dir, const Scene& scene, const ReferenceState& ref,
+                      const std::vector<Mode>& modes) {
   const System& sys = scene.system;
+  const fs::path csv = dir / "mode_states.csv";
+  std::ofstream out(csv);
+  out << "mode,phase";
+  for (const std::string& n : sys.coordinateNames()) out << ',' << n;
+  out << '\n';
   for (size_t k = 0; k < modes.size(); ++k) {
     char prefix[32];
     std::snprintf(prefix, sizeof prefix, "mode_%02zu", k + 1);
-    VtkWriter vtk(dir, sys, prefix, 4, scene.geometry, scene.feBodies);
-    const double c = shapeScale(sys, modes[k].shape.real());
+    VtkWriter vtk(dir / "vtk", sys, prefix, 4, scene.geometry, scene.feBodies);
+    const std::vector<VecX> states = shapeStates(sys, ref, modes[k]);
     for (int f = 0; f < kShapeFrames; ++f) {
-      const double phi = 2 * M_PI * f / kShapeFrames;
-      const VecX dx = c * (modes[k].shape * std::exp(std::complex<double>(0.0, phi))).real();
       OutputSample s;
       s.t = static_cast<double>(f) / kShapeFrames;  // the fraction of the period
-      s.q = sys.applyIncrement(ref.q, dx);
+      s.q = states[f];
       s.v = VecX::Zero(sys.numVelocities());
       s.a = VecX::Zero(sys.numVelocities());
       s.lambda = ref.lambda;
       vtk.write(s);
+      out << k + 1 << ',' << number(s.t);
+      for (Eigen::Index i = 0; i < s.q.size(); ++i) out << ',' << number(s.q[i]);
+      out << '\n';
     }
   }
+  if (!out) throw writeFailure(csv);
+}
+
+/// DIR/modes.json: the scene file (absolute) and the time of the reference state.
+void writeModesJson(const fs::path& dir, const std::string& scenePath, double t) {
+  nlohmann::ordered_json j;
+  std::error_code ec;
+  const fs::path absolute = fs::absolute(scenePath, ec);
+  j["scene_file"] = ec ? scenePath : absolute.lexically_normal().string();
+  j["t"] = t;
+  const fs::path file = dir / "modes.json";
+  std::ofstream out(file);
+  out << j.dump(2) << '\n';
+  if (!out) throw writeFailure(file);
 }
 
 void printTable(const std::vector<Mode>& modes) {
@@ -394,15 +429,17 @@ int runModesCommand(const std::vector<std::string>& args) {
     const std::vector<Mode> modes = computeModes(red, mo);
     writeModesCsv(out / "modes.csv", modes);
     writeShapesCsv(out / "mode_shapes.csv", modes, lin.velocityNames);
-    writeShapesVtk(out / "vtk", *scene, ref, modes);
+    writeShapeStates(out, *scene, ref, modes);
+    writeModesJson(out, o.scenePath, ref.t);
     const double aMax = ref.a.size() ? ref.a.lpNorm<Eigen::Infinity>() : 0.0;
     std::printf("flexmbd: modes of %s about t = %g (%s; max |a| = %.3g): %d velocities, %d independent\n",
                 o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : o.steady ? "steady motion" : "in motion", aMax,
                 sys.numVelocities(), static_cast<int>(red.N.cols()));
     printTable(modes);
     printBeamFrequencies(sys, o.count);
-    std::printf("results: %s, %s, %s\n", (out / "modes.csv").string().c_str(), (out / "mode_shapes.csv").string().c_str(),
-                (out / "vtk").string().c_str());
+    std::printf("results: %s, %s, %s, %s (flexmbd view %s draws them)\n", (out / "modes.csv").string().c_str(),
+                (out / "mode_shapes.csv").string().c_str(), (out / "mode_states.csv").string().c_str(),
+                (out / "vtk").string().c_str(), out.string().c_str());
     return kExitOk;
   } catch (const RunInterrupted& e) {
     cli::printError(std::string("modes: ") + e.what() + " (the modes were not written)");

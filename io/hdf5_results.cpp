@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <type_traits>
 
+#include "core/errors.hpp"
+
 #include "integrators/simulation.hpp"
 
 namespace flexmbd {
@@ -208,6 +210,51 @@ void Hdf5RowFile::append(const std::vector<double>& row, double t) {
                            std::to_string(rows_) + " complete rows kept)");
   }
   ++rows_;
+}
+
+// ----- reading results back ----------------------------------------------------------------
+
+ResultsTable readHdf5Results(const std::filesystem::path& path) {
+  QuietHdf5Errors quiet;
+  const std::string where = "'" + path.string() + "'";
+  const Id file{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  if (file.id < 0) throw InputError(where + ": not an HDF5 file that can be read (" + hdf5Reason() + ")");
+  ResultsTable t;
+  {
+    const Id ds{H5Dopen2(file.id, "columns", H5P_DEFAULT), H5Dclose};
+    const Id space{ds.id >= 0 ? H5Dget_space(ds.id) : -1, H5Sclose};
+    if (ds.id < 0 || space.id < 0 || H5Sget_simple_extent_ndims(space.id) != 1) {
+      throw InputError(where + ": no 1-D dataset /columns (the column names flexmbd run --format hdf5 writes)");
+    }
+    hsize_t n = 0;
+    H5Sget_simple_extent_dims(space.id, &n, nullptr);
+    const Id type{H5Tcopy(H5T_C_S1), H5Tclose};
+    H5Tset_size(type.id, H5T_VARIABLE);
+    H5Tset_cset(type.id, H5T_CSET_UTF8);
+    std::vector<char*> names(n, nullptr);
+    if (n > 0 && H5Dread(ds.id, type.id, H5S_ALL, H5S_ALL, H5P_DEFAULT, names.data()) < 0) {
+      throw InputError(where + ": /columns is not a dataset of strings");
+    }
+    for (char* c : names) t.columns.push_back(c ? c : "");
+    if (n > 0) H5Dvlen_reclaim(type.id, space.id, H5P_DEFAULT, names.data());
+  }
+  const Id ds{H5Dopen2(file.id, "results", H5P_DEFAULT), H5Dclose};
+  const Id space{ds.id >= 0 ? H5Dget_space(ds.id) : -1, H5Sclose};
+  if (ds.id < 0 || space.id < 0 || H5Sget_simple_extent_ndims(space.id) != 2) {
+    throw InputError(where + ": no 2-D dataset /results (rows x columns)");
+  }
+  hsize_t dims[2] = {0, 0};
+  H5Sget_simple_extent_dims(space.id, dims, nullptr);
+  if (dims[1] != t.columns.size()) {
+    throw InputError(where + ": /results has " + std::to_string(dims[1]) + " columns, /columns names " +
+                     std::to_string(t.columns.size()));
+  }
+  std::vector<double> all(dims[0] * dims[1]);
+  if (!all.empty() && H5Dread(ds.id, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, all.data()) < 0) {
+    throw InputError(where + ": /results cannot be read (" + hdf5Reason() + ")");
+  }
+  for (hsize_t r = 0; r < dims[0]; ++r) t.rows.emplace_back(all.begin() + r * dims[1], all.begin() + (r + 1) * dims[1]);
+  return t;
 }
 
 }  // namespace flexmbd

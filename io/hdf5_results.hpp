@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "io/results_table.hpp"
+
 namespace flexmbd {
 
 /// An HDF5 table written row by row, each row whole or not at all, the file flushed after
@@ -51,5 +53,9 @@ class Hdf5RowFile {
   int reserveFd_ = -1;         ///< the file again, to reserve space before each row
   long long reserveBytes_ = 0;  ///< bytes reserved past the end of the file
 };
+
+/// Reads /columns and /results of a file Hdf5RowFile wrote.
+/// @throws InputError naming the file and what is missing or malformed.
+ResultsTable readHdf5Results(const std::filesystem::path& path);
 
 }  // namespace flexmbd

@@ -417,8 +417,15 @@ std::string summaryJson(const SimulationSummary& summary, const Scene& scene) {
   return summaryObject(summary, scene).dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace);
 }
 
-void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene) {
-  writeJsonFile(dir, summaryObject(summary, scene));
+void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene,
+                  const std::string& sceneFile) {
+  nlohmann::ordered_json j = summaryObject(summary, scene);
+  if (!sceneFile.empty()) {
+    std::error_code ec;
+    const std::filesystem::path absolute = std::filesystem::absolute(sceneFile, ec);
+    j["scene_file"] = ec ? sceneFile : absolute.lexically_normal().string();
+  }
+  writeJsonFile(dir, j);
 }
 
 void writeInputErrorSummary(const std::filesystem::path& dir, const std::string& message) {

@@ -137,9 +137,12 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
 /// energy_end (null when absent), formulation, linear_solver ("dense"/"klu"), rtol,
 /// atol, atol_velocity (the one used), tolerances (per class and the model scales of
 /// their defaults, SimulationSummary::tolerances and ::scales; null if the run failed
-/// before it started), t_start, t_end, output_step, scene (the scene name).
+/// before it started), t_start, t_end, output_step, scene (the scene name), and
+/// scene_file (the absolute path of the scene file, when `sceneFile` is given: `flexmbd
+/// view` reads the scene from it).
 /// Creates `dir` if needed; the file is replaced atomically (written beside, renamed).
-void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene);
+void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene,
+                  const std::string& sceneFile = "");
 
 /// Writes DIR/summary.json for a run that stopped on an input or model error before
 /// integrating: {"status": "failed", "message": ..., "error": "input"}.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bodies/body_geometry.hpp"
+#include "io/system_drawing.hpp"
 #include "core/system.hpp"
 #include "integrators/simulation.hpp"
 #include "tensegrity/tensegrity_output.hpp"
@@ -57,21 +58,11 @@ class VtkWriter {
   long filesWritten() const { return collection_.frames(); }
   /// Bodies with nothing to draw (a flexible_invariants body without attachment
   /// points): they are missing from every frame, and the command says so on stderr.
-  const std::vector<std::string>& bodiesNotDrawn() const { return notDrawn_; }
+  const std::vector<std::string>& bodiesNotDrawn() const { return drawer_.bodiesNotDrawn(); }
 
  private:
   VtkCollection collection_;
-  const System& sys_;
-  std::vector<std::string> notDrawn_;
-  int subdivisions_;
-  std::vector<std::vector<Vec2>> rigidPoints_;  // per body: body-frame points of its line
-  // per spatial body: its joint points (body frame), drawn as lines from the centre of
-  // mass, and the length of the axis triad drawn at the centre of mass
-  std::vector<std::vector<Vec3>> spatialPoints_;
-  double triad_ = 0.1;
-  std::vector<std::vector<SurfaceMesh>> surfaces_;  // per body: its geometry, body axes
-  std::vector<FeBodyDrawing> feBodies_;
-  std::vector<int> feIndex_;  // per body: its entry in feBodies_, or -1
+  SystemDrawer drawer_;
 };
 
 /// A tensegrity structure: its nodes as points (point data: velocity) and every member
