@@ -1,7 +1,8 @@
 # Two entry points (see README, Quick start):
 #   make demo  - install missing packages, build (Release), run the flagship demo: the
 #                slider-crank with an elastic connecting rod, 8 nodal beam elements and 2
-#                modes, 3 revolutions; a table and build/demo_out/deflection.png
+#                modes, 3 revolutions; a table, build/demo_out/deflection.png and the
+#                animation build/demo_out/view.html (flexmbd view)
 #                (make demo-rigid: the rigid slider-crank against its closed form)
 #   make test  - install missing packages, build (Release), run the CTest suite except the
 #                long runs labelled "slow" (cd build && ctest -L slow runs those)
@@ -37,7 +38,9 @@ demo: build
 	$(FLEXMBD) plot $(DEMO_OUT)/nodal $(DEMO_OUT)/modal --columns mid.uy --x crank.theta --deg \
 	  --labels "8 nodal elements,2 modes" --out $(DEMO_OUT)/deflection.png \
 	  --title "Elastic slider-crank: midpoint deflection of the rod, 8 nodal elements vs 2 modes"
+	$(FLEXMBD) view $(DEMO_OUT)/nodal --out $(DEMO_OUT)/view.html
 	@echo
+	@echo "the animation in a browser (offline, one file): $(abspath $(DEMO_OUT))/view.html"
 	@echo "plot of the midpoint deflection against the crank angle: $(DEMO_OUT)/deflection.png"
 	@echo "results: $(DEMO_OUT)/nodal and $(DEMO_OUT)/modal (results.csv, summary.json);"
 	@echo "  $(FLEXMBD) summary $(DEMO_OUT)/nodal    prints a run's summary"
