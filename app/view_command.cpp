@@ -119,8 +119,10 @@ std::vector<int> coordinateColumns(const System& sys, const ResultsTable& t, con
   return cols;
 }
 
-/// The unit of a results column from its last part ("rod.x" -> "m"), "" if unknown.
-std::string unitOf(const std::string& column) {
+/// The unit of a results column: from the run's summary.json "units" (driver efforts),
+/// else from its last part ("rod.x" -> "m"); "" if unknown.
+std::string unitOf(const std::string& column, const nlohmann::json& units = {}) {
+  if (units.is_object() && units.contains(column) && units[column].is_string()) return units[column];
   static const std::map<std::string, std::string> kUnits = {
       {"x", "m"}, {"y", "m"}, {"z", "m"}, {"ux", "m"}, {"uy", "m"}, {"uz", "m"}, {"theta", "rad"},
       {"x_dot", "m/s"}, {"y_dot", "m/s"}, {"z_dot", "m/s"}, {"theta_dot", "rad/s"}, {"wx", "rad/s"},
@@ -188,8 +190,13 @@ ViewerPage runPage(const ViewOptions& o, const Scene& scene, const fs::path& sce
   }
   page.clips.push_back(std::move(clip));
   for (const auto& row : t.rows) page.plotTimes.push_back(tc >= 0 ? row[tc] : 0.0);
+  nlohmann::json units;
+  try {
+    units = readJson(o.dir / "summary.json").value("units", nlohmann::json::object());
+  } catch (const InputError&) {  // read before; a summary without units: names tell
+  }
   for (const std::string& c : plotColumns(o, scene, t)) {
-    ViewerPlotColumn p{c, unitOf(c), {}};
+    ViewerPlotColumn p{c, unitOf(c, units), {}};
     const int k = t.column(c);
     for (const auto& row : t.rows) p.values.push_back(row[k]);
     page.plots.push_back(std::move(p));

@@ -335,6 +335,24 @@ nlohmann::ordered_json tolerancesObject(const SimulationSummary& summary) {
   return j;
 }
 
+namespace {
+
+/// The units of the columns whose unit the name cannot tell: a driver's effort is a
+/// torque (N m) when it drives an angle (body_theta, joint_angle), else a force (N).
+nlohmann::ordered_json modelUnits(const System& sys) {
+  nlohmann::ordered_json units = nlohmann::ordered_json::object();
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    const Constraint& con = sys.constraint(ConstraintIndex(c));
+    if (!con.isDriver()) continue;
+    const std::string type = con.typeName();
+    const bool angle = type == "body_theta" || type == "joint_angle";
+    units[con.name() + ".effort"] = angle ? "N m" : "N";
+  }
+  return units;
+}
+
+}  // namespace
+
 nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Scene& scene) {
   const SolverSettings& s = scene.solver;
   const IntegratorStats& st = summary.stats;
@@ -408,6 +426,7 @@ nlohmann::ordered_json summaryObject(const SimulationSummary& summary, const Sce
   j["t_start"] = s.tStart;
   j["t_end"] = s.tEnd;
   j["output_step"] = s.outputStep;
+  j["units"] = modelUnits(scene.system);
   return j;
 }
 

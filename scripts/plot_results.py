@@ -22,6 +22,7 @@ itself again with /usr/bin/python3 (or says what is missing).
 """
 import argparse
 import csv
+import json
 import difflib
 import math
 import os
@@ -138,10 +139,28 @@ DESCRIPTIONS = {"ux": "elastic displacement x", "uy": "elastic displacement y", 
                 "e2": "Euler parameter e2", "e3": "Euler parameter e3", "von_mises": "von Mises stress"}
 
 
+# Units the run's summary.json gives for columns whose name cannot tell them (a driver's
+# effort: "N m" or "N"), filled by read_model_units.
+MODEL_UNITS = {}
+
+
+def read_model_units(directory):
+    """The "units" of DIR/summary.json (runs of earlier versions have none)."""
+    try:
+        with open(os.path.join(directory, "summary.json")) as f:
+            units = json.load(f).get("units", {})
+    except (OSError, ValueError, AttributeError):
+        return
+    if isinstance(units, dict):
+        MODEL_UNITS.update({k: v for k, v in units.items() if isinstance(v, str)})
+
+
 def unit_of(name, kinematics):
     """Unit of a results column, or None when it cannot be told from the name."""
     if name == "t":
         return "s"
+    if name in MODEL_UNITS:
+        return MODEL_UNITS[name]
     if kinematics:
         if name == "alpha":
             return None  # the input parameter, in the unit of the scene's input
@@ -238,6 +257,7 @@ def main(argv):
         path = results_file(d)
         header, rows = read_table(path)
         runs.append((d, path, header, rows, path.endswith("kinematics.csv")))
+        read_model_units(d)
     kinematics = runs[0][4]
     if any(r[4] != kinematics for r in runs):
         fail("cannot draw results.csv and kinematics.csv on the same axes")

@@ -46,3 +46,34 @@ def test_a_spatial_run_is_drawn_by_default(plot, tmp_path):
                      f"--t-end 0.02 --quiet > /dev/null 2>&1") == 0
     assert plot.main([str(out)]) in (0, None)
     assert (out / "plot.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("driver, unit", [("motor", "N m"), ("push", "N")])
+def test_a_driver_effort_has_the_unit_of_what_it_drives(plot, tmp_path, driver, unit):
+    # summary.json's "units": a body_theta driver's effort is a torque, a body_x driver's a
+    # force (issue 28: the axis said "N or N m")
+    import json
+    cli = os.environ.get("FLEXMBD_CLI")
+    if not cli:
+        pytest.skip("FLEXMBD_CLI not set (CTest sets it)")
+    scene = json.load(open(os.path.join(SOURCE, "examples", "slider_crank_rigid.json")))
+    if driver == "push":  # drive the slider instead of the crank, away from the dead point
+        import math
+        theta = 1.0
+        x = math.cos(theta) + math.sqrt(4.0 - math.sin(theta) ** 2)  # l1 = 1, l2 = 2
+        scene["bodies"][0]["angle"] = theta
+        scene["bodies"][1]["position"] = [math.cos(theta), math.sin(theta)]
+        scene["bodies"][1]["angle"] = -math.asin(math.sin(theta) / 2.0)
+        scene["bodies"][2]["position"] = [x, 0.0]
+        scene["drivers"] = [{"name": "push", "type": "body_x", "body": "slider",
+                             "law": {"type": "constant_speed", "speed": -0.1, "initial": x}}]
+    scene["solver"]["t_end"] = 0.5
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene))
+    out = tmp_path / "run"
+    assert os.system(f"'{cli}' run '{path}' --out '{out}' --quiet > /dev/null 2>&1") == 0
+    assert json.load(open(out / "summary.json"))["units"] == {f"{driver}.effort": unit}
+    plot.MODEL_UNITS.clear()
+    assert plot.unit_of(f"{driver}.effort", False) == "N or N m"  # a run without "units" (earlier versions)
+    plot.read_model_units(str(out))
+    assert plot.unit_of(f"{driver}.effort", False) == unit
