@@ -17,6 +17,7 @@
 #include "core/dae_system.hpp"
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
+#include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
 #include "core/number_text.hpp"
 #include "integrators/initial_conditions.hpp"
@@ -242,21 +243,43 @@ std::vector<Mode> selectModes(std::vector<Mode> all, int count, double zeroTol) 
 /// eigenvalues of a Jordan pair come out of a dense solver near sqrt(eps) |s|_max).
 constexpr double kZeroEigenvalueFraction = 1e-6;
 
+double norm1(const SpMat& S) {
+  double best = 0.0;
+  for (int j = 0; j < S.outerSize(); ++j) {
+    double c = 0.0;
+    for (SpMat::InnerIterator it(S, j); it; ++it) c += std::abs(it.value());
+    best = std::max(best, c);
+  }
+  return best;
+}
+
 /// max(sqrt(|Kr| / |Mr|), |Cr| / |Mr|) (1-norms), or 1 if zero: the scale of the
 /// first-order form.
 double frequencyScale(const ReducedSystem& red) {
-  const auto norm1 = [](const SpMat& S) {
-    double best = 0.0;
-    for (int j = 0; j < S.outerSize(); ++j) {
-      double c = 0.0;
-      for (SpMat::InnerIterator it(S, j); it; ++it) c += std::abs(it.value());
-      best = std::max(best, c);
-    }
-    return best;
-  };
   const double m = norm1(red.M);
   const double w = std::max(std::sqrt(norm1(red.K) / m), norm1(red.C) / m);
   return w > 0.0 && std::isfinite(w) ? w : 1.0;
+}
+
+/// Widest ratio of the damping's rate |Cr| / |Mr| to the stiffness' sqrt(|Kr| / |Mr|). An
+/// overdamped mode has eigenvalues ~ -k/c and ~ -c/m, a ratio (w / (c/m))^2 apart: beyond
+/// 1e3 the slow one falls below kZeroEigenvalueFraction (1e-6) of the fast and would be
+/// reported as a rigid-body (zero) mode.
+constexpr double kMaxDampingRatioOfScales = 1e3;
+
+/// @throws SolverError when damping dominates the stiffness beyond what the eigensolvers
+/// resolve (a section "damping" beta of 1e6 s: modes reported as 0 Hz otherwise).
+void checkDampingScale(const ReducedSystem& red) {
+  const double m = norm1(red.M);
+  const double damping = norm1(red.C) / m, stiffness = std::sqrt(norm1(red.K) / m);
+  if (damping > kMaxDampingRatioOfScales * stiffness && stiffness > 0.0) {
+    throw SolverError("modes: the damping dominates the stiffness by " + fmt(damping / stiffness) +
+                      " (|C| / |M| = " + fmt(damping) + " 1/s against sqrt(|K| / |M|) = " + fmt(stiffness) +
+                      " rad/s; at most " + fmt(kMaxDampingRatioOfScales) +
+                      "): the slow overdamped eigenvalues are below the solvers' resolution and would show as "
+                      "rigid-body modes; lower the damping (a section's \"damping\" beta gives the damping ratio "
+                      "beta omega / 2), or compute the modes without it");
+  }
 }
 
 std::vector<Mode> denseModes(const ReducedSystem& red, int count) {
@@ -572,6 +595,7 @@ std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& opt
   const int n = static_cast<int>(red.M.rows());
   const bool dense = options.solver == EigenSolverKind::Dense ||
                      (options.solver == EigenSolverKind::Automatic && n <= kDenseModesLimit) || 2 * n < 8;
+  checkDampingScale(red);
   return dense ? denseModes(red, options.count) : sparseModes(red, options.count, options.shift);
 }
 

@@ -33,6 +33,7 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
+#include "core/magnitude_checks.hpp"
 #include "core/system_evaluation.hpp"
 #include "joints/point_pair.hpp"
 
@@ -501,6 +502,21 @@ void readStressOutput(const ObjectReader& r, const std::vector<FeBodyDrawing>& f
 
 // ----- public API ------------------------------------------------------------------------------
 
+namespace {
+
+/// A point output farther from its body's frame than kMaxMagnitudeRatio times the model's
+/// size is a typo (z = -1e100), not a point of the body: its coordinates would be the
+/// round-off of the body's motion times 1e100.
+void checkOutputPointSize(const ObjectReader& r, const Vec3& p, const System& sys) {
+  const double L = sys.characteristicLength();
+  if (!(p.norm() <= kMaxMagnitudeRatio * L)) {
+    r.fail("point " + vectorText(p) + " is " + fmt(p.norm() / L) + " times the model's size (" + fmt(L) +
+           " m), more than " + fmt(kMaxMagnitudeRatio) + ": expected a point of the body (body frame, m)");
+  }
+}
+
+}  // namespace
+
 OutputRequest parseOutputRequest(const json& j, const std::string& where, const System& sys,
                                  const std::vector<OutputRequest>& earlier, bool spatial,
                                  const std::vector<FeBodyDrawing>& feBodies) {
@@ -559,10 +575,12 @@ OutputRequest parseOutputRequest(const json& j, const std::string& where, const 
       }
       return out;
     }
+    checkOutputPointSize(r, out.point3, sys);
     located(r.where(), [&] { out.pointId = sys.body(out.body).resolvePoint(out.point3, "output " + inQuotes(out.name)); });
     return out;
   }
   out.point = r.vec2("point", Vec2::Zero());
+  checkOutputPointSize(r, lift(out.point), sys);
   if (out.type == OutputRequest::Type::Deflection) {
     const auto* fb = dynamic_cast<const FfrBody2d*>(&sys.body(out.body));
     if (!fb || !fb->beamModel()) {

@@ -287,3 +287,30 @@ TEST_F(Cli, ModesSparseSolverConvergesOnTheSpatialElasticSliderCrank) {
   constexpr double kSolverAgreement = 1e-8;
   for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(ws[k] / wd[k], 1.0, kSolverAgreement) << k;
 }
+
+// Issue 26/28: a section damping beta of 1e6 s made every mode overdamped by far: the slow
+// eigenvalues (~ -1/beta) fell below the zero threshold and were printed as 0 Hz modes
+// (exit 0; before that, "the reduced mass matrix is not positive definite"). Now the run
+// says the damping dominates, by how much, and what to do; exit 1 (a solver limit).
+TEST_F(Cli, ModesWithDampingBeyondTheSolversResolutionSaySo) {
+  nlohmann::json scene = nlohmann::json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/modes_blade.json"));
+  for (auto& b : scene["bodies"]) {
+    if (b["type"] == "flexible") b["section"]["damping"] = 1e6;
+  }
+  const fs::path p = writeScene("damped.json", scene);
+  const CliResult r = run("modes " + shellQuote(p.string()) + " --out " + shellQuote((dir_ / "m").string()) + " --count 3");
+  EXPECT_EQ(r.status, 1) << r.out << r.err;
+  EXPECT_NE(r.err.find("the damping dominates the stiffness"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("lower the damping"), std::string::npos) << r.err;
+  // beta = 1e-3 s: the top mesh mode (8e4 rad/s) overdamped by beta omega = 80 < 1e3, resolved;
+  // the first mode (8.18 Hz) keeps its frequency (damping ratio beta omega / 2 = 0.026)
+  for (auto& b : scene["bodies"]) {
+    if (b["type"] == "flexible") b["section"]["damping"] = 1e-3;
+  }
+  const fs::path q = writeScene("light.json", scene);
+  const CliResult ok = run("modes " + shellQuote(q.string()) + " --out " + shellQuote((dir_ / "c").string()) + " --count 3");
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  const std::vector<double> w = omegas(dir_ / "c" / "modes.csv");
+  ASSERT_FALSE(w.empty());
+  EXPECT_GT(w.back(), 0.0);  // not the spurious zero modes of the refused case
+}

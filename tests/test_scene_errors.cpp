@@ -112,6 +112,20 @@ TEST(SceneErrors, ASpatialInertiaOfTwoNumbersSaysWhatItMustBe) {
   EXPECT_TRUE(Mentions(errorOf(j), {"key \"inertia\" must be 3 principal moments", "got a number"}));
 }
 
+TEST(SceneErrors, AnOutputPointFarBeyondTheModelIsATypo) {
+  // issue 26: a point output at z = -1e100 ran and exited 0 with coordinates of 1e100;
+  // beyond kMaxMagnitudeRatio (1e12) times the model's size it is refused, planar and spatial
+  json j = baseScene();
+  j["outputs"] = json::array({{{"type", "point"}, {"name", "far"}, {"body", "rod"}, {"point", {1e100, 0.0}}}});
+  EXPECT_TRUE(Mentions(errorOf(j), {"outputs[0]", "times the model's size", "expected a point of the body"}));
+  j["outputs"][0]["point"] = {1e6, 0.0};  // far, but within the ratio: accepted
+  EXPECT_NO_THROW(parseScene(j));
+  const json spatial = json::parse(R"({"dimension": 3,
+    "bodies": [{"name": "b", "type": "rigid", "mass": 1, "inertia": [1, 1, 1], "position": [1, 0, 0]}],
+    "outputs": [{"type": "point", "name": "p", "body": "b", "point": [0, 0, -1e100]}]})");
+  EXPECT_TRUE(Mentions(errorOf(spatial), {"outputs[0]", "times the model's size"}));
+}
+
 // ----- names ---------------------------------------------------------------------
 
 TEST(SceneErrors, UnknownBodyInJointNamesItAndListsKnownBodies) {
