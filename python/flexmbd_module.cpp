@@ -158,6 +158,24 @@ PYBIND11_MODULE(_flexmbd, m) {
       py::arg("f"), py::arg("derivative") = py::none(), py::arg("second_derivative") = py::none(),
       "A time law f(t) given by a Python callable (drivers, loads): f' and f'' from derivative(t) and "
       "second_derivative(t) if given, else by central differences (docs/python.md, User functions)");
+  m.def(
+      "_time_law_calls",
+      [](const Law& law, long calls) {
+        // benchmarks/bench_user_functions.py: `calls` evaluations of f(t) from C++ with the GIL
+        // released, as in a run (a Python law takes the GIL for each): seconds taken
+        if (!law || calls < 1) throw InputError("_time_law_calls: a time law and calls >= 1 expected");
+        double sum = 0.0;
+        std::chrono::steady_clock::time_point start;
+        double seconds = 0.0;
+        {
+          py::gil_scoped_release release;
+          start = std::chrono::steady_clock::now();
+          for (long i = 0; i < calls; ++i) sum += law->value(1e-7 * static_cast<double>(i));
+          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        }
+        return py::make_tuple(seconds, sum);
+      },
+      py::arg("law"), py::arg("calls"), "(seconds, sum of the values) of `calls` evaluations without the GIL");
   py::class_<SpringLaw, std::shared_ptr<SpringLaw>>(m, "SpringLaw")
       .def(
           "__call__",
