@@ -220,3 +220,32 @@ def test_ctrl_c_inside_a_callable_interrupts_the_run():
     with pytest.raises(KeyboardInterrupt):
         _python_pendulum(torque).run()
     assert _python_pendulum(lambda t: 1.0).run().ok  # the interpreter and the next run are fine
+
+
+def test_spatial_python_torque_and_driver_laws_equal_the_scene_laws_bit_for_bit():
+    # a spatial disc on a hinge with a torque about z, and a driven hinge: a Python callable
+    # against the same built-in law (the operations of core/time_law.cpp)
+    def disc(torque):
+        scene = flexmbd.Scene("disc")
+        sys_ = scene.system
+        d = sys_.add_rigid_body_3d("disc", flexmbd.RigidBody3dProperties(mass=3.0, inertia=(0.3, 0.35, 0.4)),
+                                   flexmbd.FrameState3d())
+        sys_.add_spatial_joint_at_world("hinge", "revolute", "ground", d, (0, 0, 0), axis=(0, 0, 1))
+        sys_.add_spatial_applied_load("motor", d, torque_z=torque)
+        scene.solver.t_end = 0.5
+        return scene.run()
+
+    assert np.array_equal(disc(lambda t: 0.0 + A * math.sin(W * t + 0.0)).data, disc(flexmbd.harmonic_law(A, W)).data)
+
+    def driven(law):
+        scene = flexmbd.Scene("arm")
+        sys_ = scene.system
+        arm = sys_.add_rigid_body_3d("arm", flexmbd.RigidBody3dProperties(mass=2.0, inertia=(0.01, 0.02, 0.03)),
+                                     flexmbd.FrameState3d(position=(0.5, 0, 1)))
+        hinge = sys_.add_spatial_joint_at_world("hinge", "revolute", "ground", arm, (0, 0, 1), axis=(0, 0, 1))
+        sys_.add_joint_angle_driver("motor", hinge, law)
+        scene.solver.t_end = 0.5
+        return scene.run()
+
+    assert np.array_equal(driven(flexmbd.user_law(lambda t: 0.0 + 2.0 * t, lambda t: 2.0, lambda t: 0.0)).data,
+                          driven(flexmbd.constant_speed_law(2.0)).data)
