@@ -5,7 +5,8 @@
 //     guarded by a try block), and f = t both ways: the difference per call of the latter
 //     is the user function's overhead.
 //  2. A spring-damper law's value and its derivatives by central differences (5 calls).
-//  3. Whole runs (50 s of motion, the fastest of interleaved rounds): a pendulum driven by the harmonic torque as a built-in and as a user law,
+//  3. Whole runs (50 s of motion, the fastest of interleaved rounds): a pendulum driven
+//     by the harmonic torque as a built-in and as a user law,
 //     and a slider on a built-in and a user spring law: wall time, calls counted, and
 //     (t_user - t_builtin) / calls.
 //     build/benchmarks/bench_user_functions [--calls N] [--rounds R]
@@ -136,7 +137,8 @@ int main(int argc, char** argv) {
   const double s1 = fastest(rounds, [&] { springLoop(linear, calls, true); });
   const double s2 = fastest(rounds, [&] { springLoop(withDerivative, calls, true); });
   std::printf("spring law f(t, x, xdot), %ld evaluations\n| evaluation | ns |\n|---|---|\n", calls);
-  std::printf("| value | %.2f |\n| value + central differences (5 calls) | %.2f |\n| value + user derivative | %.2f |\n\n",
+  std::printf("| value | %.2f |\n| value + central differences (5 calls) | %.2f |\n"
+              "| value + user derivative | %.2f |\n\n",
               1e9 * s0 / calls, 1e9 * s1 / calls, 1e9 * s2 / calls);
 
   // 3. whole runs (50 s, outputs every 0.01 s), calls counted

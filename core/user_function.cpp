@@ -35,9 +35,8 @@ auto guarded(const char* what, double t, F&& call) -> decltype(call()) {
     pollStop(t);  // a stop requested while the callable ran (Ctrl-C in a Python one) ends the run as interrupted
     throw UserFunctionError(std::string("the user ") + what + " raised " + e.what() + " at t = " + timeText(t), t);
   } catch (...) {
-    throw UserFunctionError(std::string("the user ") + what + " raised an exception that is not a std::exception at t = " +
-                                timeText(t),
-                            t);
+    throw UserFunctionError(
+        std::string("the user ") + what + " raised an exception that is not a std::exception at t = " + timeText(t), t);
   }
 }
 

@@ -172,7 +172,9 @@ TEST(UserSpringLaw, PlanarMassOnASpringDamperFollowsTheClosedForm) {
   ASSERT_TRUE(s.ok) << s.message;
   const int ix = sys.coordinateOffset(slider);
   double worst = 0.0;
-  for (const OutputSample& o : out) worst = std::max(worst, std::abs(o.q[ix] - l0 - dampedOscillator(m, k, c, x0 - l0, o.t)));
+  for (const OutputSample& o : out) {
+    worst = std::max(worst, std::abs(o.q[ix] - l0 - dampedOscillator(m, k, c, x0 - l0, o.t)));
+  }
   // BDF at rtol 1e-8, atol 1e-10: the global error after ~3 periods is a few hundred
   // times rtol times the amplitude 0.3 m; 1e-5 m bounds it (0.003 % of the amplitude)
   EXPECT_LT(worst, 1e-5);
@@ -241,7 +243,8 @@ TEST(UserSpringLaw, UserLinearLawRunsAsTheBuiltInSpring) {
 
 TEST(UserFunctions, AnExceptionInASpringLawEndsTheRunWithItsMessageAndTheResultsSoFar) {
   System sys;
-  const BodyIndex slider = addRigidBody(sys, "slider", {2.0, 0.1, Vec2::Zero()}, {Vec2(1.3, 0.0), 0.0, Vec2::Zero(), 0.0});
+  const BodyIndex slider =
+      addRigidBody(sys, "slider", {2.0, 0.1, Vec2::Zero()}, {Vec2(1.3, 0.0), 0.0, Vec2::Zero(), 0.0});
   addPrismaticJoint(sys, "rail", kGround, Vec2::Zero(), slider, Vec2::Zero(), Vec2(1.0, 0.0));
   addSpringDamper(sys, "spring", kGround, Vec2::Zero(), slider, Vec2::Zero(), 0.0, 0.0, 0.0,
                   makeSpringLaw([](double t, double l, double) {
@@ -265,7 +268,8 @@ TEST(UserFunctions, AnExceptionInASpringLawEndsTheRunWithItsMessageAndTheResults
 
 TEST(UserFunctions, AnExceptionInADriverLawNamesTheDriver) {
   System sys;
-  const BodyIndex rod = addRigidBody(sys, "rod", {1.0, 1.0 / 12.0, Vec2::Zero()}, {Vec2(0.5, 0.0), 0.0, Vec2::Zero(), 0.0});
+  const BodyIndex rod =
+      addRigidBody(sys, "rod", {1.0, 1.0 / 12.0, Vec2::Zero()}, {Vec2(0.5, 0.0), 0.0, Vec2::Zero(), 0.0});
   const ConstraintIndex pin = addRevoluteJoint(sys, "pin", kGround, Vec2::Zero(), rod, Vec2(-0.5, 0.0));
   addJointDriver(sys, "motor", pin, makeUserTimeLaw([](double t) {
                    if (t > 0.25) throw std::invalid_argument("speed table exhausted");
