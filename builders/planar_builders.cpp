@@ -111,20 +111,20 @@ ConstraintIndex addJointDriver(System& sys, const std::string& name, ConstraintI
 
 ForceIndex addSpringDamper(System& sys, const std::string& name, BodyIndex bodyI, const Vec2& pointI,
                            BodyIndex bodyJ, const Vec2& pointJ, double stiffness, double damping,
-                           double freeLength) {
+                           double freeLength, SpringLawPtr law) {
   checkBody(sys, bodyI, "force '" + name + "'");
   checkBody(sys, bodyJ, "force '" + name + "'");
-  return sys.addForce(
-      std::make_unique<SpringDamper>(name, bodyI, pointI, bodyJ, pointJ, stiffness, damping, freeLength));
+  return sys.addForce(std::make_unique<SpringDamper>(name, bodyI, pointI, bodyJ, pointJ, stiffness, damping, freeLength,
+                                                     std::move(law)));
 }
 
 ForceIndex addRotationalSpringDamper(System& sys, const std::string& name, ConstraintIndex joint,
-                                     double stiffness, double damping, double freeAngle) {
+                                     double stiffness, double damping, double freeAngle, SpringLawPtr law) {
   if (joint.value < 0 || joint.value >= sys.numConstraints()) {
     throw InputError("force '" + name + "': joint index does not exist");
   }
   if (dynamic_cast<const SpatialJoint*>(&sys.constraint(joint))) {  // spatial revolute or cylindrical
-    return addSpatialRotationalSpringDamper(sys, name, joint, stiffness, damping, freeAngle);
+    return addSpatialRotationalSpringDamper(sys, name, joint, stiffness, damping, freeAngle, std::move(law));
   }
   const auto* r = dynamic_cast<const RevoluteJoint*>(&sys.constraint(joint));
   if (!r) {
@@ -132,7 +132,8 @@ ForceIndex addRotationalSpringDamper(System& sys, const std::string& name, Const
                      "' is not a revolute joint; a rotational spring-damper needs one");
   }
   return sys.addForce(std::make_unique<RotationalSpringDamper>(name, r->bodies()[0], r->pointI(), r->bodies()[1],
-                                                               r->pointJ(), stiffness, damping, freeAngle));
+                                                               r->pointJ(), stiffness, damping, freeAngle,
+                                                               std::move(law)));
 }
 
 ForceIndex addAppliedLoad(System& sys, const std::string& name, BodyIndex b, const Vec2& point,

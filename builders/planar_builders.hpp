@@ -9,6 +9,7 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "core/system.hpp"
 #include "core/time_law.hpp"
+#include "core/user_function.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
@@ -30,13 +31,15 @@ ConstraintIndex addBodyCoordinateDriver(System& sys, const std::string& name, Bo
 /// (planar, or spatial: addJointAngleDriver / addJointDisplacementDriver of
 /// builders/spatial_builders.hpp).
 ConstraintIndex addJointDriver(System& sys, const std::string& name, ConstraintIndex joint, TimeLawPtr law);
+/// law: a user law f(t, l, l') in place of k (l - l0) + c l' (core/user_function.hpp).
 ForceIndex addSpringDamper(System& sys, const std::string& name, BodyIndex bodyI, const Vec2& pointI,
                            BodyIndex bodyJ, const Vec2& pointJ, double stiffness, double damping,
-                           double freeLength);
+                           double freeLength, SpringLawPtr law = nullptr);
 /// Acts on a revolute joint's relative angle; freeAngle: angle of zero torque (a spatial
-/// revolute or cylindrical joint: addSpatialRotationalSpringDamper).
+/// revolute or cylindrical joint: addSpatialRotationalSpringDamper). law: a user law
+/// tau(t, phi, phi') in place of k (phi - phi0) + c phi'.
 ForceIndex addRotationalSpringDamper(System& sys, const std::string& name, ConstraintIndex revoluteJoint,
-                                     double stiffness, double damping, double freeAngle);
+                                     double stiffness, double damping, double freeAngle, SpringLawPtr law = nullptr);
 ForceIndex addAppliedLoad(System& sys, const std::string& name, BodyIndex body, const Vec2& point,
                           TimeLawPtr forceX, TimeLawPtr forceY, TimeLawPtr torque);
 

@@ -169,7 +169,7 @@ double initialJointAngle(const System& sys, ConstraintIndex joint) {
 
 ForceIndex addSpatialSpringDamper(System& sys, const std::string& name, BodyIndex bi, const Vec3& pointI,
                                   BodyIndex bj, const Vec3& pointJ, double stiffness, double damping,
-                                  std::optional<double> freeLength) {
+                                  std::optional<double> freeLength, SpringLawPtr law) {
   const std::string who = "force '" + name + "'";
   checkSpatialBody(sys, bi, who);
   checkSpatialBody(sys, bj, who);
@@ -182,11 +182,13 @@ ForceIndex addSpatialSpringDamper(System& sys, const std::string& name, BodyInde
           sys.body(bi).frameKinematics(sys.body(bi).initialCoordinates(), pointI).r)
              .norm();
   }
-  return sys.addForce(std::make_unique<SpatialSpringDamper>(name, bi, pointI, bj, pointJ, stiffness, damping, l0));
+  return sys.addForce(
+      std::make_unique<SpatialSpringDamper>(name, bi, pointI, bj, pointJ, stiffness, damping, l0, std::move(law)));
 }
 
 ForceIndex addSpatialRotationalSpringDamper(System& sys, const std::string& name, ConstraintIndex joint,
-                                            double stiffness, double damping, std::optional<double> freeAngle) {
+                                            double stiffness, double damping, std::optional<double> freeAngle,
+                                            SpringLawPtr law) {
   const std::string who = "force '" + name + "'";
   const SpatialJoint& j = spatialJointAt(sys, joint, who);
   requireJointType(j, SpatialJointType::Revolute, SpatialJointType::Cylindrical, who, "a rotational spring-damper");
@@ -196,7 +198,8 @@ ForceIndex addSpatialRotationalSpringDamper(System& sys, const std::string& name
   const double a0 = freeAngle ? *freeAngle : initialJointAngle(sys, joint);
   if (!std::isfinite(a0)) throw InputError(who + ": free_angle must be finite");
   return sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(name, j.bodies()[0], j.frameI(), j.bodies()[1],
-                                                                      j.frameJ(), stiffness, damping, a0));
+                                                                      j.frameJ(), stiffness, damping, a0,
+                                                                      std::move(law)));
 }
 
 ForceIndex addSpatialBushing(System& sys, const std::string& name, BodyIndex bi, const JointFrame& fi, BodyIndex bj,

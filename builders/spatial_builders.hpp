@@ -18,6 +18,7 @@
 #include "bodies/rigid_body_3d.hpp"
 #include "core/system.hpp"
 #include "core/time_law.hpp"
+#include "core/user_function.hpp"
 #include "joints/frame_pair.hpp"
 #include "joints/spatial_joint.hpp"
 
@@ -91,12 +92,13 @@ double initialJointAngle(const System& sys, ConstraintIndex joint);
 /// freeLength: the length at zero tension; none: the points' initial distance.
 ForceIndex addSpatialSpringDamper(System& sys, const std::string& name, BodyIndex bi, const Vec3& pointI,
                                   BodyIndex bj, const Vec3& pointJ, double stiffness, double damping,
-                                  std::optional<double> freeLength = std::nullopt);
+                                  std::optional<double> freeLength = std::nullopt, SpringLawPtr law = nullptr);
 /// About a spatial revolute or cylindrical joint's axis; freeAngle: the angle of zero
-/// torque, none: the joint's initial angle.
+/// torque, none: the joint's initial angle. law (both): a user law in place of the linear
+/// one (core/user_function.hpp).
 ForceIndex addSpatialRotationalSpringDamper(System& sys, const std::string& name, ConstraintIndex joint,
                                             double stiffness, double damping,
-                                            std::optional<double> freeAngle = std::nullopt);
+                                            std::optional<double> freeAngle = std::nullopt, SpringLawPtr law = nullptr);
 /// Six-component bushing between frames fi and fj (SpatialBushing; translations along
 /// and rotations about frame i's x, y, z); stiffness and damping >= 0.
 ForceIndex addSpatialBushing(System& sys, const std::string& name, BodyIndex bi, const JointFrame& fi, BodyIndex bj,

@@ -21,6 +21,9 @@ class TimeLaw {
   virtual ~TimeLaw() = default;
   /// f, f', f'' at time t (all exact, no finite differences).
   virtual LawValue evaluate(double t) const = 0;
+  /// f(t) alone (loads): the same number as evaluate(t).f; a user law (core/user_function.hpp)
+  /// computes no derivatives for it.
+  virtual double value(double t) const { return evaluate(t).f; }
   /// Short type name as used in scene files ("constant_speed", ...).
   virtual std::string typeName() const = 0;
 };

@@ -1,6 +1,7 @@
 #include "forces/applied_load.hpp"
 
 #include "core/errors.hpp"
+#include "core/user_function.hpp"
 
 namespace flexmbd {
 
@@ -28,8 +29,15 @@ void AppliedLoad::addForce(double t, const BodyStates& b, const VecX&, VecX& Q, 
   // Q = Jr^T F + tau Jphi^T (virtual work of a force F at the point and a torque tau)
   b[0].point(point_, b.pointId(0), dQdq != nullptr, w.pi);
   const PointKinematics& p = w.pi;
-  const Vec2 F(forceX_ ? forceX_->evaluate(t).f : 0.0, forceY_ ? forceY_->evaluate(t).f : 0.0);
-  const double tau = torque_ ? torque_->evaluate(t).f : 0.0;
+  Vec2 F = Vec2::Zero();
+  double tau = 0.0;
+  try {
+    if (forceX_) F.x() = forceX_->value(t);
+    if (forceY_) F.y() = forceY_->value(t);
+    if (torque_) tau = torque_->value(t);
+  } catch (const UserFunctionError& e) {  // a user law raised: name the force
+    rethrowWithOwner(e, "force '" + name() + "'");
+  }
   Q.noalias() += p.Jr.transpose() * F;
   Q += tau * p.Jphi.transpose();
   if (dQdq) *dQdq += F.x() * p.Hrx + F.y() * p.Hry + tau * p.Hphi;

@@ -1,6 +1,7 @@
 #include "forces/spatial_forces.hpp"
 
 #include "core/errors.hpp"
+#include "core/user_function.hpp"
 #include "forces/applied_load.hpp"
 #include "joints/frame_pair.hpp"
 #include "joints/spatial_drivers.hpp"
@@ -22,9 +23,13 @@ SpatialAppliedLoad::SpatialAppliedLoad(std::string name, BodyIndex body, const V
 void SpatialAppliedLoad::addForce(double t, const BodyStates& bodies, const VecX&, VecX& Q, MatX* dQdq, MatX*,
                                   KinematicsWork& w) const {
   Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-  for (int k = 0; k < 3; ++k) {
-    if (laws_[k]) F[k] = laws_[k]->evaluate(t).f;
-    if (laws_[3 + k]) M[k] = laws_[3 + k]->evaluate(t).f;
+  try {
+    for (int k = 0; k < 3; ++k) {
+      if (laws_[k]) F[k] = laws_[k]->value(t);
+      if (laws_[3 + k]) M[k] = laws_[3 + k]->value(t);
+    }
+  } catch (const UserFunctionError& e) {  // a user law raised: name the force
+    rethrowWithOwner(e, "force '" + name() + "'");
   }
   bodies[0].frame(point_, bodies.pointId(0), w.fi);
   Q.noalias() += w.fi.Jr.transpose() * F;
@@ -33,9 +38,10 @@ void SpatialAppliedLoad::addForce(double t, const BodyStates& bodies, const VecX
 }
 
 SpatialSpringDamper::SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ,
-                                         const Vec3& pointJ, double stiffness, double damping, double freeLength)
+                                         const Vec3& pointJ, double stiffness, double damping, double freeLength,
+                                         SpringLawPtr law)
     : Force(std::move(name), {bodyI, bodyJ}), pointI_(pointI), pointJ_(pointJ), stiffness_(stiffness),
-      damping_(damping), freeLength_(freeLength) {
+      damping_(damping), freeLength_(freeLength), law_(std::move(law)) {
   const std::string who = "force '" + this->name() + "'";
   if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
   for (int k = 0; k < 3; ++k) {
@@ -59,11 +65,12 @@ double SpatialSpringDamper::length(const BodyStates& bodies) const {
 }
 
 double SpatialSpringDamper::potentialEnergy(const BodyStates& bodies) const {
+  if (law_) return 0.0;  // a user law has no potential the engine knows
   const double s = length(bodies) - freeLength_;
   return 0.5 * stiffness_ * s * s;
 }
 
-void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+void SpatialSpringDamper::addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                                    KinematicsWork& w) const {
   JointFrame fi, fj;
   fi.point = pointI_;
@@ -73,14 +80,17 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
   if (!(l > 1e-12)) {
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
   }
-  // grad l = e^T Jd;  l' = grad l v;  f = k (l - l0) + c l';  Q = -f grad l^T
+  // grad l = e^T Jd;  l' = grad l v;  f = k (l - l0) + c l' (or the user law f(t, l, l') with
+  // k = df/dl, c = df/dl');  Q = -f grad l^T
   const Vec3 e = pair.d() / l;
   RowVecX& gradL = w.row;
   gradL.noalias() = e.transpose() * pair.Jd();
-  const double f = stiffness_ * (l - freeLength_) + damping_ * gradL.dot(v);
+  const SpringLawValue law = springDamperValue(law_.get(), stiffness_, damping_, freeLength_, t, l, gradL.dot(v),
+                                               dQdq != nullptr || dQdv != nullptr, name());
+  const double f = law.f, k = law.dfdx, c = law.dfdxdot;
   Q.noalias() -= f * gradL.transpose();
   if (dQdv) {
-    w.row3 = damping_ * gradL;
+    w.row3 = c * gradL;
     dQdv->noalias() -= gradL.transpose() * w.row3;
   }
   if (!dQdq) return;
@@ -95,9 +105,9 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
   Hl.noalias() += pair.Jd().transpose() * w.JT2;
   RowVecX& dfdq = w.row2;
   dfdq.noalias() = gradL * pair.Tinv();
-  dfdq *= stiffness_;
+  dfdq *= k;
   w.row4.noalias() = v.transpose() * Hl;
-  dfdq += damping_ * w.row4;
+  dfdq += c * w.row4;
   dQdq->noalias() -= gradL.transpose() * dfdq;
   *dQdq -= f * Hl;
 }
@@ -105,9 +115,9 @@ void SpatialSpringDamper::addForce(double, const BodyStates& bodies, const VecX&
 SpatialRotationalSpringDamper::SpatialRotationalSpringDamper(std::string name, BodyIndex bodyI,
                                                              const JointFrame& frameI, BodyIndex bodyJ,
                                                              const JointFrame& frameJ, double stiffness,
-                                                             double damping, double freeAngle)
+                                                             double damping, double freeAngle, SpringLawPtr law)
     : Force(std::move(name), {bodyI, bodyJ}), frameI_(frameI), frameJ_(frameJ), stiffness_(stiffness),
-      damping_(damping), freeAngle_(freeAngle) {
+      damping_(damping), freeAngle_(freeAngle), law_(std::move(law)) {
   const std::string who = "force '" + this->name() + "'";
   requireFinite(stiffness, who + ": stiffness");
   requireFinite(damping, who + ": damping");
@@ -116,6 +126,7 @@ SpatialRotationalSpringDamper::SpatialRotationalSpringDamper(std::string name, B
 }
 
 double SpatialRotationalSpringDamper::potentialEnergy(const BodyStates& bodies) const {
+  if (law_) return 0.0;  // a user law has no potential the engine knows
   KinematicsWork w;
   double theta = 0.0;
   evaluateJointAngle(bodies, frameI_, frameJ_, w, theta, w.row7, nullptr);
@@ -123,7 +134,7 @@ double SpatialRotationalSpringDamper::potentialEnergy(const BodyStates& bodies) 
   return 0.5 * stiffness_ * a * a;
 }
 
-void SpatialRotationalSpringDamper::addForce(double, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq,
+void SpatialRotationalSpringDamper::addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq,
                                              MatX* dQdv, KinematicsWork& w) const {
   // tau = -k a - c theta', theta' = grad v;  Q = tau grad^T;
   // dQ/dq = tau H + grad^T dtau/dq, dtau/dq = -k grad T+ - c v^T H;  dQ/dv = -c grad^T grad
@@ -132,17 +143,20 @@ void SpatialRotationalSpringDamper::addForce(double, const BodyStates& bodies, c
   MatX& H = w.C;
   evaluateJointAngle(bodies, frameI_, frameJ_, w, theta, grad, dQdq ? &H : nullptr);
   const double a = std::remainder(theta - freeAngle_, 2.0 * M_PI);
-  const double tau = -stiffness_ * a - damping_ * grad.dot(v);
+  // the linear law on a (x0 = 0), or the user law on theta = theta0 + a (k = dlaw/dtheta, c = dlaw/dtheta')
+  const SpringLawValue law = springDamperValue(law_.get(), stiffness_, damping_, 0.0, t, law_ ? freeAngle_ + a : a,
+                                               grad.dot(v), dQdq != nullptr || dQdv != nullptr, name());
+  const double tau = -law.f, k = law.dfdx, c = law.dfdxdot;
   Q.noalias() += tau * grad.transpose();
   if (dQdv) {
-    w.row6 = damping_ * grad;  // (rows sized nv; row3, row4 are nq-long: not reused across sizes)
+    w.row6 = c * grad;  // (rows sized nv; row3, row4 are nq-long: not reused across sizes)
     dQdv->noalias() -= grad.transpose() * w.row6;
   }
   if (!dQdq) return;
   w.row3.noalias() = grad * w.Tinv;
-  w.row3 *= -stiffness_;
+  w.row3 *= -k;
   w.row4.noalias() = v.transpose() * H;
-  w.row3 -= damping_ * w.row4;
+  w.row3 -= c * w.row4;
   *dQdq += tau * H;
   dQdq->noalias() += grad.transpose() * w.row3;
 }

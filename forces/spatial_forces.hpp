@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/time_law.hpp"
+#include "core/user_function.hpp"
 #include "joints/frame_pair.hpp"
 
 namespace flexmbd {
@@ -30,10 +31,11 @@ class SpatialAppliedLoad final : public Force {
 
 /// Tension f = k (l - l0) + c l' along the line of two body points, l = |r_j - r_i|:
 /// Q = -f grad(l)^T (Shabana, Dynamics of Multibody Systems, ch. 7, in velocity form).
+/// With a user law (core/user_function.hpp), f = law(t, l, l') instead (no potential).
 class SpatialSpringDamper final : public Force {
  public:
   SpatialSpringDamper(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
-                      double stiffness, double damping, double freeLength);
+                      double stiffness, double damping, double freeLength, SpringLawPtr law = nullptr);
   std::string typeName() const override { return "spring_damper"; }
   std::vector<Attachment> attachments() const override {
     return {{bodies()[0], pointI_}, {bodies()[1], pointJ_}};
@@ -42,22 +44,26 @@ class SpatialSpringDamper final : public Force {
                 KinematicsWork& work) const override;
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
-  bool isConservative() const override { return damping_ == 0.0; }
+  bool isConservative() const override { return damping_ == 0.0 && !law_; }
   /// The current length l.
   double length(const BodyStates& bodies) const;
 
  private:
   Vec3 pointI_, pointJ_;
   double stiffness_, damping_, freeLength_;
+  SpringLawPtr law_;
 };
 
 /// Torque -k (theta - theta0) - c theta' about a spatial revolute or cylindrical joint's
 /// axis, theta the joint angle of SpatialJointAngleDriver (frame j's x axis from frame i's,
 /// about frame i's z axis), taken within half a turn of theta0: Q = tau grad(theta)^T.
+/// With a user law (core/user_function.hpp), tau = -law(t, theta, theta') instead, theta
+/// within half a turn of theta0 (no potential).
 class SpatialRotationalSpringDamper final : public Force {
  public:
   SpatialRotationalSpringDamper(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
-                                const JointFrame& frameJ, double stiffness, double damping, double freeAngle);
+                                const JointFrame& frameJ, double stiffness, double damping, double freeAngle,
+                                SpringLawPtr law = nullptr);
   std::string typeName() const override { return "rotational_spring_damper"; }
   std::vector<Attachment> attachments() const override {
     return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
@@ -66,11 +72,12 @@ class SpatialRotationalSpringDamper final : public Force {
                 KinematicsWork& work) const override;
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
-  bool isConservative() const override { return damping_ == 0.0; }
+  bool isConservative() const override { return damping_ == 0.0 && !law_; }
 
  private:
   JointFrame frameI_, frameJ_;
   double stiffness_, damping_, freeAngle_;
+  SpringLawPtr law_;
 };
 
 /// Six-component bushing between frame i (body i) and frame j (body j): the measures

@@ -7,13 +7,14 @@ namespace flexmbd {
 
 SpringDamper::SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI,
                            BodyIndex bodyJ, const Vec2& pointJ, double stiffness, double damping,
-                           double freeLength)
+                           double freeLength, SpringLawPtr law)
     : Force(std::move(name), {bodyI, bodyJ}),
       pointI_(pointI),
       pointJ_(pointJ),
       stiffness_(stiffness),
       damping_(damping),
-      freeLength_(freeLength) {
+      freeLength_(freeLength),
+      law_(std::move(law)) {
   const std::string who = "force '" + this->name() + "'";
   if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
   for (int k = 0; k < 2; ++k) {
@@ -32,7 +33,7 @@ double SpringDamper::length(const BodyStates& b) const {
   return (b[1].point(pointJ_, b.pointId(1), false).r - b[0].point(pointI_, b.pointId(0), false).r).norm();
 }
 
-void SpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
+void SpringDamper::addForce(double t, const BodyStates& b, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                             KinematicsWork& w) const {
   const bool withHessians = dQdq != nullptr;
   b[0].point(pointI_, b.pointId(0), withHessians, w.pi);
@@ -43,12 +44,15 @@ void SpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q,
   if (!(l > 1e-12)) {
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
   }
-  // l = |d|, e = d / l, dl/dq = e^T D, f = k (l - l0) + c dl/dt, Q = -f (dl/dq)^T
+  // l = |d|, e = d / l, dl/dq = e^T D, f = k (l - l0) + c dl/dt (or the user law f(t, l, ldot)
+  // with k = df/dl, c = df/dldot), Q = -f (dl/dq)^T
   const Vec2 e = p.d / l;
   RowVecX& eD = w.row;
   eD.noalias() = e.transpose() * p.D;
   const double ldot = eD.dot(v);
-  const double f = stiffness_ * (l - freeLength_) + damping_ * ldot;
+  const SpringLawValue law = springDamperValue(law_.get(), stiffness_, damping_, freeLength_, t, l, ldot,
+                                               dQdq != nullptr || dQdv != nullptr, name());
+  const double f = law.f, k = law.dfdx, c = law.dfdxdot;
   Q -= f * eD.transpose();
   if (dQdq) {
     // d2l/dq2 = He + D^T P D / l with He = e_x Hdx + e_y Hdy, P = I - e e^T, and
@@ -59,16 +63,17 @@ void SpringDamper::addForce(double, const BodyStates& b, const VecX& v, VecX& Q,
     RowVecX& dfdq = w.row2;
     dfdq.noalias() = ((Dv - e * e.dot(Dv)) / l).transpose() * p.D;
     dfdq.noalias() += v.transpose() * He;
-    dfdq = stiffness_ * eD + damping_ * dfdq;
+    dfdq = k * eD + c * dfdq;
     dQdq->noalias() -= eD.transpose() * dfdq;
     *dQdq -= f * He;
     dQdq->noalias() -= (f / l) * p.D.transpose() * p.D;
     dQdq->noalias() += (f / l) * eD.transpose() * eD;
   }
-  if (dQdv) dQdv->noalias() -= damping_ * eD.transpose() * eD;
+  if (dQdv) dQdv->noalias() -= c * eD.transpose() * eD;
 }
 
 double SpringDamper::potentialEnergy(const BodyStates& b) const {
+  if (law_) return 0.0;  // a user law has no potential the engine knows
   const double s = length(b) - freeLength_;
   return 0.5 * stiffness_ * s * s;
 }

@@ -2,22 +2,25 @@
 #pragma once
 
 #include "core/force.hpp"
+#include "core/user_function.hpp"
 
 namespace flexmbd {
 
 /// Tension f = k (l - l0) + c ldot along e = d/l, d = r_j - r_i; generalised force
-/// Q = -f D^T e (D = dd/dq); potential V = k (l - l0)^2 / 2.
+/// Q = -f D^T e (D = dd/dq); potential V = k (l - l0)^2 / 2. With a user law
+/// (core/user_function.hpp), f = law(t, l, ldot) instead (k, c, l0 unused; no potential).
 class SpringDamper final : public Force {
  public:
   /// @throws InputError if k < 0, c < 0, l0 < 0 or a value is not finite.
   SpringDamper(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
-               const Vec2& pointJ, double stiffness, double damping, double freeLength);
+               const Vec2& pointJ, double stiffness, double damping, double freeLength,
+               SpringLawPtr law = nullptr);
   std::string typeName() const override { return "spring_damper"; }
   void addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq, MatX* dQdv,
                 KinematicsWork& work) const override;
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
-  bool isConservative() const override { return damping_ == 0.0; }
+  bool isConservative() const override { return damping_ == 0.0 && !law_; }
   std::vector<Attachment> attachments() const override {
     return {{bodies()[0], lift(pointI_)}, {bodies()[1], lift(pointJ_)}};
   }
@@ -27,6 +30,7 @@ class SpringDamper final : public Force {
  private:
   Vec2 pointI_, pointJ_;
   double stiffness_, damping_, freeLength_;
+  SpringLawPtr law_;
 };
 
 }  // namespace flexmbd

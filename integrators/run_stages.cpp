@@ -7,6 +7,7 @@
 
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
+#include "core/user_function.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/bdf_stability.hpp"
 #include "integrators/integrator_choice.hpp"
@@ -342,6 +343,8 @@ RunFailure diagnoseFailure(const std::exception_ptr& error, const FailureContext
   } catch (const CrossingFailure& e) {
     return {e.what(), e.time()};
   } catch (const StepBudgetExceeded& e) {
+    return {e.what(), e.time()};
+  } catch (const UserFunctionError& e) {  // a user law raised: its message, at its time
     return {e.what(), e.time()};
   } catch (const SolverError& e) {
     return {withDiagnosis(e.what(), ctx, e.time()), e.time()};

@@ -3,6 +3,7 @@
 
 #include "core/errors.hpp"
 #include "core/time_law.hpp"
+#include "core/user_function.hpp"
 #include "joints/point_pair.hpp"
 
 namespace flexmbd {
@@ -20,7 +21,12 @@ class LawDriver : public Base {
   int numEquations() const override { return 1; }
   bool isDriver() const override { return true; }
   void timeFunction(double t, VecX& f, VecX& df, VecX& ddf) const override {
-    const LawValue v = law_->evaluate(t);
+    LawValue v;
+    try {
+      v = law_->evaluate(t);
+    } catch (const UserFunctionError& e) {  // a user law raised: name the driver
+      rethrowWithOwner(e, "driver '" + this->name() + "'");
+    }
     f.setConstant(1, v.f);
     df.setConstant(1, v.df);
     ddf.setConstant(1, v.ddf);

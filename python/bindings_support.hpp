@@ -40,6 +40,18 @@ class PythonSignalCheck {
     throw py::error_already_set();
   }
 
+  /// With the GIL, in a Python user function that raised KeyboardInterrupt (Ctrl-C while
+  /// it ran): keeps the exception for raiseIfInterrupted(), so that the run's next stop
+  /// check ends it as an interruption. False if no check is installed on this thread.
+  static bool keepInterrupt(py::error_already_set& e) {
+    if (!detail::tStopPoll) return false;
+    State& s = state();
+    if (s.type) return true;
+    e.restore();  // back into Python's error state, then taken from it
+    PyErr_Fetch(&s.type, &s.value, &s.traceback);
+    return true;
+  }
+
  private:
   struct State {
     unsigned calls = 0;

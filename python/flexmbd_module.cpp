@@ -29,6 +29,7 @@
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
 #include "bindings_support.hpp"
+#include "user_functions.hpp"
 
 namespace py = pybind11;
 using namespace flexmbd;
@@ -143,6 +144,59 @@ PYBIND11_MODULE(_flexmbd, m) {
   m.def("tabulated_law",
         [](std::vector<double> t, std::vector<double> v) { return mutableLaw(makeTabulatedLaw(std::move(t), std::move(v))); },
         py::arg("times"), py::arg("values"));
+  // ----- user functions (core/user_function.hpp; python/user_functions.hpp) ---------------
+  m.def(
+      "user_law",
+      [](const py::object& f, const py::object& df, const py::object& ddf) {
+        if (!isUserCallable(f)) badArgument("user_law", "f", "a callable f(t)", f);
+        if (!df.is_none() && !isUserCallable(df)) badArgument("user_law", "derivative", "a callable f'(t) or None", df);
+        if (!ddf.is_none() && !isUserCallable(ddf)) {
+          badArgument("user_law", "second_derivative", "a callable f''(t) or None", ddf);
+        }
+        return pythonTimeLaw(f, df, ddf);
+      },
+      py::arg("f"), py::arg("derivative") = py::none(), py::arg("second_derivative") = py::none(),
+      "A time law f(t) given by a Python callable (drivers, loads): f' and f'' from derivative(t) and "
+      "second_derivative(t) if given, else by central differences (docs/python.md, User functions)");
+  m.def(
+      "_time_law_calls",
+      [](const Law& law, long calls) {
+        // benchmarks/bench_user_functions.py: `calls` evaluations of f(t) from C++ with the GIL
+        // released, as in a run (a Python law takes the GIL for each): seconds taken
+        if (!law || calls < 1) throw InputError("_time_law_calls: a time law and calls >= 1 expected");
+        double sum = 0.0;
+        std::chrono::steady_clock::time_point start;
+        double seconds = 0.0;
+        {
+          py::gil_scoped_release release;
+          start = std::chrono::steady_clock::now();
+          for (long i = 0; i < calls; ++i) sum += law->value(1e-7 * static_cast<double>(i));
+          seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        }
+        return py::make_tuple(seconds, sum);
+      },
+      py::arg("law"), py::arg("calls"), "(seconds, sum of the values) of `calls` evaluations without the GIL");
+  py::class_<SpringLaw, std::shared_ptr<SpringLaw>>(m, "SpringLaw")
+      .def(
+          "__call__",
+          [](const SpringLaw& law, double t, double x, double xdot) {
+            const SpringLawValue v = law.evaluate(t, x, xdot, true);
+            return py::make_tuple(v.f, v.dfdx, v.dfdxdot);
+          },
+          py::arg("t"), py::arg("x"), py::arg("xdot"), "(f, df/dx, df/dxdot) at (t, x, xdot)")
+      .def_property_readonly("has_user_derivative", &SpringLaw::hasUserDerivative);
+  m.def(
+      "spring_law",
+      [](const py::object& f, const py::object& derivative) {
+        if (!isUserCallable(f)) badArgument("spring_law", "f", "a callable f(t, x, xdot)", f);
+        if (!derivative.is_none() && !isUserCallable(derivative)) {
+          badArgument("spring_law", "derivative", "a callable (t, x, xdot) -> (df/dx, df/dxdot) or None", derivative);
+        }
+        return pythonSpringLaw(f, derivative);
+      },
+      py::arg("f"), py::arg("derivative") = py::none(),
+      "A spring-damper law f(t, x, xdot) (x: length or joint angle) given by a Python callable, in place of "
+      "k (x - x0) + c xdot; derivative(t, x, xdot) -> (df/dx, df/dxdot), else central differences");
 
   // ----- flexible beams (bodies/ffr_beam_model.hpp) --------------------------------------
   py::class_<BeamSection>(m, "BeamSection")
@@ -257,35 +311,63 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"))
       .def(
           "add_body_coordinate_driver",
-          [](System& s, const std::string& name, py::object b, const std::string& coordinate, Law law) {
-            return addBodyCoordinateDriver(s, name, body(s, b), coordinate, std::move(law));
+          [](System& s, const std::string& name, py::object b, const std::string& coordinate, const py::object& law) {
+            Law l = lawArg(law, "add_body_coordinate_driver", "law");
+            if (!l) badArgument("add_body_coordinate_driver", "law", "a time law or a callable f(t)", law);
+            return addBodyCoordinateDriver(s, name, body(s, b), coordinate, std::move(l));
           },
           py::arg("name"), py::arg("body"), py::arg("coordinate"), py::arg("law"))
       .def(
           "add_joint_driver",
-          [](System& s, const std::string& name, py::object j, Law law) {
-            return addJointDriver(s, name, joint(s, j), std::move(law));
+          [](System& s, const std::string& name, py::object j, const py::object& law) {
+            Law l = lawArg(law, "add_joint_driver", "law");
+            if (!l) badArgument("add_joint_driver", "law", "a time law or a callable f(t)", law);
+            return addJointDriver(s, name, joint(s, j), std::move(l));
           },
           py::arg("name"), py::arg("joint"), py::arg("law"))
       .def(
           "add_spring_damper",
           [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj,
-             double k, double c, double l0) {
-            return addSpringDamper(s, name, body(s, bi), pi, body(s, bj), pj, k, c, l0);
+             const py::object& k, const py::object& c, const py::object& l0, const py::object& law) {
+            constexpr const char* fn = "add_spring_damper";
+            const SpringLawPtr userLaw = springLawArg(law, fn);
+            requireLinearOrLaw(userLaw, k, c, fn);
+            if (userLaw) return addSpringDamper(s, name, body(s, bi), pi, body(s, bj), pj, 0.0, 0.0, 0.0, userLaw);
+            return addSpringDamper(s, name, body(s, bi), pi, body(s, bj), pj, numberArg(k, fn, "stiffness"),
+                                   numberArg(c, fn, "damping"), numberArg(l0, fn, "free_length"));
           },
           py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
-          py::arg("stiffness"), py::arg("damping"), py::arg("free_length"))
+          py::arg("stiffness") = py::none(), py::arg("damping") = py::none(), py::arg("free_length") = py::none(),
+          py::arg("law") = py::none(),
+          "stiffness (l - free_length) + damping ldot, or law: a user law f(t, l, ldot) (flexmbd.spring_law or a "
+          "callable)")
       .def(
           "add_rotational_spring_damper",
-          [](System& s, const std::string& name, py::object j, double k, double c, double a0) {
-            return addRotationalSpringDamper(s, name, joint(s, j), k, c, a0);
+          [](System& s, const std::string& name, py::object j, const py::object& k, const py::object& c,
+             const py::object& a0, const py::object& law) {
+            constexpr const char* fn = "add_rotational_spring_damper";
+            const SpringLawPtr userLaw = springLawArg(law, fn);
+            requireLinearOrLaw(userLaw, k, c, fn);
+            const double freeAngle = a0.is_none() && userLaw ? 0.0 : numberArg(a0, fn, "free_angle");
+            if (userLaw) return addRotationalSpringDamper(s, name, joint(s, j), 0.0, 0.0, freeAngle, userLaw);
+            return addRotationalSpringDamper(s, name, joint(s, j), numberArg(k, fn, "stiffness"),
+                                             numberArg(c, fn, "damping"), freeAngle);
           },
-          py::arg("name"), py::arg("joint"), py::arg("stiffness"), py::arg("damping"), py::arg("free_angle"))
+          py::arg("name"), py::arg("joint"), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
+          py::arg("free_angle") = py::none(), py::arg("law") = py::none(),
+          "stiffness (phi - free_angle) + damping phi_dot, or law: a user torque law tau(t, phi, phi_dot) "
+          "(flexmbd.spring_law or a callable)")
       .def(
           "add_applied_load",
-          [](System& s, const std::string& name, py::object b, const Vec2& point, Law fx, Law fy, Law torque) { return addAppliedLoad(s, name, body(s, b), point, fx, fy, torque); },
-          py::arg("name"), py::arg("body"), py::arg("point"), py::arg("force_x") = nullptr,
-          py::arg("force_y") = nullptr, py::arg("torque") = nullptr)
+          [](System& s, const std::string& name, py::object b, const Vec2& point, const py::object& fx,
+             const py::object& fy, const py::object& torque) {
+            constexpr const char* fn = "add_applied_load";
+            return addAppliedLoad(s, name, body(s, b), point, lawArg(fx, fn, "force_x"), lawArg(fy, fn, "force_y"),
+                                  lawArg(torque, fn, "torque"));
+          },
+          py::arg("name"), py::arg("body"), py::arg("point"), py::arg("force_x") = py::none(),
+          py::arg("force_y") = py::none(), py::arg("torque") = py::none(),
+          "Force and torque laws (time laws or callables f(t)), world axes")
       .def(
           "set_gravity",
           [](System& s, const py::object& g) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bindings_support.hpp"
+#include "user_functions.hpp"
 #include "bodies/fe_body_model.hpp"
 #include "bodies/sid_data.hpp"
 #include "io/sid_file.hpp"
@@ -118,12 +119,6 @@ int intArg(const py::handle& h, const char* fn, const char* arg) {
   } catch (const py::cast_error&) {  // beyond int: pybind11's RuntimeError names nothing
     throw InputError(std::string(fn) + ": " + arg + " is beyond the range of an int, got " + pyRepr(h));
   }
-}
-
-Law lawArg(const py::handle& h, const char* fn, const char* arg) {
-  if (h.is_none()) return nullptr;
-  if (!py::isinstance<TimeLaw>(h)) badArgument(fn, arg, "a time law (flexmbd.constant_law(...), ...) or None", h);
-  return h.cast<Law>();
 }
 
 JointFrame frameArg(const py::handle& h, const char* fn, const char* arg) {
@@ -753,29 +748,41 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def(
           "add_spatial_spring_damper",
           [](System& s, const std::string& name, const py::object& bi, const py::object& pi, const py::object& bj,
-             const py::object& pj, const py::object& k, const py::object& c, const py::object& l0) {
+             const py::object& pj, const py::object& k, const py::object& c, const py::object& l0,
+             const py::object& law) {
             constexpr const char* fn = "add_spatial_spring_damper";
+            const SpringLawPtr userLaw = springLawArg(law, fn);
+            requireLinearOrLaw(userLaw, k, c, fn);
             std::optional<double> freeLength;
             if (!l0.is_none()) freeLength = nonNegativeArg(l0, fn, "free_length");
             return addSpatialSpringDamper(s, name, body(s, bi, fn, "body_i"), vec3Arg(pi, fn, "point_i"),
                                           body(s, bj, fn, "body_j"), vec3Arg(pj, fn, "point_j"),
-                                          nonNegativeArg(k, fn, "stiffness"), nonNegativeArg(c, fn, "damping"), freeLength);
+                                          userLaw ? 0.0 : nonNegativeArg(k, fn, "stiffness"),
+                                          userLaw ? 0.0 : nonNegativeArg(c, fn, "damping"), freeLength, userLaw);
           },
           py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
-          py::arg("stiffness"), py::arg("damping") = 0.0, py::arg("free_length") = py::none(),
-          "free_length None: the points' initial distance")
+          py::arg("stiffness") = py::none(), py::arg("damping") = 0.0, py::arg("free_length") = py::none(),
+          py::arg("law") = py::none(),
+          "free_length None: the points' initial distance; law: a user law f(t, l, ldot) (flexmbd.spring_law or a "
+          "callable) in place of stiffness (l - free_length) + damping ldot")
       .def(
           "add_spatial_rotational_spring_damper",
           [](System& s, const std::string& name, const py::object& j, const py::object& k, const py::object& c,
-             const py::object& a0) {
+             const py::object& a0, const py::object& law) {
             constexpr const char* fn = "add_spatial_rotational_spring_damper";
+            const SpringLawPtr userLaw = springLawArg(law, fn);
+            requireLinearOrLaw(userLaw, k, c, fn);
             std::optional<double> freeAngle;
             if (!a0.is_none()) freeAngle = numberArg(a0, fn, "free_angle");
-            return addSpatialRotationalSpringDamper(s, name, joint(s, j, fn, "joint"), nonNegativeArg(k, fn, "stiffness"),
-                                                    nonNegativeArg(c, fn, "damping"), freeAngle);
+            return addSpatialRotationalSpringDamper(s, name, joint(s, j, fn, "joint"),
+                                                    userLaw ? 0.0 : nonNegativeArg(k, fn, "stiffness"),
+                                                    userLaw ? 0.0 : nonNegativeArg(c, fn, "damping"), freeAngle, userLaw);
           },
-          py::arg("name"), py::arg("joint"), py::arg("stiffness"), py::arg("damping") = 0.0,
-          py::arg("free_angle") = py::none(), "free_angle None: the joint's initial angle")
+          py::arg("name"), py::arg("joint"), py::arg("stiffness") = py::none(), py::arg("damping") = 0.0,
+          py::arg("free_angle") = py::none(), py::arg("law") = py::none(),
+          "free_angle None: the joint's initial angle; law: a user torque law tau(t, theta, theta_dot) "
+          "(flexmbd.spring_law or a callable; theta within half a turn of free_angle) in place of "
+          "stiffness (theta - free_angle) + damping theta_dot")
       .def(
           "add_spatial_bushing",
           [](System& s, const std::string& name, const py::object& bi, const py::object& fi, const py::object& bj,

@@ -23,6 +23,7 @@
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 #include "core/time_law.hpp"
+#include "core/user_function.hpp"
 #include "ffr3d_test_models.hpp"
 #include "ffr_test_models.hpp"
 #include "io/scene.hpp"
@@ -197,6 +198,51 @@ TEST(Allocations, EveryJointDriverAndForceType) {
   sys.setGravity(Vec2(0.0, -9.81));
   sys.finalize();
   expectAllocationFree(sys, "every component type");
+}
+
+TEST(Allocations, UserFunctionsOfCppCallables) {
+  // core/user_function.hpp: C++ callables as time laws (driver, load) and spring-damper laws
+  // (planar and spatial), derivatives by central differences and given: no allocation
+  System sys;
+  RigidBodyProperties p{2.0, 0.3, Vec2(0.1, 0.0)};
+  FrameState2d sa, sb;
+  sb.position = Vec2(1.0, 0.2);
+  const BodyIndex a = addRigidBody(sys, "a", p, sa);
+  const BodyIndex b = addRigidBody(sys, "b", p, sb);
+  const ConstraintIndex rev = addRevoluteJoint(sys, "rev", kGround, Vec2::Zero(), a, Vec2::Zero());
+  const auto spring = [](double t, double x, double xdot) { return 100.0 * (x - 0.5) + 2.0 * xdot + 0.1 * t * x * x; };
+  addJointDriver(sys, "angle", rev, makeUserTimeLaw([](double t) { return 0.2 * std::sin(3.0 * t); }));
+  addSpringDamper(sys, "spring", kGround, Vec2(0.0, 1.0), b, Vec2(0.1, 0.0), 0.0, 0.0, 0.0, makeSpringLaw(spring));
+  addSpringDamper(sys, "spring2", a, Vec2(0.3, 0.0), b, Vec2(-0.1, 0.0), 0.0, 0.0, 0.0,
+                  makeSpringLaw(spring, [](double, double, double) { return std::array<double, 2>{100.0, 2.0}; }));
+  addAppliedLoad(sys, "load", b, Vec2(0.2, 0.0), makeUserTimeLaw([](double t) { return 1.0 + t; }), nullptr,
+                 makeUserTimeLaw([](double t) { return 0.3 * t; }, [](double) { return 0.3; }));
+  sys.setGravity(Vec2(0.0, -9.81));
+  sys.finalize();
+  expectAllocationFree(sys, "user functions (planar)");
+
+  System s3;
+  RigidBody3dProperties q;
+  q.mass = 2.0;
+  q.inertia = Vec3(0.1, 0.2, 0.25).asDiagonal();
+  FrameState3d f;
+  const BodyIndex c = s3.addBody(std::make_unique<RigidBody3d>("c", q, f));
+  f.position = Vec3(1.0, 0.2, 0.1);
+  const BodyIndex d = s3.addBody(std::make_unique<RigidBody3d>("d", q, f));
+  JointFrame f0, f1;
+  f1.axes = quaternionRotation(Vec4(0.9, 0.1, 0.3, -0.2));
+  s3.addConstraint(std::make_unique<SpatialJoint>("hinge", SpatialJointType::Revolute, kGround, f0, c, f0));
+  s3.addForce(std::make_unique<SpatialSpringDamper>("spring", kGround, Vec3(0, 1, 0), d, Vec3::Zero(), 0.0, 0.0, 0.0,
+                                                    makeSpringLaw(spring)));
+  s3.addForce(std::make_unique<SpatialRotationalSpringDamper>("torsion", c, f0, d, f1, 0.0, 0.0, 0.1,
+                                                              makeSpringLaw(spring)));
+  s3.addForce(std::make_unique<SpatialAppliedLoad>(
+      "load", d, Vec3::Zero(),
+      std::array<TimeLawPtr, 6>{makeUserTimeLaw([](double t) { return t; }), nullptr, nullptr, nullptr, nullptr,
+                                makeUserTimeLaw([](double t) { return 0.5 * t; })}));
+  s3.setGravity(Vec3(0.0, 0.0, -9.81));
+  s3.finalize();
+  expectAllocationFree(s3, "user functions (spatial)");
 }
 
 TEST(Allocations, SpatialSliderCrank) {

@@ -332,6 +332,15 @@ TEST(SpatialForceDerivatives, SpringDampersBushingAndAppliedLoadMatchFiniteDiffe
       fj.axes = randomRotation(rnd);
       const ForceIndex torsion = sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(
           "torsion", toGround ? kGround : a, fi, b, fj, 30.0, 1.5, 0.2));
+      // user laws (core/user_function.hpp), nonlinear, derivatives by central differences
+      const auto law = [](double t, double x, double xdot) {
+        return 50.0 * (x - 0.4) + 20.0 * x * x * x + 3.0 * xdot + 0.5 * xdot * xdot * xdot + 0.1 * t * x;
+      };
+      const ForceIndex userSpring = sys.addForce(std::make_unique<SpatialSpringDamper>(
+          "user_spring", toGround ? kGround : a, Vec3(rnd.vector(3, -1, 1)), b, Vec3(rnd.vector(3, -1, 1)), 0.0, 0.0,
+          0.0, makeSpringLaw(law)));
+      const ForceIndex userTorsion = sys.addForce(std::make_unique<SpatialRotationalSpringDamper>(
+          "user_torsion", toGround ? kGround : a, fj, b, fi, 0.0, 0.0, 0.2, makeSpringLaw(law)));
       const ForceIndex bushing = sys.addForce(std::make_unique<SpatialBushing>(
           "bushing", toGround ? kGround : a, fj, b, fi, std::array<double, 6>{10, 20, 30, 4, 5, 6},
           std::array<double, 6>{0.1, 0.2, 0.3, 0.04, 0.05, 0.06}));
@@ -340,7 +349,7 @@ TEST(SpatialForceDerivatives, SpringDampersBushingAndAppliedLoadMatchFiniteDiffe
       for (BodyIndex bi : {a, b}) q.segment(sys.coordinateOffset(bi), 7) = randomCoordinates(rnd);
       const VecX vAll = rnd.vector(sys.numVelocities(), -1.0, 1.0);
       const std::string at = std::string(toGround ? "to ground, " : "") + "sample " + std::to_string(s);
-      for (ForceIndex fi : {spring, load, torsion, bushing}) {
+      for (ForceIndex fi : {spring, load, torsion, bushing, userSpring, userTorsion}) {
         const Force& f = sys.force(fi);
         const auto& vcols = sys.forceColumns(fi);
         const auto& qcols = sys.forceCoordinateColumns(fi);

@@ -50,6 +50,7 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     SolidShape,
     SolverSettings,
     SpatialJointType,
+    SpringLaw,
     System,
     TimeLaw,
     circular_section_3d,
@@ -69,8 +70,10 @@ from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     shape_properties,
     shape_volume,
     spin_up_law,
+    spring_law,
     write_sid,
     tabulated_law,
+    user_law,
     world_joint_frame,
 )
 from . import _flexmbd
