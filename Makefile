@@ -8,6 +8,9 @@
 #                long runs labelled "slow" (cd build && ctest -L slow runs those)
 #   make sanitize - the same suite built Debug with AddressSanitizer (leaks included) and
 #                UndefinedBehaviorSanitizer in build-sanitize/; any report fails the test
+#   make apidocs - the API reference: the C++ headers through Doxygen (docs/Doxyfile) into
+#                build/apidocs/html, the Python module's docstrings through pydoc into
+#                build/apidocs/python (scripts/apidocs.cmake)
 BUILD ?= build
 JOBS  ?= 2
 
@@ -16,7 +19,7 @@ SANITIZE_BUILD ?= build-sanitize
 # -fno-sanitize-recover: an undefined-behaviour report ends the test (it fails).
 SANITIZE_FLAGS = -O1 -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 
-.PHONY: demo demo-rigid test setup build bench clean sanitize
+.PHONY: demo demo-rigid test setup build bench clean sanitize apidocs
 
 setup:
 	./scripts/setup.sh
@@ -62,6 +65,12 @@ sanitize: setup
 	  ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:halt_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --output-on-failure -j $(JOBS) -LE slow
+
+apidocs: build
+	cmake --build $(BUILD) --target apidocs
+	@echo
+	@echo "the C++ API reference: $(abspath $(BUILD))/apidocs/html/index.html"
+	@echo "the Python API reference: $(abspath $(BUILD))/apidocs/python/index.html"
 
 bench: build
 	$(BUILD)/benchmarks/bench_rigid_slider_crank

@@ -1,5 +1,6 @@
-// Command-line helpers shared by the flexmbd commands (run, kinematics, tensegrity):
-// one-line errors, option splitting and number parsing. Exit status 2 on UsageError.
+/// @file
+/// Command-line helpers shared by the flexmbd commands (run, kinematics, tensegrity):
+/// one-line errors, option splitting and number parsing. Exit status 2 on UsageError.
 #pragma once
 
 #include <signal.h>

@@ -1,5 +1,6 @@
-// flexmbd kinematics SCENE.json --out DIR: kinematic analysis of a planar linkage
-// (docs/kinematics.md), results per input step in DIR/kinematics.csv and DIR/summary.json.
+/// @file
+/// flexmbd kinematics SCENE.json --out DIR: kinematic analysis of a planar linkage
+/// (docs/kinematics.md), results per input step in DIR/kinematics.csv and DIR/summary.json.
 #pragma once
 
 #include <string>

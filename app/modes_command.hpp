@@ -1,6 +1,7 @@
-// flexmbd modes SCENE --out DIR [--at T] [--count N] [--sweep NAME:FROM:TO:N]: the
-// linearised equations of motion about a state of the scene, their modes, and a Campbell
-// diagram over a speed range (docs/modes.md).
+/// @file
+/// flexmbd modes SCENE --out DIR [--at T] [--count N] [--sweep NAME:FROM:TO:N]: the
+/// linearised equations of motion about a state of the scene, their modes, and a Campbell
+/// diagram over a speed range (docs/modes.md).
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
-// flexmbd plot DIR [DIR ...] [--columns A,B] [--x COLUMN] [--out FILE.png] [--labels L1,L2]
-// [--title T] [--deg]: results columns drawn to a PNG (docs/results.md).
+/// @file
+/// flexmbd plot DIR [DIR ...] [--columns A,B] [--x COLUMN] [--out FILE.png] [--labels L1,L2]
+/// [--title T] [--deg]: results columns drawn to a PNG (docs/results.md).
 #pragma once
 
 #include <string>
@@ -15,7 +16,7 @@ namespace flexmbd {
 int runPlotCommand(const std::vector<std::string>& args);
 
 /// Runs the plotting script `scriptName` of scripts/ (found and interpreted as for plot:
-/// <bin>/../share/flexmbd/, then the source tree's scripts/; $FLEXMBD_PYTHON or
+/// `<bin>/../share/flexmbd/`, then the source tree's scripts/; $FLEXMBD_PYTHON or
 /// /usr/bin/python3) with `args`: its exit status, 0 or 2, any other failure 1.
 /// @throws std::runtime_error if the script cannot be found or started.
 int runPythonScript(const std::string& scriptName, const std::vector<std::string>& args);

@@ -1,6 +1,7 @@
-// flexmbd sid SCENE.json --body NAME --out FILE: the Standard Input Data (SID) of a spatial
-// flexible body of a scene, for other multibody codes or for a "sid_body" (docs/fe-import.md,
-// "SID").
+/// @file
+/// flexmbd sid SCENE.json --body NAME --out FILE: the Standard Input Data (SID) of a spatial
+/// flexible body of a scene, for other multibody codes or for a "sid_body" (docs/fe-import.md,
+/// "SID").
 #pragma once
 
 #include <string>

@@ -1,4 +1,5 @@
-// flexmbd summary DIR: the run's DIR/summary.json printed readably (docs/results.md).
+/// @file
+/// flexmbd summary DIR: the run's DIR/summary.json printed readably (docs/results.md).
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
-// `flexmbd run SCENE.json --out DIR` for tensegrity scenes ("model": "tensegrity"):
-// writes DIR/results.csv, DIR/events.csv and DIR/summary.json (docs/tensegrity.md), and
-// with --vtk the frames DIR/vtk/bodies_NNNNNN.vtu and DIR/vtk/bodies.pvd.
+/// @file
+/// `flexmbd run SCENE.json --out DIR` for tensegrity scenes ("model": "tensegrity"):
+/// writes DIR/results.csv, DIR/events.csv and DIR/summary.json (docs/tensegrity.md), and
+/// with --vtk the frames DIR/vtk/bodies_NNNNNN.vtu and DIR/vtk/bodies.pvd.
 #pragma once
 
 #include <optional>

@@ -1,5 +1,6 @@
-// Beam finite-element meshes of flexible bodies: nodes (body frame, undeformed) and
-// two-node elements, planar (BeamMesh2d) and spatial (BeamMesh3d).
+/// @file
+/// Beam finite-element meshes of flexible bodies: nodes (body frame, undeformed) and
+/// two-node elements, planar (BeamMesh2d) and spatial (BeamMesh3d).
 #pragma once
 
 #include <vector>

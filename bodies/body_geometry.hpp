@@ -1,6 +1,7 @@
-// What a body looks like, for viewing only (scene key "geometry" of a rigid body): solid
-// shapes placed in the body frame, drawn as surfaces in the VTK frames (and by viewers);
-// they take no part in the dynamics. docs/scene-format.md, "Geometry".
+/// @file
+/// What a body looks like, for viewing only (scene key "geometry" of a rigid body): solid
+/// shapes placed in the body frame, drawn as surfaces in the VTK frames (and by viewers);
+/// they take no part in the dynamics. docs/scene-format.md, "Geometry".
 #pragma once
 
 #include <vector>

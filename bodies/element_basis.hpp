@@ -1,7 +1,8 @@
-// The rows of a beam model's nodal basis (nodal displacements = basis * q_f) that belong
-// to one element, restricted to the elastic coordinates they depend on, so that element
-// loops stay O(elements) for nodal and reduced bodies alike. Planar (N = 6) and spatial
-// (N = 12) beam models.
+/// @file
+/// The rows of a beam model's nodal basis (nodal displacements = basis * q_f) that belong
+/// to one element, restricted to the elastic coordinates they depend on, so that element
+/// loops stay O(elements) for nodal and reduced bodies alike. Planar (N = 6) and spatial
+/// (N = 12) beam models.
 #pragma once
 
 #include <Eigen/Sparse>

@@ -1,7 +1,8 @@
-// The kinematic equation q' = T(q) v of a spatial body whose coordinates start with a
-// frame (R, p): origin R (world) and Euler parameters p, with velocities (R' world,
-// w body axes), followed by `extra` coordinates that are their own velocities' integrals
-// (elastic coordinates). Shared by RigidBody3d (extra = 0) and FfrBody3d (extra = nf).
+/// @file
+/// The kinematic equation q' = T(q) v of a spatial body whose coordinates start with a
+/// frame (R, p): origin R (world) and Euler parameters p, with velocities (R' world,
+/// w body axes), followed by `extra` coordinates that are their own velocities' integrals
+/// (elastic coordinates). Shared by RigidBody3d (extra = 0) and FfrBody3d (extra = nf).
 #pragma once
 
 #include "core/matrix_sink.hpp"

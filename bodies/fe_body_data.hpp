@@ -1,6 +1,7 @@
-// The data of a flexible body exported from a finite element code (Abaqus, Ansys: the
-// readers in io/fe_abaqus.hpp and io/fe_ansys.hpp): nodes, elements, node sets, the
-// degree-of-freedom map and the sparse mass and stiffness matrices. docs/fe-import.md.
+/// @file
+/// The data of a flexible body exported from a finite element code (Abaqus, Ansys: the
+/// readers in io/fe_abaqus.hpp and io/fe_ansys.hpp): nodes, elements, node sets, the
+/// degree-of-freedom map and the sparse mass and stiffness matrices. docs/fe-import.md.
 #pragma once
 
 #include <map>

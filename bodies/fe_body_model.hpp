@@ -1,7 +1,8 @@
-// A spatial floating-frame-of-reference body from a finite element mesh of solid elements
-// (3 translational DOF per node, FeBodyData from io/fe_abaqus.hpp or io/fe_ansys.hpp):
-// the inertia invariants (FfrInvariants3d) computed from the FE mass matrix and the nodal
-// coordinates, reduced to free-free normal modes about mean axes. docs/fe-import.md.
+/// @file
+/// A spatial floating-frame-of-reference body from a finite element mesh of solid elements
+/// (3 translational DOF per node, FeBodyData from io/fe_abaqus.hpp or io/fe_ansys.hpp):
+/// the inertia invariants (FfrInvariants3d) computed from the FE mass matrix and the nodal
+/// coordinates, reduced to free-free normal modes about mean axes. docs/fe-import.md.
 #pragma once
 
 #include <string>

@@ -1,10 +1,11 @@
-// A beam finite-element mesh as the generator of a flexible body's invariants, one code
-// for planar and spatial bodies (FfrBeamModelT<PlanarBeam> = FfrBeamModel,
-// FfrBeamModelT<SpatialBeam> = FfrBeamModel3d; what differs: bodies/ffr_beam_traits.hpp):
-// nodal inertia shape integrals summed from the elements, reference conditions (B2),
-// optional modal reduction (normal modes, Craig-Bampton, inertia modes), and the
-// (optionally geometrically nonlinear) strain energy. docs/flexible-bodies.md,
-// docs/spatial-flexible.md.
+/// @file
+/// A beam finite-element mesh as the generator of a flexible body's invariants, one code
+/// for planar and spatial bodies (FfrBeamModelT<PlanarBeam> = FfrBeamModel,
+/// FfrBeamModelT<SpatialBeam> = FfrBeamModel3d; what differs: bodies/ffr_beam_traits.hpp):
+/// nodal inertia shape integrals summed from the elements, reference conditions (B2),
+/// optional modal reduction (normal modes, Craig-Bampton, inertia modes), and the
+/// (optionally geometrically nonlinear) strain energy. docs/flexible-bodies.md,
+/// docs/spatial-flexible.md.
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
-// The options of a beam model (FfrBeamModelT, bodies/ffr_beam_model.hpp), one definition
-// for planar (Dim 2) and spatial (Dim 3) bodies: reference conditions (B2), modal
-// reduction, inertia modes, geometric stiffening, beam theory.
+/// @file
+/// The options of a beam model (FfrBeamModelT, bodies/ffr_beam_model.hpp), one definition
+/// for planar (Dim 2) and spatial (Dim 3) bodies: reference conditions (B2), modal
+/// reduction, inertia modes, geometric stiffening, beam theory.
 #pragma once
 
 #include <vector>

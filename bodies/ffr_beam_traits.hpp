@@ -1,9 +1,10 @@
-// What a planar and a spatial beam model do differently (FfrBeamModelT,
-// bodies/ffr_beam_model.hpp): the node's coordinates (3 or 6), the element, the
-// element's inertia shape integrals summed into the body's invariants, the pinned-pinned
-// and mean-axis reference conditions, the inertia loads of the frame's rigid motion, and
-// the shape of a point on an element. PlanarBeam: bodies/ffr_beam_planar.cpp;
-// SpatialBeam: bodies/ffr_beam_spatial.cpp.
+/// @file
+/// What a planar and a spatial beam model do differently (FfrBeamModelT,
+/// bodies/ffr_beam_model.hpp): the node's coordinates (3 or 6), the element, the
+/// element's inertia shape integrals summed into the body's invariants, the pinned-pinned
+/// and mean-axis reference conditions, the inertia loads of the frame's rigid motion, and
+/// the shape of a point on an element. PlanarBeam: bodies/ffr_beam_planar.cpp;
+/// SpatialBeam: bodies/ffr_beam_spatial.cpp.
 #pragma once
 
 #include <array>

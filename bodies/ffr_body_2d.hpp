@@ -1,4 +1,5 @@
-// Planar flexible body in the floating frame of reference formulation.
+/// @file
+/// Planar flexible body in the floating frame of reference formulation.
 #pragma once
 
 #include <memory>

@@ -1,4 +1,5 @@
-// Spatial flexible body in the floating frame of reference formulation (issue 14).
+/// @file
+/// Spatial flexible body in the floating frame of reference formulation (issue 14).
 #pragma once
 
 #include <array>
@@ -37,6 +38,8 @@ namespace flexmbd {
 /// A (w + Ntheta q_f'), which equals that of A_node up to O(|theta| |theta'|).
 class FfrBody3d final : public Body {
  public:
+  /// @param name the body's name.
+  /// @param invariants the body's inertia invariants and elastic matrices.
   /// @param initial frame ORIGIN (not the centre of mass), orientation, origin velocity
   ///        (world) and angular velocity (body axes).
   /// @param qf0, qf0dot initial elastic coordinates and rates (empty: zero).

@@ -1,7 +1,8 @@
-// The inertia and stiffness invariants of a planar floating-frame-of-reference body:
-// everything its equations of motion need at run time, besides the current q_f.
-// Definitions and sign conventions: docs/flexible-bodies.md. What planar and spatial
-// invariants share: bodies/ffr_invariants_base.hpp.
+/// @file
+/// The inertia and stiffness invariants of a planar floating-frame-of-reference body:
+/// everything its equations of motion need at run time, besides the current q_f.
+/// Definitions and sign conventions: docs/flexible-bodies.md. What planar and spatial
+/// invariants share: bodies/ffr_invariants_base.hpp.
 #pragma once
 
 #include <string>

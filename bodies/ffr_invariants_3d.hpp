@@ -1,7 +1,8 @@
-// The inertia and stiffness invariants of a spatial floating-frame-of-reference body:
-// everything its equations of motion need at run time, besides the current q_f.
-// Definitions: docs/spatial-flexible.md (document 003; Shabana, Dynamics of Multibody
-// Systems, ch. 5, eq. 5.96-5.140 for the spatial mass matrix blocks).
+/// @file
+/// The inertia and stiffness invariants of a spatial floating-frame-of-reference body:
+/// everything its equations of motion need at run time, besides the current q_f.
+/// Definitions: docs/spatial-flexible.md (document 003; Shabana, Dynamics of Multibody
+/// Systems, ch. 5, eq. 5.96-5.140 for the spatial mass matrix blocks).
 #pragma once
 
 #include <array>

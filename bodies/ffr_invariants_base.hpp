@@ -1,7 +1,8 @@
-// What the planar and spatial invariants of a floating-frame-of-reference body share:
-// the attachment points, the mass, first moment, S-bar, m_ff, K_ff, D_ff, their checks
-// and their change of elastic coordinates. FfrInvariants (planar, bodies/ffr_invariants.hpp)
-// and FfrInvariants3d (spatial, bodies/ffr_invariants_3d.hpp) add their own inertia terms.
+/// @file
+/// What the planar and spatial invariants of a floating-frame-of-reference body share:
+/// the attachment points, the mass, first moment, S-bar, m_ff, K_ff, D_ff, their checks
+/// and their change of elastic coordinates. FfrInvariants (planar, bodies/ffr_invariants.hpp)
+/// and FfrInvariants3d (spatial, bodies/ffr_invariants_3d.hpp) add their own inertia terms.
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
-// The checks FfrInvariants::validate and FfrInvariants3d::validate share: sizes,
-// finiteness, symmetry and positive definiteness of an invariant, each failure an
-// InputError "<owner>: invariant <what> ...".
+/// @file
+/// The checks FfrInvariants::validate and FfrInvariants3d::validate share: sizes,
+/// finiteness, symmetry and positive definiteness of an invariant, each failure an
+/// InputError "<owner>: invariant <what> ...".
 #pragma once
 
 #include <string>

@@ -1,13 +1,14 @@
-// Reduction bases shared by the planar and spatial beam models (FfrBeamModel,
-// FfrBeamModel3d), both given the body's stiffness K and mass M in its elastic
-// coordinates after the reference conditions (q_n = B2 x):
-//  - normal modes of K phi = omega^2 M phi;
-//  - Craig-Bampton: static constraint modes (unit displacement of each interface
-//    coordinate, the rest statically condensed) and fixed-interface normal modes (the
-//    interface held). docs/flexible-bodies.md, "Craig-Bampton reduction";
-//  - static modes appended to either basis (the inertia modes: static responses to the
-//    inertia loads of the frame's rigid motion), docs/flexible-bodies.md, "Section
-//    forces of reduced bodies".
+/// @file
+/// Reduction bases shared by the planar and spatial beam models (FfrBeamModel,
+/// FfrBeamModel3d), both given the body's stiffness K and mass M in its elastic
+/// coordinates after the reference conditions (q_n = B2 x):
+///  - normal modes of K phi = omega^2 M phi;
+///  - Craig-Bampton: static constraint modes (unit displacement of each interface
+///    coordinate, the rest statically condensed) and fixed-interface normal modes (the
+///    interface held). docs/flexible-bodies.md, "Craig-Bampton reduction";
+///  - static modes appended to either basis (the inertia modes: static responses to the
+///    inertia loads of the frame's rigid motion), docs/flexible-bodies.md, "Section
+///    forces of reduced bodies".
 #pragma once
 
 #include <string>

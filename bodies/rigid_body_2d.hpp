@@ -1,4 +1,5 @@
-// Planar rigid body described by its frame: position (x, y) and angle theta.
+/// @file
+/// Planar rigid body described by its frame: position (x, y) and angle theta.
 #pragma once
 
 #include "core/body.hpp"

@@ -1,6 +1,7 @@
-// Spatial rigid body: centre-of-mass position and Euler parameters (unit quaternion);
-// velocities are the centre of mass's velocity (world axes) and the angular velocity in
-// body axes, so the mass matrix is constant (docs/spatial.md).
+/// @file
+/// Spatial rigid body: centre-of-mass position and Euler parameters (unit quaternion);
+/// velocities are the centre of mass's velocity (world axes) and the angular velocity in
+/// body axes, so the mass matrix is constant (docs/spatial.md).
 #pragma once
 
 #include "core/body.hpp"

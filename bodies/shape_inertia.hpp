@@ -1,8 +1,9 @@
-// Mass and inertia of a spatial rigid body from solid shapes of uniform density: box,
-// solid cylinder, tube (hollow cylinder) and sphere, each placed in the body by an offset
-// and an orientation; several shapes add up by the parallel-axis theorem. The body frame
-// is the centre of mass, so the shapes' common centre of mass must be at the body origin
-// (docs/scene-format.md, "shape"; docs/spatial.md, "Inertia from shapes").
+/// @file
+/// Mass and inertia of a spatial rigid body from solid shapes of uniform density: box,
+/// solid cylinder, tube (hollow cylinder) and sphere, each placed in the body by an offset
+/// and an orientation; several shapes add up by the parallel-axis theorem. The body frame
+/// is the centre of mass, so the shapes' common centre of mass must be at the body origin
+/// (docs/scene-format.md, "shape"; docs/spatial.md, "Inertia from shapes").
 #pragma once
 
 #include <vector>

@@ -1,12 +1,13 @@
-// Convenience builders of spatial models, the counterpart of builders/planar_builders.hpp:
-// free functions that make a spatial body, joint, driver or force and add it to a System
-// through its generic addBody / addConstraint / addForce (docs/spatial.md). What the
-// scene reader does for "dimension": 3 scenes, from C++:
-//   BodyIndex arm = addRigidBody3d(sys, "arm", shapeProperties(box, 0.0, 7800.0), init);
-//   ConstraintIndex hinge = addSpatialJointAtWorld(sys, "hinge", SpatialJointType::Revolute,
-//                                                  kGround, arm, Vec3::Zero(), &axis);
-//   addJointAngleDriver(sys, "motor", hinge, makeConstantSpeedLaw(2.0));
-// Bound in Python with the same names in snake case (docs/python.md).
+/// @file
+/// Convenience builders of spatial models, the counterpart of builders/planar_builders.hpp:
+/// free functions that make a spatial body, joint, driver or force and add it to a System
+/// through its generic addBody / addConstraint / addForce (docs/spatial.md). What the
+/// scene reader does for "dimension": 3 scenes, from C++:
+///   BodyIndex arm = addRigidBody3d(sys, "arm", shapeProperties(box, 0.0, 7800.0), init);
+///   ConstraintIndex hinge = addSpatialJointAtWorld(sys, "hinge", SpatialJointType::Revolute,
+///                                                  kGround, arm, Vec3::Zero(), &axis);
+///   addJointAngleDriver(sys, "motor", hinge, makeConstantSpeedLaw(2.0));
+/// Bound in Python with the same names in snake case (docs/python.md).
 #pragma once
 
 #include <array>

@@ -1,5 +1,6 @@
-// The interface every body implements: its coordinates, mass matrix, forces and the
-// kinematics of its material points (what joints and forces attach to).
+/// @file
+/// The interface every body implements: its coordinates, mass matrix, forces and the
+/// kinematics of its material points (what joints and forces attach to).
 #pragma once
 
 #include <string>
@@ -16,14 +17,18 @@ enum class CoordinateKind { Position, Angle, Elastic };
 
 /// A body contributes to the equations of motion  M(q) v' = Q(t, q, v) + ...
 /// All methods are const and pure: a body holds only constant data.
+/// The concrete bodies: RigidBody2d, FfrBody2d (planar), RigidBody3d, FfrBody3d
+/// (spatial: beams, FE exports, SID data), Ground; added to a System with System::addBody (or the builders'
+/// addRigidBody(sys, ...), ...), which gives each its offsets in q and v.
 class Body {
  public:
+  /// @param name unique in the system (among bodies, constraints and forces).
   explicit Body(std::string name) : name_(std::move(name)) {}
   virtual ~Body() = default;
   Body(const Body&) = delete;
   Body& operator=(const Body&) = delete;
 
-  const std::string& name() const { return name_; }
+  const std::string& name() const { return name_; }  ///< The name given at construction.
 
   /// Number of generalised coordinates nq.
   virtual int numCoordinates() const = 0;
@@ -89,7 +94,7 @@ class Body {
   virtual std::vector<CoordinateKind> velocityKinds() const { return coordinateKinds(); }
   /// Coordinates (nq) and velocities (nv) given at construction (initial guess).
   virtual VecX initialCoordinates() const = 0;
-  virtual VecX initialVelocities() const = 0;
+  virtual VecX initialVelocities() const = 0;  ///< @copydoc initialCoordinates
 
   /// Total mass (for checks and the Newton-Euler balance).
   virtual double mass() const = 0;
@@ -119,16 +124,17 @@ class Body {
   }
   /// Potential energy of gravity (zero at the world origin) and internal (elastic) energy.
   virtual double gravityPotential(const ConstVecRef& q, const Vec3& g) const = 0;
+  /// Internal (elastic) energy at q; zero for rigid bodies.
   virtual double internalPotential(const ConstVecRef& q) const { (void)q; return 0.0; }
   /// The constant mass, stiffness and damping matrices of the body's elastic coordinates
   /// (nf x nf, sparse, views valid as long as the body), for modal analyses (the BDF
   /// order limit, linearisation); all null for a body without elastic coordinates.
   struct ElasticMatrices {
-    const SpMat* mass = nullptr;
-    const SpMat* stiffness = nullptr;
-    const SpMat* damping = nullptr;
+    const SpMat* mass = nullptr;       ///< M_ff
+    const SpMat* stiffness = nullptr;  ///< K_ff
+    const SpMat* damping = nullptr;    ///< D_ff
   };
-  virtual ElasticMatrices elasticMatrices() const { return {}; }
+  virtual ElasticMatrices elasticMatrices() const { return {}; }  ///< See ElasticMatrices.
   /// True if internal forces dissipate energy (damping).
   virtual bool isDissipative() const { return false; }
 
@@ -163,6 +169,7 @@ class Body {
     pointKinematics(q, point, resolvePoint(lift(point), "point"), nullptr, withHessians, p);
     return p;
   }
+  /// The same over the coordinates `cols` (allocates: outputs and tests).
   PointKinematics pointKinematics(const ConstVecRef& q, const Vec2& point, const std::vector<int>& cols,
                                   bool withHessians) const {
     PointKinematics p;

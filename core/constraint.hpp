@@ -1,4 +1,5 @@
-// The interface of constraints: joints (scleronomic) and drivers (rheonomic).
+/// @file
+/// The interface of constraints: joints (scleronomic) and drivers (rheonomic).
 #pragma once
 
 #include <array>
@@ -18,6 +19,8 @@ namespace flexmbd {
 /// velocities (first derivatives, nv_used columns) and the used coordinates (second
 /// derivatives d/dq of first derivatives, nq_used columns); with T = I the two are the same.
 struct BodyState {
+  /// A view of body b's coordinates at `data` (nq of them) using the velocities `used`
+  /// and the coordinates `usedCoordinates` (null: all; coordinates null: as `used`).
   BodyState(const Body& b, const double* data, const std::vector<int>* used = nullptr,
             const std::vector<int>* usedCoordinates = nullptr)
       : BodyState(b, data, b.numCoordinates(), used, usedCoordinates) {}
@@ -25,10 +28,10 @@ struct BodyState {
   BodyState(const Body& b, const double* data, int numCoordinates, const std::vector<int>* used,
             const std::vector<int>* usedCoordinates)
       : body(b), q(data, numCoordinates), cols(used), qcols(usedCoordinates ? usedCoordinates : used) {}
-  const Body& body;
-  Eigen::Map<const VecX> q;
-  const std::vector<int>* cols;
-  const std::vector<int>* qcols;
+  const Body& body;               ///< the body
+  Eigen::Map<const VecX> q;        ///< its coordinates (all nq of them)
+  const std::vector<int>* cols;    ///< the used velocities (body-local, ascending; null: all)
+  const std::vector<int>* qcols;   ///< the used coordinates (body-local, ascending; null: all)
   /// Number of used velocities.
   int numUsed() const { return cols ? static_cast<int>(cols->size()) : body.numVelocities(); }
   /// Number of used coordinates.
@@ -71,8 +74,8 @@ class BodyStates {
     if (n_ == kMaxBodies) throw std::logic_error("BodyStates: more than kMaxBodies bodies");
     states_[n_++].emplace(b, q, numCoordinates, used, usedCoordinates);
   }
-  int size() const { return n_; }
-  const BodyState& operator[](int k) const { return *states_[k]; }
+  int size() const { return n_; }  ///< Number of bodies (the element's bodies()).
+  const BodyState& operator[](int k) const { return *states_[k]; }  ///< The state of bodies()[k].
   /// The body's identifier of the element's attachment k (in the order of its
   /// attachments()), resolved by System::finalize; Body::kAnyPoint when not resolved.
   int pointId(int k) const { return pointIds_ && k < numPointIds_ ? pointIds_[k] : Body::kAnyPoint; }
@@ -91,8 +94,8 @@ class BodyStates {
 
 /// A body point a constraint or force element attaches to (body axes; planar: z = 0).
 struct Attachment {
-  BodyIndex body;
-  Vec3 point = Vec3::Zero();
+  BodyIndex body;             ///< the body
+  Vec3 point = Vec3::Zero();  ///< the point in body axes
 };
 
 /// Constraint equations g(q, t) = h(q) - f(t) = 0 of the constraint's bodies. Their
@@ -107,15 +110,22 @@ struct ConstraintEvaluation {
   KinematicsWork work;  ///< working memory of evaluate()
 };
 
+/// The interface of joints and drivers: m equations g(q, t) = h(q) - f(t) = 0 on the
+/// coordinates of its bodies (ConstraintEvaluation), with their Jacobian G and, on
+/// request, Hessians; drivers add a prescribed f(t). The system's multipliers lambda of
+/// its equations give the reactions(). Added to a System with System::addConstraint
+/// (or the builders' addRevoluteJoint(sys, ...), ...); evaluated through System's maps.
 class Constraint {
  public:
+  /// @param name unique in the system (among bodies, constraints and forces).
+  /// @param bodies the bodies the equations act on, in the order of BodyStates.
   Constraint(std::string name, std::vector<BodyIndex> bodies)
       : name_(std::move(name)), bodies_(std::move(bodies)) {}
   virtual ~Constraint() = default;
   Constraint(const Constraint&) = delete;
   Constraint& operator=(const Constraint&) = delete;
 
-  const std::string& name() const { return name_; }
+  const std::string& name() const { return name_; }  ///< The name given at construction.
   /// The bodies whose coordinates enter h (ground included where it takes part).
   const std::vector<BodyIndex>& bodies() const { return bodies_; }
 
@@ -130,6 +140,7 @@ class Constraint {
     return std::nullopt;
   }
 
+  /// Number of equations m (rows of h and G).
   virtual int numEquations() const = 0;
   /// "revolute", "prismatic", "fixed", "body_coordinate", "joint_angle", ...
   virtual std::string typeName() const = 0;

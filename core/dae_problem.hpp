@@ -1,6 +1,7 @@
-// The interface the time integrators see: a DAE F(t, y, y') = 0 with a fixed sparse
-// Jacobian pattern. The engine's assembled model (DaeSystem) is one; the hand-coded
-// benchmark problems are others, integrated by the same integrators.
+/// @file
+/// The interface the time integrators see: a DAE F(t, y, y') = 0 with a fixed sparse
+/// Jacobian pattern. The engine's assembled model (DaeSystem) is one; the hand-coded
+/// benchmark problems are others, integrated by the same integrators.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,6 @@
-// The DAE F(t, y, y') = 0 that the integrator sees, its residual and its Jacobian
-// dF/dy + cj dF/dy', assembled from the components of a finalized System.
+/// @file
+/// The DAE F(t, y, y') = 0 that the integrator sees, its residual and its Jacobian
+/// dF/dy + cj dF/dy', assembled from the components of a finalized System.
 #pragma once
 
 #include <cstdint>

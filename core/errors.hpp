@@ -1,5 +1,6 @@
-// Exception types of the engine. Every message names the object (body, joint, key)
-// that is wrong, what was found and what was expected.
+/// @file
+/// Exception types of the engine. Every message names the object (body, joint, key)
+/// that is wrong, what was found and what was expected.
 #pragma once
 
 #include <cmath>

@@ -1,4 +1,5 @@
-// The interface of force elements (springs, dampers, applied loads).
+/// @file
+/// The interface of force elements (springs, dampers, applied loads).
 #pragma once
 
 #include <string>
@@ -11,16 +12,21 @@ namespace flexmbd {
 /// A force element adds generalised forces Q(t, q, v) over the local velocities of its
 /// bodies, v_local = [used velocities of body 0; of body 1; ...] (see BodyState): Q and
 /// v are nv_local, dQ/dq is nv_local x nq_local, dQ/dv nv_local x nv_local.
+/// Added to a System with System::addForce (or the builders' addSpringDamper(sys, ...),
+/// ...); the system sums the Q of all force elements into the equations of motion.
 class Force {
  public:
+  /// @param name unique in the system (among bodies, constraints and forces).
+  /// @param bodies the bodies the force acts on, in the order of BodyStates.
   Force(std::string name, std::vector<BodyIndex> bodies)
       : name_(std::move(name)), bodies_(std::move(bodies)) {}
   virtual ~Force() = default;
   Force(const Force&) = delete;
   Force& operator=(const Force&) = delete;
 
-  const std::string& name() const { return name_; }
-  const std::vector<BodyIndex>& bodies() const { return bodies_; }
+  const std::string& name() const { return name_; }  ///< The name given at construction.
+  const std::vector<BodyIndex>& bodies() const { return bodies_; }  ///< The bodies it acts on.
+  /// "spring_damper", "applied_load", "rotational_spring_damper", "bushing", ...
   virtual std::string typeName() const = 0;
   /// Body points the force attaches to, resolved by System::finalize() into the
   /// identifiers BodyStates::pointId(k) gives in this order.

@@ -1,5 +1,6 @@
-// The ground: a body without coordinates; its points are fixed in the world frame. Part of
-// the core: every System makes it as body 0 (kGround) in its constructor.
+/// @file
+/// The ground: a body without coordinates; its points are fixed in the world frame. Part of
+/// the core: every System makes it as body 0 (kGround) in its constructor.
 #pragma once
 
 #include "core/body.hpp"

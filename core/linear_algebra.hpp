@@ -1,4 +1,5 @@
-// Small dense linear-algebra helpers shared by the model set-up and the integrators.
+/// @file
+/// Small dense linear-algebra helpers shared by the model set-up and the integrators.
 #pragma once
 
 #include <vector>

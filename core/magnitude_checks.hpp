@@ -1,7 +1,8 @@
-// Input values that are positive but numerically meaningless next to the rest of the
-// model (issue 26, D2): one bound for the smallest magnitude of any positive scene value
-// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths);
-// the same smallest magnitude for the length of an axis or direction (D22).
+/// @file
+/// Input values that are positive but numerically meaningless next to the rest of the
+/// model (issue 26, D2): one bound for the smallest magnitude of any positive scene value
+/// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths);
+/// the same smallest magnitude for the length of an axis or direction (D22).
 #pragma once
 
 #include <string>

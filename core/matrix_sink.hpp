@@ -1,6 +1,7 @@
-// Where a body writes a matrix block (mass matrix, force Jacobians): a dense matrix, or
-// the DAE Jacobian at an offset, with a scale factor. Bodies write only their structural
-// non-zeros, so a large flexible body fills a sparse Jacobian in O(non-zeros).
+/// @file
+/// Where a body writes a matrix block (mass matrix, force Jacobians): a dense matrix, or
+/// the DAE Jacobian at an offset, with a scale factor. Bodies write only their structural
+/// non-zeros, so a large flexible body fills a sparse Jacobian in O(non-zeros).
 #pragma once
 
 #include "core/sparse_pattern.hpp"

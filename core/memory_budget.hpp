@@ -1,5 +1,6 @@
-// The memory a model may take: what this machine has available, and the refusal, before
-// the big allocations, of a model whose estimate exceeds it (docs/stability.md, "Sizes").
+/// @file
+/// The memory a model may take: what this machine has available, and the refusal, before
+/// the big allocations, of a model whose estimate exceeds it (docs/stability.md, "Sizes").
 #pragma once
 
 #include <optional>

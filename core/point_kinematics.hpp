@@ -1,5 +1,6 @@
-// Kinematics of body points with their first and second derivatives: what bodies give
-// to joints and force elements, and the working memory their evaluations reuse.
+/// @file
+/// Kinematics of body points with their first and second derivatives: what bodies give
+/// to joints and force elements, and the working memory their evaluations reuse.
 #pragma once
 
 #include <vector>

@@ -1,5 +1,6 @@
-// Spatial rotations: the skew-symmetric matrix of a vector and the Euler parameters (unit
-// quaternion) of a rotation with their kinematic matrices (Nikravesh 1988, ch. 6).
+/// @file
+/// Spatial rotations: the skew-symmetric matrix of a vector and the Euler parameters (unit
+/// quaternion) of a rotation with their kinematic matrices (Nikravesh 1988, ch. 6).
 #pragma once
 
 #include <Eigen/Geometry>

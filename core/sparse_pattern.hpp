@@ -1,5 +1,6 @@
-// Compressed-sparse-column pattern of the DAE Jacobian, built once after finalize,
-// and the sink the assembly writes entries into (dense or sparse storage).
+/// @file
+/// Compressed-sparse-column pattern of the DAE Jacobian, built once after finalize,
+/// and the sink the assembly writes entries into (dense or sparse storage).
 #pragma once
 
 #include <Eigen/SparseCore>

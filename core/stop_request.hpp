@@ -1,7 +1,8 @@
-// Stopping a run from outside (SIGINT/SIGTERM in the command line, Ctrl-C in Python)
-// without waiting for the next output row (issue 26, item 8): the integrators' inner
-// loops (every residual of the model's DAE, every ALI3-P, CVODE, time-stepping and
-// kinematics step) call pollStop(), which runs the check the thread's caller installed.
+/// @file
+/// Stopping a run from outside (SIGINT/SIGTERM in the command line, Ctrl-C in Python)
+/// without waiting for the next output row (issue 26, item 8): the integrators' inner
+/// loops (every residual of the model's DAE, every ALI3-P, CVODE, time-stepping and
+/// kinematics step) call pollStop(), which runs the check the thread's caller installed.
 #pragma once
 
 namespace flexmbd {

@@ -1,6 +1,7 @@
-// Whole-system quantities assembled from the components, on dense global arrays:
-// used by consistent initialisation, outputs and tests (the integrator's residual and
-// Jacobian assembly is in dae_system.hpp).
+/// @file
+/// Whole-system quantities assembled from the components, on dense global arrays:
+/// used by consistent initialisation, outputs and tests (the integrator's residual and
+/// Jacobian assembly is in dae_system.hpp).
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
-// Prescribed functions of time f(t) with exact first and second derivatives, used by
-// drivers (rheonomic constraints) and by applied forces and torques.
+/// @file
+/// Prescribed functions of time f(t) with exact first and second derivatives, used by
+/// drivers (rheonomic constraints) and by applied forces and torques.
 #pragma once
 
 #include <memory>

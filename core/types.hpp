@@ -1,4 +1,5 @@
-// Basic types of the engine: Eigen aliases, planar rotation helpers, typed indices.
+/// @file
+/// Basic types of the engine: Eigen aliases, planar rotation helpers, typed indices.
 #pragma once
 
 #include <Eigen/Core>

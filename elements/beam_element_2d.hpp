@@ -1,5 +1,6 @@
-// Planar beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
-// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 6-7).
+/// @file
+/// Planar beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
+/// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 6-7).
 #pragma once
 
 #include <Eigen/Core>

@@ -1,6 +1,7 @@
-// Spatial beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
-// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 5-6; Przemieniecki,
-// Theory of Matrix Structural Analysis, sec. 5.6). docs/spatial-flexible.md.
+/// @file
+/// Spatial beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
+/// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 5-6; Przemieniecki,
+/// Theory of Matrix Structural Analysis, sec. 5.6). docs/spatial-flexible.md.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,6 @@
-// Cross-sections and materials of Euler-Bernoulli beams: planar (BeamSection) and
-// spatial (BeamSection3d).
+/// @file
+/// Cross-sections and materials of Euler-Bernoulli beams: planar (BeamSection) and
+/// spatial (BeamSection3d).
 #pragma once
 
 #include <string>

@@ -1,15 +1,16 @@
-// The strain energy of a two-node Euler-Bernoulli beam element, planar (N = 6 element
-// coordinates) or spatial (N = 12): one code for BeamElement2d and BeamElement3d.
-//
-// Linear model: U = e^T K e / 2. With geometric stiffening the membrane strain is the
-// element-averaged second-order strain
-//   eps_m = u' + (1/2l) int_0^l |w_perp'|^2 dx = a e + e^T G e / (2l)
-// (constant along the element; a = the axial strain row, G = int b^T b dx over the slope
-// rows b), and U = EA l eps_m^2 / 2 + e^T K_b e / 2 with K_b the bending (and torsion)
-// part of K. The pointwise u' + |w'|^2 / 2 cannot vanish in bending with a linear u and
-// cubic transverse fields and locks coarse meshes (membrane locking: Stolarski &
-// Belytschko, J. Appl. Mech. 49 (1982); Crisfield, Non-linear Finite Element Analysis of
-// Solids and Structures vol. 1 (1991); docs/flexible-bodies.md).
+/// @file
+/// The strain energy of a two-node Euler-Bernoulli beam element, planar (N = 6 element
+/// coordinates) or spatial (N = 12): one code for BeamElement2d and BeamElement3d.
+///
+/// Linear model: U = e^T K e / 2. With geometric stiffening the membrane strain is the
+/// element-averaged second-order strain
+///   eps_m = u' + (1/2l) int_0^l |w_perp'|^2 dx = a e + e^T G e / (2l)
+/// (constant along the element; a = the axial strain row, G = int b^T b dx over the slope
+/// rows b), and U = EA l eps_m^2 / 2 + e^T K_b e / 2 with K_b the bending (and torsion)
+/// part of K. The pointwise u' + |w'|^2 / 2 cannot vanish in bending with a linear u and
+/// cubic transverse fields and locks coarse meshes (membrane locking: Stolarski &
+/// Belytschko, J. Appl. Mech. 49 (1982); Crisfield, Non-linear Finite Element Analysis of
+/// Solids and Structures vol. 1 (1991); docs/flexible-bodies.md).
 #pragma once
 
 #include <Eigen/Core>

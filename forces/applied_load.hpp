@@ -1,4 +1,5 @@
-// Prescribed force (world components) at a body point and torque on the body.
+/// @file
+/// Prescribed force (world components) at a body point and torque on the body.
 #pragma once
 
 #include "core/force.hpp"

@@ -1,4 +1,5 @@
-// Rotational spring-damper acting in a revolute joint.
+/// @file
+/// Rotational spring-damper acting in a revolute joint.
 #pragma once
 
 #include "core/force.hpp"

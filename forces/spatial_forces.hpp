@@ -1,5 +1,6 @@
-// Force elements of spatial models: a prescribed force and torque at a body point, and a
-// translational spring-damper between two body points.
+/// @file
+/// Force elements of spatial models: a prescribed force and torque at a body point, and a
+/// translational spring-damper between two body points.
 #pragma once
 
 #include "core/force.hpp"

@@ -1,4 +1,5 @@
-// Linear translational spring-damper between two body points.
+/// @file
+/// Linear translational spring-damper between two body points.
 #pragma once
 
 #include "core/force.hpp"

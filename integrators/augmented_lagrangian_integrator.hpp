@@ -1,21 +1,22 @@
-// Index-3 augmented Lagrangian formulation with mass-orthogonal projections (ALI3-P) and
-// the trapezoidal rule: E. Bayo, R. Ledesma, "Augmented Lagrangian and mass-orthogonal
-// projection methods for constrained multibody dynamics", Nonlinear Dynamics 9 (1996)
-// 113-130; J. Cuadrado, J. Cardenal, E. Bayo, "Modeling and solution methods for
-// efficient real-time simulation of multibody dynamics", Multibody System Dynamics 1
-// (1997) 259-280. Written from the formulas of these papers.
-//
-// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) stays regular where the
-// constraint Jacobian G loses rank, so it carries a mechanism through the isolated
-// singular positions (change points, dead centres) where the index-2 and index-3 DAE
-// integrators stop: the engine uses it as a bridge across them (integrators/simulation.cpp)
-// and as an integrator of its own ("ali3p").
-//
-// Models whose velocities are not coordinate rates (q' = T(q) v: spatial bodies with Euler
-// parameters) are integrated in velocity space: the unknown of a step is its displacement
-// d (nv), q_{n+1} = q_n (+) d by each body's own increment (Body::applyIncrement), the
-// trapezoidal rule relates d, v and a as it relates q_{n+1} - q_n, v and a for T = I, and
-// Newton's corrections are velocity-space increments (docs/formulations.md).
+/// @file
+/// Index-3 augmented Lagrangian formulation with mass-orthogonal projections (ALI3-P) and
+/// the trapezoidal rule: E. Bayo, R. Ledesma, "Augmented Lagrangian and mass-orthogonal
+/// projection methods for constrained multibody dynamics", Nonlinear Dynamics 9 (1996)
+/// 113-130; J. Cuadrado, J. Cardenal, E. Bayo, "Modeling and solution methods for
+/// efficient real-time simulation of multibody dynamics", Multibody System Dynamics 1
+/// (1997) 259-280. Written from the formulas of these papers.
+///
+/// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) stays regular where the
+/// constraint Jacobian G loses rank, so it carries a mechanism through the isolated
+/// singular positions (change points, dead centres) where the index-2 and index-3 DAE
+/// integrators stop: the engine uses it as a bridge across them (integrators/simulation.cpp)
+/// and as an integrator of its own ("ali3p").
+///
+/// Models whose velocities are not coordinate rates (q' = T(q) v: spatial bodies with Euler
+/// parameters) are integrated in velocity space: the unknown of a step is its displacement
+/// d (nv), q_{n+1} = q_n (+) d by each body's own increment (Body::applyIncrement), the
+/// trapezoidal rule relates d, v and a as it relates q_{n+1} - q_n, v and a for T = I, and
+/// Newton's corrections are velocity-space increments (docs/formulations.md).
 #pragma once
 
 #include <memory>

@@ -1,6 +1,7 @@
-// SUNDIALS CVODE (BDF, Newton with a dense difference-quotient Jacobian) behind a small
-// RAII class, with root-finding: every flag checked, exceptions never cross the C
-// callbacks (stored and rethrown), the same pattern as IdaSolver.
+/// @file
+/// SUNDIALS CVODE (BDF, Newton with a dense difference-quotient Jacobian) behind a small
+/// RAII class, with root-finding: every flag checked, exceptions never cross the C
+/// callbacks (stored and rethrown), the same pattern as IdaSolver.
 #pragma once
 
 #include <memory>

@@ -1,5 +1,6 @@
-// What every time integrator of the engine offers (IDA's BDF, Radau IIA), so that a run,
-// a benchmark or a test can pick one by name: options, statistics and the stepping call.
+/// @file
+/// What every time integrator of the engine offers (IDA's BDF, Radau IIA), so that a run,
+/// a benchmark or a test can pick one by name: options, statistics and the stepping call.
 #pragma once
 
 #include <memory>
@@ -14,7 +15,7 @@ enum class LinearSolverKind {
   Dense,      ///< SUNDIALS dense LU
   Klu,        ///< SuiteSparse KLU on the CSC pattern fixed at finalize
 };
-std::string toString(LinearSolverKind k);
+std::string toString(LinearSolverKind k);  ///< "auto", "dense", "klu".
 /// "auto", "dense", "klu". @throws InputError otherwise.
 LinearSolverKind parseLinearSolver(const std::string& name);
 
@@ -24,8 +25,9 @@ LinearSolverKind parseLinearSolver(const std::string& name);
 /// for the smallest systems.
 inline constexpr int kDenseSizeLimit = 8;
 
+/// The settings a DaeIntegrator is made with (from SolverSettings by the run).
 struct IntegratorOptions {
-  double rtol = 1e-8;
+  double rtol = 1e-8;  ///< relative tolerance
   /// Absolute tolerance per unknown (size n of the DAE), e.g. from absoluteTolerances()
   /// in simulation.hpp. Multipliers get a large one, so that the algebraic variables
   /// (already out of the error test) stay out of the Newton convergence test too.
@@ -35,10 +37,13 @@ struct IntegratorOptions {
   double minStepSize = 0.0;      ///< IDA fails (IDA_ERR_FAIL/IDA_CONV_FAIL) below this
   int maxOrder = 5;              ///< highest BDF order, 1..5 (IDA only)
   double initialStepSize = 0.0;  ///< first step tried; 0: IDA's estimate from y'
-  LinearSolverKind linearSolver = LinearSolverKind::Automatic;
+  LinearSolverKind linearSolver = LinearSolverKind::Automatic;  ///< the Newton systems' solver
   bool finiteDifferenceJacobian = false;  ///< IDA's own difference quotients (dense only)
 };
 
+/// An integrator's counters (SUNDIALS' names): steps, residual and Jacobian evaluations,
+/// Newton iterations and failures, error-test failures, linear solver setups; the last
+/// step size and the time reached.
 struct IntegratorStats {
   long steps = 0, residualEvals = 0, jacobianEvals = 0, nonlinearIterations = 0,
        nonlinearConvFailures = 0, errorTestFailures = 0, linearSetups = 0;

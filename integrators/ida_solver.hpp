@@ -1,5 +1,6 @@
-// SUNDIALS IDA behind a small RAII class: every flag checked, exceptions never cross
-// the C callbacks (they are stored and rethrown).
+/// @file
+/// SUNDIALS IDA behind a small RAII class: every flag checked, exceptions never cross
+/// the C callbacks (they are stored and rethrown).
 #pragma once
 
 #include <exception>

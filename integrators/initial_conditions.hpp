@@ -1,4 +1,5 @@
-// Consistent initial values for the constrained equations of motion.
+/// @file
+/// Consistent initial values for the constrained equations of motion.
 #pragma once
 
 #include "core/linear_algebra.hpp"

@@ -1,7 +1,8 @@
-// "integrator": "auto" (issue 24, item 2; docs/formulations.md, "Why a nodal rod takes so
-// many steps, and what auto does about it"): the integrator and the error weights a run
-// uses, chosen from the model at the start, with the reason in one line for summary.json
-// and the progress output; and the quasi-static elastic start of fast modes.
+/// @file
+/// "integrator": "auto" (issue 24, item 2; docs/formulations.md, "Why a nodal rod takes so
+/// many steps, and what auto does about it"): the integrator and the error weights a run
+/// uses, chosen from the model at the start, with the reason in one line for summary.json
+/// and the progress output; and the quasi-static elastic start of fast modes.
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
-// How the engine sets up KLU for its DAE Jacobians (used by IdaSolver, RadauSolver and
-// the micro-benchmarks, so all factor the same way).
+/// @file
+/// How the engine sets up KLU for its DAE Jacobians (used by IdaSolver, RadauSolver and
+/// the micro-benchmarks, so all factor the same way).
 #pragma once
 
 #include <klu.h>

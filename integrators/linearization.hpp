@@ -1,7 +1,8 @@
-// Linearisation of the constrained equations of motion about a state, and modal analysis
-// of the result (docs/modes.md). Sources: Géradin & Cardona, Flexible Multibody Dynamics
-// (2001), ch. 11 "Linearized analysis"; Shabana, Dynamics of Multibody Systems, 3rd ed.,
-// sec. 6.x on the embedding (null-space) technique.
+/// @file
+/// Linearisation of the constrained equations of motion about a state, and modal analysis
+/// of the result (docs/modes.md). Sources: Géradin & Cardona, Flexible Multibody Dynamics
+/// (2001), ch. 11 "Linearized analysis"; Shabana, Dynamics of Multibody Systems, 3rd ed.,
+/// sec. 6.x on the embedding (null-space) technique.
 #pragma once
 
 #include <complex>

@@ -1,7 +1,8 @@
-// Modal participation of the flexible bodies over a run (issue 24, item 4): per mode of
-// each body (frame held, integrators/elastic_modes.hpp) the largest amplitude and energy
-// reached at the outputs, the modes that carry the motion, and a warning when a nodal body
-// moves in so few slow modes that a reduced model would be much cheaper.
+/// @file
+/// Modal participation of the flexible bodies over a run (issue 24, item 4): per mode of
+/// each body (frame held, integrators/elastic_modes.hpp) the largest amplitude and energy
+/// reached at the outputs, the modes that carry the motion, and a warning when a nodal body
+/// moves in so few slow modes that a reduced model would be much cheaper.
 #pragma once
 
 #include <string>

@@ -1,6 +1,7 @@
-// A first-order system y' = f(t, y) with root functions g(t, y), as integrated by
-// CvodeSolver. Implementations may throw from rhs() and roots(): the solver stores the
-// exception and rethrows it (it never crosses the SUNDIALS callbacks).
+/// @file
+/// A first-order system y' = f(t, y) with root functions g(t, y), as integrated by
+/// CvodeSolver. Implementations may throw from rhs() and roots(): the solver stores the
+/// exception and rethrows it (it never crosses the SUNDIALS callbacks).
 #pragma once
 
 #include "core/types.hpp"

@@ -1,6 +1,7 @@
-// The outputs of a run: each state the integrators reach at an output time is completed
-// (accelerations, multipliers), checked (finite values), measured (constraint violations,
-// energy, largest coordinate and speed) and passed to the caller's callback.
+/// @file
+/// The outputs of a run: each state the integrators reach at an output time is completed
+/// (accelerations, multipliers), checked (finite values), measured (constraint violations,
+/// energy, largest coordinate and speed) and passed to the caller's callback.
 #pragma once
 
 #include <optional>

@@ -1,8 +1,9 @@
-// A quasi-static elastic start (issue 24; docs/formulations.md, "Why a nodal rod takes so
-// many steps"): the fast elastic modes of flexible bodies begin in their quasi-static
-// deflection under the loads of the initial state (inertia of the frame's motion, joint
-// reactions, applied loads, gravity) and with its rate, instead of undeformed and at rest
-// relative to the frame, which sets them vibrating for the whole run.
+/// @file
+/// A quasi-static elastic start (issue 24; docs/formulations.md, "Why a nodal rod takes so
+/// many steps"): the fast elastic modes of flexible bodies begin in their quasi-static
+/// deflection under the loads of the initial state (inertia of the frame's motion, joint
+/// reactions, applied loads, gravity) and with its rate, instead of undeformed and at rest
+/// relative to the frame, which sets them vibrating for the whole run.
 #pragma once
 
 #include <vector>

@@ -1,9 +1,10 @@
-// The Radau IIA methods with s = 3, 5 and 7 stages (orders 5, 9 and 13) and what the
-// solver derives from each once: the transformation of A^-1 to one real and (s-1)/2
-// complex eigenvalues, the embedded error estimate and the collocation polynomial.
-// Computed, not tabulated: nodes as roots of the Radau polynomial, the rest from them in
-// long double (Hairer & Wanner, Solving ODEs II, IV.5 (5.3)-(5.4) and IV.8; Hairer &
-// Wanner, J. Comput. Appl. Math. 111 (1999) 93-111, section 5).
+/// @file
+/// The Radau IIA methods with s = 3, 5 and 7 stages (orders 5, 9 and 13) and what the
+/// solver derives from each once: the transformation of A^-1 to one real and (s-1)/2
+/// complex eigenvalues, the embedded error estimate and the collocation polynomial.
+/// Computed, not tabulated: nodes as roots of the Radau polynomial, the rest from them in
+/// long double (Hairer & Wanner, Solving ODEs II, IV.5 (5.3)-(5.4) and IV.8; Hairer &
+/// Wanner, J. Comput. Appl. Math. 111 (1999) 93-111, section 5).
 #pragma once
 
 #include <Eigen/Core>

@@ -1,12 +1,13 @@
-// Radau IIA of orders 5, 9 and 13 (3, 5 and 7 stages) for the engine's implicit DAEs
-// F(t, y, y') = 0, at a fixed order or with the order chosen step by step: simplified
-// Newton on the collocation equations with the matrix transformed into one real and
-// (s-1)/2 complex systems, a stiffly filtered embedded error estimate, the predictive
-// (Gustafsson) step-size controller and continuous output from the collocation
-// polynomial. Written from the formulas of Hairer & Wanner, Solving Ordinary Differential
-// Equations II (2nd ed.), sections IV.5, IV.8, VI.1 and VII.4, and Hairer & Wanner,
-// J. Comput. Appl. Math. 111 (1999) 93-111 (the variable order); the method, the order
-// choice and what is reused between steps are described in docs/formulations.md.
+/// @file
+/// Radau IIA of orders 5, 9 and 13 (3, 5 and 7 stages) for the engine's implicit DAEs
+/// F(t, y, y') = 0, at a fixed order or with the order chosen step by step: simplified
+/// Newton on the collocation equations with the matrix transformed into one real and
+/// (s-1)/2 complex systems, a stiffly filtered embedded error estimate, the predictive
+/// (Gustafsson) step-size controller and continuous output from the collocation
+/// polynomial. Written from the formulas of Hairer & Wanner, Solving Ordinary Differential
+/// Equations II (2nd ed.), sections IV.5, IV.8, VI.1 and VII.4, and Hairer & Wanner,
+/// J. Comput. Appl. Math. 111 (1999) 93-111 (the variable order); the method, the order
+/// choice and what is reused between steps are described in docs/formulations.md.
 #pragma once
 
 #include <memory>

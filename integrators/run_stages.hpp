@@ -1,10 +1,11 @@
-// The stages of a run (simulate in integrators/simulation.cpp reads as their pipeline):
-//   start      the consistent initial state, the corrections it made, the first output;
-//   choose     the integrator's options (tolerances, BDF order limit, min step);
-//   integrate  output by output, handing IDA over to Radau IIA when it is trapped and
-//              crossing singular positions (integrators/singular_crossing.hpp);
-//   diagnose   the message of a run that stopped early;
-//   finish     the summary and its warnings.
+/// @file
+/// The stages of a run (simulate in integrators/simulation.cpp reads as their pipeline):
+///   start      the consistent initial state, the corrections it made, the first output;
+///   choose     the integrator's options (tolerances, BDF order limit, min step);
+///   integrate  output by output, handing IDA over to Radau IIA when it is trapped and
+///              crossing singular positions (integrators/singular_crossing.hpp);
+///   diagnose   the message of a run that stopped early;
+///   finish     the summary and its warnings.
 #pragma once
 
 #include <exception>

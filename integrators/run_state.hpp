@@ -1,7 +1,8 @@
-// What a run of simulate() holds while it advances, shared by its stages
-// (integrators/run_stages.hpp, integrators/singular_crossing.hpp): the output times, the
-// integrator running with the statistics of those it replaced, the progress line, and
-// the text formats of its messages.
+/// @file
+/// What a run of simulate() holds while it advances, shared by its stages
+/// (integrators/run_stages.hpp, integrators/singular_crossing.hpp): the output times, the
+/// integrator running with the statistics of those it replaced, the progress line, and
+/// the text formats of its messages.
 #pragma once
 
 #include <chrono>

@@ -1,6 +1,7 @@
-// Singular positions of a mechanism during a run: the diagnosis of a failure (is the
-// constraint Jacobian G losing rank?) and the crossing with the augmented Lagrangian
-// integrator ALI3-P, after which the DAE integrator restarts.
+/// @file
+/// Singular positions of a mechanism during a run: the diagnosis of a failure (is the
+/// constraint Jacobian G losing rank?) and the crossing with the augmented Lagrangian
+/// integrator ALI3-P, after which the DAE integrator restarts.
 #pragma once
 
 #include <optional>

@@ -1,4 +1,5 @@
-// Static equilibrium of a constrained system: Q(t, q, 0) = G^T lambda, g(q, t) = 0.
+/// @file
+/// Static equilibrium of a constrained system: Q(t, q, 0) = G^T lambda, g(q, t) = 0.
 #pragma once
 
 #include <vector>

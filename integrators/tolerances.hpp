@@ -1,8 +1,9 @@
-// Tolerances by coordinate class (issue 24): the defaults relative to the model's own
-// sizes, the override of rtol/atol that scales every class together (command line,
-// Python, C++), and the absolute tolerance of every unknown a run hands to its integrator.
-// docs/scene-format.md (Solver) and docs/formulations.md ("Tolerances by coordinate
-// class") state the rules key by key.
+/// @file
+/// Tolerances by coordinate class (issue 24): the defaults relative to the model's own
+/// sizes, the override of rtol/atol that scales every class together (command line,
+/// Python, C++), and the absolute tolerance of every unknown a run hands to its integrator.
+/// docs/scene-format.md (Solver) and docs/formulations.md ("Tolerances by coordinate
+/// class") state the rules key by key.
 #pragma once
 
 #include <optional>

@@ -1,7 +1,8 @@
-// Reader of a body exported from Abaqus: the input file (.inp: *Node, *Element, *Nset)
-// and the matrices written by *MATRIX GENERATE / *MATRIX OUTPUT, FORMAT=COORDINATE
-// (.mtx: lines "row column value", 1-based global DOF numbers, both triangles).
-// docs/fe-import.md.
+/// @file
+/// Reader of a body exported from Abaqus: the input file (.inp: *Node, *Element, *Nset)
+/// and the matrices written by *MATRIX GENERATE / *MATRIX OUTPUT, FORMAT=COORDINATE
+/// (.mtx: lines "row column value", 1-based global DOF numbers, both triangles).
+/// docs/fe-import.md.
 #pragma once
 
 #include <string>

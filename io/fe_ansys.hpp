@@ -1,8 +1,9 @@
-// Reader of a body exported from Ansys (Mechanical APDL): the mass and stiffness in
-// MatrixMarket coordinate form (as *EXPORT writes them, "real symmetric": the lower
-// triangle), the DOF mapping vector (MatrixMarket array: for each matrix node, in matrix
-// order, its node number), and the nodal coordinates and elements as tab-separated tables
-// with one header line (Mechanical's export; decimal comma accepted). docs/fe-import.md.
+/// @file
+/// Reader of a body exported from Ansys (Mechanical APDL): the mass and stiffness in
+/// MatrixMarket coordinate form (as *EXPORT writes them, "real symmetric": the lower
+/// triangle), the DOF mapping vector (MatrixMarket array: for each matrix node, in matrix
+/// order, its node number), and the nodal coordinates and elements as tab-separated tables
+/// with one header line (Mechanical's export; decimal comma accepted). docs/fe-import.md.
 #pragma once
 
 #include <string>

@@ -1,7 +1,8 @@
-// The scene object of a flexible body imported from a finite element code ("type":
-// "fe_body", docs/scene-format.md "FE bodies"; docs/fe-import.md): which export to read
-// ("abaqus", "ansys" or "calculix" files, relative to the scene file's folder), and the reduction
-// options of FeBodyModel (modes, stiffness scale, modal damping, point masses).
+/// @file
+/// The scene object of a flexible body imported from a finite element code ("type":
+/// "fe_body", docs/scene-format.md "FE bodies"; docs/fe-import.md): which export to read
+/// ("abaqus", "ansys" or "calculix" files, relative to the scene file's folder), and the reduction
+/// options of FeBodyModel (modes, stiffness scale, modal damping, point masses).
 #pragma once
 
 #include <string>

@@ -1,11 +1,12 @@
-// Reader of a body exported from CalculiX (ccx): the input deck (.inp, the Abaqus keyword
-// format: *NODE, *ELEMENT, *NSET) and the matrices that *FREQUENCY, SOLVER=MATRIXSTORAGE
-// writes: jobname.sti (stiffness) and jobname.mas (mass), lines "row column value" with
-// 1-based equation numbers, the upper triangle (row <= column) of the symmetric matrix,
-// and jobname.dof, line i "node.direction" (e.g. "12.3": node 12, z) naming what equation
-// i moves; a DOF held by *BOUNDARY has no equation. Also a reader of the nodal result
-// blocks of the .frd file (mode shapes DISP, stresses STRESS, ...). docs/fe-import.md,
-// "CalculiX".
+/// @file
+/// Reader of a body exported from CalculiX (ccx): the input deck (.inp, the Abaqus keyword
+/// format: *NODE, *ELEMENT, *NSET) and the matrices that *FREQUENCY, SOLVER=MATRIXSTORAGE
+/// writes: jobname.sti (stiffness) and jobname.mas (mass), lines "row column value" with
+/// 1-based equation numbers, the upper triangle (row <= column) of the symmetric matrix,
+/// and jobname.dof, line i "node.direction" (e.g. "12.3": node 12, z) naming what equation
+/// i moves; a DOF held by *BOUNDARY has no equation. Also a reader of the nodal result
+/// blocks of the .frd file (mode shapes DISP, stresses STRESS, ...). docs/fe-import.md,
+/// "CalculiX".
 #pragma once
 
 #include <map>

@@ -1,6 +1,7 @@
-// The mesh part of an input deck in the Abaqus keyword format, which Abaqus and CalculiX
-// share (io/fe_abaqus.hpp, io/fe_calculix.hpp): *Node, *Element (solid types), *Nset.
-// docs/fe-import.md.
+/// @file
+/// The mesh part of an input deck in the Abaqus keyword format, which Abaqus and CalculiX
+/// share (io/fe_abaqus.hpp, io/fe_calculix.hpp): *Node, *Element (solid types), *Nset.
+/// docs/fe-import.md.
 #pragma once
 
 #include <string>

@@ -1,7 +1,8 @@
-// What the readers of finite element exports (io/fe_abaqus.hpp, io/fe_ansys.hpp) share:
-// a text file read line by line whose errors name the file and the line, number fields,
-// the sparse symmetric matrices (coordinate entries, checked for symmetry and duplicates)
-// and the checks of the assembled body data. docs/fe-import.md.
+/// @file
+/// What the readers of finite element exports (io/fe_abaqus.hpp, io/fe_ansys.hpp) share:
+/// a text file read line by line whose errors name the file and the line, number fields,
+/// the sparse symmetric matrices (coordinate entries, checked for symmetry and duplicates)
+/// and the checks of the assembled body data. docs/fe-import.md.
 #pragma once
 
 #include <fstream>

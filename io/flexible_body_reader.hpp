@@ -1,9 +1,10 @@
-// What the planar (io/scene.cpp) and spatial (io/spatial_scene.cpp) scene readers share
-// for flexible bodies (docs/scene-format.md): the body's type and name, the mesh ("beam"
-// or "nodes" and "elements"), the beam-model keys ("reference", "modes", "reduction" with
-// "interface_nodes", "inertia_modes", "geometric_stiffening", "beam_theory"; each
-// reader's key list says which a body accepts), the initial elastic state and the sized
-// matrices of "flexible_invariants" bodies.
+/// @file
+/// What the planar (io/scene.cpp) and spatial (io/spatial_scene.cpp) scene readers share
+/// for flexible bodies (docs/scene-format.md): the body's type and name, the mesh ("beam"
+/// or "nodes" and "elements"), the beam-model keys ("reference", "modes", "reduction" with
+/// "interface_nodes", "inertia_modes", "geometric_stiffening", "beam_theory"; each
+/// reader's key list says which a body accepts), the initial elastic state and the sized
+/// matrices of "flexible_invariants" bodies.
 #pragma once
 
 #include <string>

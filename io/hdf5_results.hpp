@@ -1,9 +1,10 @@
-// Results as HDF5 (flexmbd run --format hdf5): DIR/results.h5 with
-//   /columns  1-D dataset of variable-length UTF-8 strings: the column names, in order,
-//             the same as the header of results.csv;
-//   /results  2-D dataset of float64, rows x columns, chunked and extendible: one row per
-//             output time, appended as the run goes.
-// The HDF5 C API stays in hdf5_results.cpp (a private dependency of the library).
+/// @file
+/// Results as HDF5 (flexmbd run --format hdf5): DIR/results.h5 with
+///   /columns  1-D dataset of variable-length UTF-8 strings: the column names, in order,
+///             the same as the header of results.csv;
+///   /results  2-D dataset of float64, rows x columns, chunked and extendible: one row per
+///             output time, appended as the run goes.
+/// The HDF5 C API stays in hdf5_results.cpp (a private dependency of the library).
 #pragma once
 
 #include <cstdint>

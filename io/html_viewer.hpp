@@ -1,7 +1,8 @@
-// The browser viewer (`flexmbd view`): one self-contained HTML page (three.js, the
-// viewer's script and the data compiled in) that animates drawings of a system
-// (io/system_drawing.hpp) with plots of results columns. It works offline from a file://
-// URL. The data's format is docs/viewer.md, "The page's data".
+/// @file
+/// The browser viewer (`flexmbd view`): one self-contained HTML page (three.js, the
+/// viewer's script and the data compiled in) that animates drawings of a system
+/// (io/system_drawing.hpp) with plots of results columns. It works offline from a file://
+/// URL. The data's format is docs/viewer.md, "The page's data".
 #pragma once
 
 #include <filesystem>

@@ -1,6 +1,7 @@
-// The strict JSON reading shared by every scene format (multibody, kinematics,
-// tensegrity): typed, checked access to the keys of one object, one-line errors
-// "<location>: <what is wrong>, got <what was found>", and the time-law objects.
+/// @file
+/// The strict JSON reading shared by every scene format (multibody, kinematics,
+/// tensegrity): typed, checked access to the keys of one object, one-line errors
+/// "<location>: <what is wrong>, got <what was found>", and the time-law objects.
 #pragma once
 
 #include <algorithm>
@@ -181,7 +182,7 @@ inline std::string shownName(const std::string& name) {
   return json(shorten(name)).dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
-/// @throws InputError "<where>: key "<key>": the name "a,b" has the character ',' at
+/// @throws InputError "\<where\>: key "\<key\>": the name "a,b" has the character ',' at
 /// position 2 (names are 1 to 64 characters, ...)" if `name` breaks the rule.
 inline void checkName(const std::string& name, const std::string& key, const std::string& where) {
   const std::string problem = nameProblem(name);

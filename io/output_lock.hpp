@@ -1,5 +1,6 @@
-// The lock of an output folder: one run at a time writes into a --out DIR, so that nothing
-// a run leaves (results, summary, frames) mixes two runs (issue 26, item 4).
+/// @file
+/// The lock of an output folder: one run at a time writes into a --out DIR, so that nothing
+/// a run leaves (results, summary, frames) mixes two runs (issue 26, item 4).
 #pragma once
 
 #include <filesystem>

@@ -1,5 +1,6 @@
-// A run's results read back (results.csv or results.h5 of `flexmbd run`): the viewer and
-// other commands that work on a finished run.
+/// @file
+/// A run's results read back (results.csv or results.h5 of `flexmbd run`): the viewer and
+/// other commands that work on a finished run.
 #pragma once
 
 #include <filesystem>

@@ -1,6 +1,7 @@
-// Results of a run: DIR/results.csv, or DIR/results.h5 with --format hdf5 (one row per
-// output time, written as the run goes) and DIR/summary.json (status and statistics,
-// written at the end).
+/// @file
+/// Results of a run: DIR/results.csv, or DIR/results.h5 with --format hdf5 (one row per
+/// output time, written as the run goes) and DIR/summary.json (status and statistics,
+/// written at the end).
 #pragma once
 
 #include <filesystem>
@@ -136,7 +137,7 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
 /// cpu_seconds, max_position_violation, max_velocity_violation, energy_start and
 /// energy_end (null when absent), formulation, linear_solver ("dense"/"klu"), rtol,
 /// atol, atol_velocity (the one used), tolerances (per class and the model scales of
-/// their defaults, SimulationSummary::tolerances and ::scales; null if the run failed
+/// their defaults, SimulationSummary::tolerances and SimulationSummary::scales; null if the run failed
 /// before it started), t_start, t_end, output_step, scene (the scene name), and
 /// scene_file (the absolute path of the scene file, when `sceneFile` is given: `flexmbd
 /// view` reads the scene from it).

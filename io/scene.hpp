@@ -1,6 +1,7 @@
-// Scene files: a JSON description of a model, its solver settings and extra outputs,
-// read strictly (unknown keys, missing keys, wrong types and out-of-range numbers are
-// errors that name their location). The format is documented in docs/scene-format.md.
+/// @file
+/// Scene files: a JSON description of a model, its solver settings and extra outputs,
+/// read strictly (unknown keys, missing keys, wrong types and out-of-range numbers are
+/// errors that name their location). The format is documented in docs/scene-format.md.
 #pragma once
 
 #include <string>
@@ -14,15 +15,18 @@
 
 namespace flexmbd {
 
-/// An extra quantity written to results.csv at every output time.
+/// An extra quantity written to results.csv at every output time: one object of a
+/// scene's "outputs" (parseOutputRequest). columnNames() names its columns and
+/// evaluate() gives their values at a state (of an OutputSample, for example).
 struct OutputRequest {
+  /// The kind of quantity, the scene's "type" key.
   enum class Type {
     Point,   ///< world position and velocity of a body point
     Energy,  ///< kinetic, potential and total energy of the system
     Deflection,  ///< elastic displacement (body frame) and section forces at a beam point
     Stress,      ///< stress components and von Mises at a node of an fe_body with "stresses"
   };
-  Type type = Type::Point;
+  Type type = Type::Point;     ///< which quantity; the members below apply to the kinds they name
   std::string name;            ///< Point: prefix of the columns
   std::string bodyName;        ///< Point: the body the point belongs to
   BodyIndex body;              ///< Point: index of that body in the System
@@ -50,12 +54,14 @@ struct OutputRequest {
   std::vector<double> evaluate(const System& sys, const VecX& q, const VecX& v) const;
 };
 
-/// A model ready to run. System is move-only, so a Scene is too.
+/// A model ready to run, planar or spatial ("dimension": 3), as loadScene() reads it
+/// from a scene file: run it with simulate(scene.system, scene.solver, ...) and evaluate
+/// `outputs` at each OutputSample. System is move-only, so a Scene is too.
 struct Scene {
-  std::string name;
-  System system;  ///< finalized
-  SolverSettings solver;
-  std::vector<OutputRequest> outputs;
+  std::string name;       ///< the scene's "name" (results' summary.json)
+  System system;          ///< the model, finalized
+  SolverSettings solver;  ///< the scene's "solver" object (defaults for the keys it omits)
+  std::vector<OutputRequest> outputs;  ///< the scene's "outputs", in order
   std::vector<BodyGeometry> geometry;  ///< the rigid bodies' "geometry" (viewing only)
   std::vector<FeBodyDrawing> feBodies;  ///< the fe_bodies' surfaces and stress shapes
 };

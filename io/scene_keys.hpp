@@ -1,9 +1,10 @@
-// The keys every scene reader accepts, per kind of object: the one list that the
-// readers (io/scene.cpp, io/json_reader.cpp, linkage/kinematics_scene.cpp,
-// tensegrity/tensegrity_scene.cpp) pass to ObjectReader::allowOnly, and that
-// tests/test_docs_keys.cpp compares, both ways, with the key tables of
-// docs/scene-format.md (a table tagged `<!-- keys: ID ... -->` documents the keys of
-// the objects ID; an object's keys are the union of the tables tagged with it).
+/// @file
+/// The keys every scene reader accepts, per kind of object: the one list that the
+/// readers (io/scene.cpp, io/json_reader.cpp, linkage/kinematics_scene.cpp,
+/// tensegrity/tensegrity_scene.cpp) pass to ObjectReader::allowOnly, and that
+/// tests/test_docs_keys.cpp compares, both ways, with the key tables of
+/// docs/scene-format.md (a table tagged `<!-- keys: ID ... -->` documents the keys of
+/// the objects ID; an object's keys are the union of the tables tagged with it).
 #pragma once
 
 #include <string>

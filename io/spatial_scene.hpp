@@ -1,6 +1,7 @@
-// Readers of the objects of spatial scenes ("dimension": 3): rigid bodies with
-// orientations, joints as frame pairs, their drivers and the spatial force elements
-// (docs/scene-format.md, "Spatial scenes"). Called by io/scene.cpp.
+/// @file
+/// Readers of the objects of spatial scenes ("dimension": 3): rigid bodies with
+/// orientations, joints as frame pairs, their drivers and the spatial force elements
+/// (docs/scene-format.md, "Spatial scenes"). Called by io/scene.cpp.
 #pragma once
 
 #include <array>

@@ -1,7 +1,8 @@
-// What a multibody system looks like at a state: every body as points, poly-lines and
-// polygons with the quantities drawn on them, and every joint as a point (and axis). One
-// place for the geometry that the VTK frames (io/vtk_writer.hpp) and the browser viewer
-// (io/html_viewer.hpp) draw.
+/// @file
+/// What a multibody system looks like at a state: every body as points, poly-lines and
+/// polygons with the quantities drawn on them, and every joint as a point (and axis). One
+/// place for the geometry that the VTK frames (io/vtk_writer.hpp) and the browser viewer
+/// (io/html_viewer.hpp) draw.
 #pragma once
 
 #include <string>

@@ -1,5 +1,6 @@
-// The browser viewer's assets, compiled in (cmake/embed_viewer_assets.cmake): the page
-// `flexmbd view` writes works offline from a file:// URL, with nothing installed.
+/// @file
+/// The browser viewer's assets, compiled in (cmake/embed_viewer_assets.cmake): the page
+/// `flexmbd view` writes works offline from a file:// URL, with nothing installed.
 #pragma once
 
 #include <string>

@@ -1,8 +1,9 @@
-// VTK output for ParaView: one .vtu (unstructured grid, ASCII XML) per output time and
-// a .pvd collection, written as the run goes (a failed run keeps what was written).
-// Every .vtu names what it draws: a FieldData string array "body_names" (one entry per
-// body drawn, in the order of the CellData "body_index" of its cells; ParaView shows it
-// in the Information panel and the spreadsheet view), repeated in an XML comment.
+/// @file
+/// VTK output for ParaView: one .vtu (unstructured grid, ASCII XML) per output time and
+/// a .pvd collection, written as the run goes (a failed run keeps what was written).
+/// Every .vtu names what it draws: a FieldData string array "body_names" (one entry per
+/// body drawn, in the order of the CellData "body_index" of its cells; ParaView shows it
+/// in the Information panel and the spreadsheet view), repeated in an XML comment.
 #pragma once
 
 #include <filesystem>

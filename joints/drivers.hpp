@@ -1,4 +1,5 @@
-// Drivers: rheonomic constraints h(q) - f(t) = 0 that prescribe a motion in time.
+/// @file
+/// Drivers: rheonomic constraints h(q) - f(t) = 0 that prescribe a motion in time.
 #pragma once
 
 #include "core/errors.hpp"

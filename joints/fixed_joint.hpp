@@ -1,4 +1,5 @@
-// Fixed joint (weld): the points coincide and the relative angle stays at its reference.
+/// @file
+/// Fixed joint (weld): the points coincide and the relative angle stays at its reference.
 #pragma once
 
 #include "joints/point_pair.hpp"

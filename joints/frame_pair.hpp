@@ -1,9 +1,10 @@
-// Relative kinematics of two body frames and the three scalar primitives spatial joints
-// and drivers are written in (Haug 1989, ch. 9): with d = r_j - r_i,
-//   gap(k)        = e_k . d        (world axis k)
-//   axisGap(a)    = x_a^i . d      (along axis a of frame i)
-//   axisAxis(a,b) = x_a^i . x_b^j  (axes of the two frames)
-// each with its velocity gradient (1 x nv) and its H = d(G^T)/dq (nv x nq).
+/// @file
+/// Relative kinematics of two body frames and the three scalar primitives spatial joints
+/// and drivers are written in (Haug 1989, ch. 9): with d = r_j - r_i,
+///   gap(k)        = e_k . d        (world axis k)
+///   axisGap(a)    = x_a^i . d      (along axis a of frame i)
+///   axisAxis(a,b) = x_a^i . x_b^j  (axes of the two frames)
+/// each with its velocity gradient (1 x nv) and its H = d(G^T)/dq (nv x nq).
 #pragma once
 
 #include "core/constraint.hpp"

@@ -1,7 +1,8 @@
-// The relative coordinates of spatial joints and their rates, for results tables
-// (docs/results.md, "Joint columns"; sign conventions in docs/spatial.md, "Joint
-// outputs"): what a joint lets move, measured as frame J relative to frame I in frame
-// I's axes.
+/// @file
+/// The relative coordinates of spatial joints and their rates, for results tables
+/// (docs/results.md, "Joint columns"; sign conventions in docs/spatial.md, "Joint
+/// outputs"): what a joint lets move, measured as frame J relative to frame I in frame
+/// I's axes.
 #pragma once
 
 #include <string>

@@ -1,4 +1,5 @@
-// Relative kinematics of two body points: the building block of every planar joint.
+/// @file
+/// Relative kinematics of two body points: the building block of every planar joint.
 #pragma once
 
 #include <vector>

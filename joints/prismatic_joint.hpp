@@ -1,4 +1,5 @@
-// Prismatic joint: point j slides along an axis fixed in body i; relative rotation locked.
+/// @file
+/// Prismatic joint: point j slides along an axis fixed in body i; relative rotation locked.
 #pragma once
 
 #include "joints/point_pair.hpp"

@@ -1,4 +1,5 @@
-// Revolute joint: point i of body i and point j of body j coincide.
+/// @file
+/// Revolute joint: point i of body i and point j of body j coincide.
 #pragma once
 
 #include "joints/point_pair.hpp"

@@ -1,5 +1,6 @@
-// Drivers of spatial joints: the angle of a revolute (or cylindrical) joint and the
-// displacement of a prismatic (or cylindrical) joint, prescribed by a time law.
+/// @file
+/// Drivers of spatial joints: the angle of a revolute (or cylindrical) joint and the
+/// displacement of a prismatic (or cylindrical) joint, prescribed by a time law.
 #pragma once
 
 #include "joints/drivers.hpp"

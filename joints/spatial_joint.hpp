@@ -1,5 +1,6 @@
-// Spatial joints as a pair of frames plus the constrained directions: spherical, revolute,
-// prismatic, cylindrical, universal, fixed and planar (docs/spatial.md).
+/// @file
+/// Spatial joints as a pair of frames plus the constrained directions: spherical, revolute,
+/// prismatic, cylindrical, universal, fixed and planar (docs/spatial.md).
 #pragma once
 
 #include <vector>

@@ -1,11 +1,12 @@
-// Joint frames placed in the world: a joint given by a world point and world axes in the
-// initial configuration becomes one frame on each body, in body axes (docs/spatial.md,
-// "Joints placed in the world"). Used by the scene reader ("world" of a spatial joint)
-// and from C++:
-//   const JointFrame w = worldJointFrame(Vec3(0, 0, 1), Vec3::UnitY(), nullptr, "hinge");
-//   const auto [fi, fj] = jointFramesFromWorld(sys, crank, rod, w, "joint 'hinge'");
-//   sys.addConstraint(std::make_unique<SpatialJoint>("hinge", SpatialJointType::Revolute,
-//                                                    crank, fi, rod, fj));
+/// @file
+/// Joint frames placed in the world: a joint given by a world point and world axes in the
+/// initial configuration becomes one frame on each body, in body axes (docs/spatial.md,
+/// "Joints placed in the world"). Used by the scene reader ("world" of a spatial joint)
+/// and from C++:
+///   const JointFrame w = worldJointFrame(Vec3(0, 0, 1), Vec3::UnitY(), nullptr, "hinge");
+///   const auto [fi, fj] = jointFramesFromWorld(sys, crank, rod, w, "joint 'hinge'");
+///   sys.addConstraint(std::make_unique<SpatialJoint>("hinge", SpatialJointType::Revolute,
+///                                                    crank, fi, rod, fj));
 #pragma once
 
 #include <array>

@@ -1,7 +1,8 @@
-// Kinematic analysis of a planar linkage by the deformation-parameter method of source
-// document 000 (Yamada & Tatsumi 1981, after van der Werff 1977): transfer functions,
-// Taylor predictor and Newton corrector on the exact deformation parameters, velocities
-// and accelerations, and detection of singular positions (lock, dead and change points).
+/// @file
+/// Kinematic analysis of a planar linkage by the deformation-parameter method of source
+/// document 000 (Yamada & Tatsumi 1981, after van der Werff 1977): transfer functions,
+/// Taylor predictor and Newton corrector on the exact deformation parameters, velocities
+/// and accelerations, and detection of singular positions (lock, dead and change points).
 #pragma once
 
 #include <functional>

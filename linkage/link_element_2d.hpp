@@ -1,5 +1,6 @@
-// Planar rigid link element of the deformation-parameter formulation (source document
-// 000: Yamada & Tatsumi 1981, after K. van der Werff, CMAME 11 (1977) 1-18).
+/// @file
+/// Planar rigid link element of the deformation-parameter formulation (source document
+/// 000: Yamada & Tatsumi 1981, after K. van der Werff, CMAME 11 (1977) 1-18).
 #pragma once
 
 #include <string>

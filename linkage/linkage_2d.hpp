@@ -1,6 +1,7 @@
-// A planar linkage assembled from rigid link elements (source document 000): nodes
-// (fixed, free, or sliding along a line), links between them, and the prescribed
-// input coordinates. The model of the kinematic analysis (linkage/kinematic_analysis).
+/// @file
+/// A planar linkage assembled from rigid link elements (source document 000): nodes
+/// (fixed, free, or sliding along a line), links between them, and the prescribed
+/// input coordinates. The model of the kinematic analysis (linkage/kinematic_analysis).
 #pragma once
 
 #include <string>

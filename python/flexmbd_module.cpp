@@ -87,6 +87,12 @@ PYBIND11_MODULE(_flexmbd, m) {
   // ----- errors: the C++ types, the same messages ------------------------------------
   static py::exception<InputError> inputError(m, "InputError", PyExc_ValueError);
   static py::exception<ModelError> modelError(m, "ModelError", inputError.ptr());
+  inputError.attr("__doc__") =
+      "Invalid input (a scene key, an argument, a model that cannot be built): the engine's one-line message "
+      "naming its location. A ValueError.";
+  modelError.attr("__doc__") =
+      "A model the engine refuses as a whole (redundant or inconsistent constraints, masses too far apart): "
+      "an InputError.";
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -98,52 +104,59 @@ PYBIND11_MODULE(_flexmbd, m) {
   });
 
   // ----- indices, states, properties -----------------------------------------------------
-  py::class_<BodyIndex>(m, "BodyIndex")
-      .def_readonly("value", &BodyIndex::value)
+  py::class_<BodyIndex>(m, "BodyIndex", "The index of a body in its System (GROUND is body 0)")
+      .def_readonly("value", &BodyIndex::value, "the index as an int")
       .def("__repr__", [](const BodyIndex& b) { return "BodyIndex(" + std::to_string(b.value) + ")"; });
-  py::class_<ConstraintIndex>(m, "ConstraintIndex").def_readonly("value", &ConstraintIndex::value);
-  py::class_<ForceIndex>(m, "ForceIndex").def_readonly("value", &ForceIndex::value);
+  py::class_<ConstraintIndex>(m, "ConstraintIndex", "The index of a joint or driver in its System")
+      .def_readonly("value", &ConstraintIndex::value, "the index as an int");
+  py::class_<ForceIndex>(m, "ForceIndex", "The index of a force element in its System")
+      .def_readonly("value", &ForceIndex::value, "the index as an int");
   m.attr("GROUND") = kGround;
 
-  py::class_<FrameState2d>(m, "FrameState2d")
+  py::class_<FrameState2d>(m, "FrameState2d", "The state of a planar body frame (initial values of a body)")
       .def(py::init([](const Vec2& position, double angle, const Vec2& velocity, double angularVelocity) {
              return FrameState2d{position, angle, velocity, angularVelocity};
            }),
            py::arg("position") = Vec2::Zero(), py::arg("angle") = 0.0, py::arg("velocity") = Vec2::Zero(),
-           py::arg("angular_velocity") = 0.0)
-      .def_readwrite("position", &FrameState2d::position)
-      .def_readwrite("angle", &FrameState2d::angle)
-      .def_readwrite("velocity", &FrameState2d::velocity)
-      .def_readwrite("angular_velocity", &FrameState2d::angularVelocity);
-  py::class_<RigidBodyProperties>(m, "RigidBodyProperties")
+           py::arg("angular_velocity") = 0.0,
+           "Position (m) and velocity (m/s) of the frame origin, angle (rad) and angular velocity (rad/s)")
+      .def_readwrite("position", &FrameState2d::position, "origin of the frame (x, y), m")
+      .def_readwrite("angle", &FrameState2d::angle, "rad")
+      .def_readwrite("velocity", &FrameState2d::velocity, "velocity of the origin (m/s)")
+      .def_readwrite("angular_velocity", &FrameState2d::angularVelocity, "rad/s");
+  py::class_<RigidBodyProperties>(m, "RigidBodyProperties", "Mass and inertia of a planar rigid body (add_rigid_body)")
       .def(py::init([](double mass, double inertia, const Vec2& com) { return RigidBodyProperties{mass, inertia, com}; }),
-           py::arg("mass"), py::arg("inertia"), py::arg("com") = Vec2::Zero())
-      .def_readwrite("mass", &RigidBodyProperties::mass)
-      .def_readwrite("inertia", &RigidBodyProperties::inertia)
-      .def_readwrite("com", &RigidBodyProperties::com);
+           py::arg("mass"), py::arg("inertia"), py::arg("com") = Vec2::Zero(),
+           "Mass (kg), rotational inertia about the centre of mass (kg m^2), centre of mass in body axes (m)")
+      .def_readwrite("mass", &RigidBodyProperties::mass, "kg")
+      .def_readwrite("inertia", &RigidBodyProperties::inertia, "about the centre of mass (kg m^2)")
+      .def_readwrite("com", &RigidBodyProperties::com, "centre of mass, body axes (m)");
 
   // ----- time laws (core/time_law.hpp) ----------------------------------------------------
   // pybind11 holders cannot be shared_ptr<const T>: laws are held as shared_ptr<TimeLaw>
   // (Law) and handed to the engine as TimeLawPtr (immutable there).
-  py::class_<TimeLaw, Law>(m, "TimeLaw")
+  py::class_<TimeLaw, Law>(m, "TimeLaw", "A function of time f(t) with its derivatives, for drivers and loads (the *_law functions)")
       .def("__call__", [](const TimeLaw& law, double t) {
         const LawValue v = law.evaluate(t);
         return py::make_tuple(v.f, v.df, v.ddf);
       }, "(f, f', f'') at t")
-      .def_property_readonly("type_name", &TimeLaw::typeName);
-  m.def("constant_law", [](double v) { return mutableLaw(makeConstantLaw(v)); }, py::arg("value"));
+      .def_property_readonly("type_name", &TimeLaw::typeName, "the scene format's law type (\"constant\", ...)");
+  m.def("constant_law", [](double v) { return mutableLaw(makeConstantLaw(v)); }, py::arg("value"), "f(t) = value");
   m.def("constant_speed_law", [](double w, double a0) { return mutableLaw(makeConstantSpeedLaw(w, a0)); },
-        py::arg("speed"), py::arg("initial") = 0.0);
+        py::arg("speed"), py::arg("initial") = 0.0, "f(t) = initial + speed t");
   m.def("polynomial_law", [](std::vector<double> c) { return mutableLaw(makePolynomialLaw(std::move(c))); },
-        py::arg("coefficients"));
+        py::arg("coefficients"), "f(t) = c0 + c1 t + c2 t^2 + ... of the coefficients [c0, c1, ...]");
   m.def("harmonic_law",
         [](double a, double w, double phase, double offset) { return mutableLaw(makeHarmonicLaw(a, w, phase, offset)); },
-        py::arg("amplitude"), py::arg("omega"), py::arg("phase") = 0.0, py::arg("offset") = 0.0);
+        py::arg("amplitude"), py::arg("omega"), py::arg("phase") = 0.0, py::arg("offset") = 0.0,
+        "f(t) = offset + amplitude sin(omega t + phase)");
   m.def("spin_up_law", [](double w, double ramp, double a0) { return mutableLaw(makeSpinUpLaw(w, ramp, a0)); },
-        py::arg("speed"), py::arg("ramp_time"), py::arg("initial") = 0.0);
+        py::arg("speed"), py::arg("ramp_time"), py::arg("initial") = 0.0,
+        "An angle whose rate rises smoothly from 0 to speed over ramp_time, then constant");
   m.def("tabulated_law",
         [](std::vector<double> t, std::vector<double> v) { return mutableLaw(makeTabulatedLaw(std::move(t), std::move(v))); },
-        py::arg("times"), py::arg("values"));
+        py::arg("times"), py::arg("values"),
+        "A natural cubic spline through (times, values), times increasing; linear beyond the table");
   // ----- user functions (core/user_function.hpp; python/user_functions.hpp) ---------------
   m.def(
       "user_law",
@@ -199,7 +212,7 @@ PYBIND11_MODULE(_flexmbd, m) {
       "k (x - x0) + c xdot; derivative(t, x, xdot) -> (df/dx, df/dxdot), else central differences");
 
   // ----- flexible beams (bodies/ffr_beam_model.hpp) --------------------------------------
-  py::class_<BeamSection>(m, "BeamSection")
+  py::class_<BeamSection>(m, "BeamSection", "Cross-section and material of a planar beam")
       .def(py::init([](double area, double inertia, double E, double rho, double damping) {
              BeamSection s;
              s.area = area;
@@ -209,12 +222,13 @@ PYBIND11_MODULE(_flexmbd, m) {
              s.damping = damping;
              return s;
            }),
-           py::arg("area"), py::arg("inertia"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0)
-      .def_readwrite("area", &BeamSection::area)
-      .def_readwrite("inertia", &BeamSection::inertia)
-      .def_readwrite("youngs_modulus", &BeamSection::youngsModulus)
-      .def_readwrite("density", &BeamSection::density)
-      .def_readwrite("damping", &BeamSection::damping);
+           py::arg("area"), py::arg("inertia"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0,
+           "Area A (m^2), second moment of area I (m^4), E (Pa), density (kg/m^3), damping beta (s)")
+      .def_readwrite("area", &BeamSection::area, "A (m^2)")
+      .def_readwrite("inertia", &BeamSection::inertia, "second moment of area I (m^4)")
+      .def_readwrite("youngs_modulus", &BeamSection::youngsModulus, "Young's modulus E (Pa)")
+      .def_readwrite("density", &BeamSection::density, "rho (kg/m^3)")
+      .def_readwrite("damping", &BeamSection::damping, "stiffness-proportional damping beta (s): D = beta K");
   m.def(
       "rectangular_section",
       [](double width, double height, double E, double rho, double damping) {
@@ -222,8 +236,9 @@ PYBIND11_MODULE(_flexmbd, m) {
         s.damping = damping;
         return s;
       },
-      py::arg("width"), py::arg("height"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0);
-  py::class_<BeamMesh2d>(m, "BeamMesh2d")
+      py::arg("width"), py::arg("height"), py::arg("youngs_modulus"), py::arg("density"), py::arg("damping") = 0.0,
+      "A rectangular width x height section (bending about the axis parallel to the width), m, Pa, kg/m^3");
+  py::class_<BeamMesh2d>(m, "BeamMesh2d", "A planar beam mesh: nodes (body frame) and 2-node elements with their sections")
       .def(py::init([](const std::vector<Vec2>& nodes, const std::vector<std::pair<int, int>>& elements,
                        const BeamSection& section) {
              BeamMesh2d mesh;
@@ -231,18 +246,21 @@ PYBIND11_MODULE(_flexmbd, m) {
              for (const auto& [a, b] : elements) mesh.elements.push_back({a, b, section});
              return mesh;
            }),
-           py::arg("nodes"), py::arg("elements"), py::arg("section"))
+           py::arg("nodes"), py::arg("elements"), py::arg("section"),
+           "nodes [[x, y], ...] (body frame), elements [(i, j), ...] of one section")
       .def_static("straight", &BeamMesh2d::straight, py::arg("length"), py::arg("elements"), py::arg("section"),
-                  py::arg("origin") = Vec2::Zero())
-      .def_readonly("nodes", &BeamMesh2d::nodes);
-  py::enum_<ReferenceConditions::Type>(m, "Reference")
+                  py::arg("origin") = Vec2::Zero(), "A straight beam of equal elements along the body x axis from origin")
+      .def_readonly("nodes", &BeamMesh2d::nodes, "the nodes' positions (body frame, m)");
+  py::enum_<ReferenceConditions::Type>(m, "Reference",
+                                          "Reference conditions of a planar beam's body frame (default PINNED_PINNED)")
       .value("PINNED_PINNED", ReferenceConditions::Type::PinnedPinned)
       .value("CLAMPED", ReferenceConditions::Type::Clamped)
       .value("FREE_FREE", ReferenceConditions::Type::FreeFree);
-  py::enum_<ModalReduction>(m, "ModalReduction")
+  py::enum_<ModalReduction>(m, "ModalReduction", "How a beam model's modes are chosen: normal modes or Craig-Bampton")
       .value("NORMAL", ModalReduction::Normal)
       .value("CRAIG_BAMPTON", ModalReduction::CraigBampton);
-  py::class_<FfrBeamOptions>(m, "FfrBeamOptions")
+  py::class_<FfrBeamOptions>(m, "FfrBeamOptions",
+                              "Options of a planar beam model: reference conditions, modes kept, stiffening")
       .def(py::init([](ReferenceConditions::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
                        bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes) {
              FfrBeamOptions o;
@@ -260,24 +278,34 @@ PYBIND11_MODULE(_flexmbd, m) {
            py::arg("reference") = ReferenceConditions::Type::PinnedPinned, py::arg("node_a") = 0,
            py::arg("node_b") = -1, py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{},
            py::arg("geometric_stiffening") = false, py::arg("reduction") = ModalReduction::Normal,
-           py::arg("interface_nodes") = std::vector<int>{}, py::arg("inertia_modes") = false);
-  py::class_<FfrBeamModel, std::shared_ptr<FfrBeamModel>>(m, "FfrBeamModel")
+           py::arg("interface_nodes") = std::vector<int>{}, py::arg("inertia_modes") = false,
+           "reference conditions (pinned-pinned between node_a and node_b = last by default), modes (0: nodal), "
+           "mode_set, geometric stiffening, modal reduction (normal or Craig-Bampton with interface_nodes), "
+           "inertia modes");
+  py::class_<FfrBeamModel, std::shared_ptr<FfrBeamModel>>(
+      m, "FfrBeamModel", "A planar beam mesh as a floating-frame body model (add_flexible_body)")
       .def(py::init([](BeamMesh2d mesh, const FfrBeamOptions& o, const std::string& owner) {
              return std::make_shared<FfrBeamModel>(std::move(mesh), o, owner);
            }),
-           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model")
+           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model",
+           "The model of the mesh under the options; owner names it in messages")
       .def("natural_frequencies", &FfrBeamModel::naturalFrequencies, "rad/s, ascending (frame held fixed)")
-      .def_property_readonly("num_elastic", &FfrBeamModel::numElastic);
+      .def_property_readonly("num_elastic", &FfrBeamModel::numElastic, "number of elastic coordinates nf");
 
   // ----- the system and the builders (builders/planar_builders.hpp) --------------------
-  py::class_<System> systemClass(m, "System");
+  py::class_<System> systemClass(
+      m, "System",
+      "A multibody system, planar or spatial: bodies, joints, drivers and forces are added (add_*), then "
+      "finalize() freezes it. Body 0 is the ground (GROUND or \"ground\"). Bodies and joints are given by "
+      "name or index.");
   systemClass
       .def(
           "add_rigid_body",
           [](System& s, const std::string& name, const RigidBodyProperties& p, const FrameState2d& init) {
             return addRigidBody(s, name, p, init);
           },
-          py::arg("name"), py::arg("properties"), py::arg("initial") = FrameState2d{})
+          py::arg("name"), py::arg("properties"), py::arg("initial") = FrameState2d{},
+          "A planar rigid body (RigidBodyProperties, FrameState2d): its BodyIndex")
       .def(
           "add_flexible_body",
           [](System& s, const std::string& name, std::shared_ptr<FfrBeamModel> model, const FrameState2d& init,
@@ -290,25 +318,30 @@ PYBIND11_MODULE(_flexmbd, m) {
             return s.addBody(std::move(b));
           },
           py::arg("name"), py::arg("model"), py::arg("initial") = FrameState2d{},
-          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none())
+          py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none(),
+          "A planar FFR body of a beam model (FfrBeamModel), with its initial frame state and elastic "
+          "coordinates and rates (None: zero): its BodyIndex")
       .def(
           "add_revolute_joint",
           [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj) {
             return addRevoluteJoint(s, name, body(s, bi), pi, body(s, bj), pj);
           },
-          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"))
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
+          "A planar revolute joint: point_i of body_i coincides with point_j of body_j (body axes)")
       .def(
           "add_prismatic_joint",
           [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj,
              const Vec2& axis) { return addPrismaticJoint(s, name, body(s, bi), pi, body(s, bj), pj, axis); },
           py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
-          py::arg("axis"))
+          py::arg("axis"),
+          "A planar prismatic joint: point_j of body_j slides along axis (body_i axes) through point_i")
       .def(
           "add_fixed_joint",
           [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj) {
             return addFixedJoint(s, name, body(s, bi), pi, body(s, bj), pj);
           },
-          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"))
+          py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
+          "A planar fixed joint: the points coincide and the relative angle keeps its initial value")
       .def(
           "add_body_coordinate_driver",
           [](System& s, const std::string& name, py::object b, const std::string& coordinate, const py::object& law) {
@@ -316,7 +349,8 @@ PYBIND11_MODULE(_flexmbd, m) {
             if (!l) badArgument("add_body_coordinate_driver", "law", "a time law or a callable f(t)", law);
             return addBodyCoordinateDriver(s, name, body(s, b), coordinate, std::move(l));
           },
-          py::arg("name"), py::arg("body"), py::arg("coordinate"), py::arg("law"))
+          py::arg("name"), py::arg("body"), py::arg("coordinate"), py::arg("law"),
+          "Drives one coordinate of a body (\"x\", \"y\", \"theta\") by a time law")
       .def(
           "add_joint_driver",
           [](System& s, const std::string& name, py::object j, const py::object& law) {
@@ -324,7 +358,8 @@ PYBIND11_MODULE(_flexmbd, m) {
             if (!l) badArgument("add_joint_driver", "law", "a time law or a callable f(t)", law);
             return addJointDriver(s, name, joint(s, j), std::move(l));
           },
-          py::arg("name"), py::arg("joint"), py::arg("law"))
+          py::arg("name"), py::arg("joint"), py::arg("law"),
+          "Drives a planar joint (revolute: its relative angle, prismatic: its displacement) by a time law")
       .def(
           "add_spring_damper",
           [](System& s, const std::string& name, py::object bi, const Vec2& pi, py::object bj, const Vec2& pj,
@@ -339,7 +374,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("name"), py::arg("body_i"), py::arg("point_i"), py::arg("body_j"), py::arg("point_j"),
           py::arg("stiffness") = py::none(), py::arg("damping") = py::none(), py::arg("free_length") = py::none(),
           py::arg("law") = py::none(),
-          "stiffness (l - free_length) + damping ldot, or law: a user law f(t, l, ldot) (flexmbd.spring_law or a "
+          "A spring-damper between two body points: stiffness (N/m) (l - free_length) + damping (N s/m) ldot, or law: a user law f(t, l, ldot) (flexmbd.spring_law or a "
           "callable)")
       .def(
           "add_rotational_spring_damper",
@@ -355,7 +390,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           },
           py::arg("name"), py::arg("joint"), py::arg("stiffness") = py::none(), py::arg("damping") = py::none(),
           py::arg("free_angle") = py::none(), py::arg("law") = py::none(),
-          "stiffness (phi - free_angle) + damping phi_dot, or law: a user torque law tau(t, phi, phi_dot) "
+          "A torsional spring-damper on a planar revolute joint: stiffness (N m/rad) (phi - free_angle) + damping phi_dot, or law: a user torque law tau(t, phi, phi_dot) "
           "(flexmbd.spring_law or a callable)")
       .def(
           "add_applied_load",
@@ -381,14 +416,16 @@ PYBIND11_MODULE(_flexmbd, m) {
             s.setGravity(argumentAs<Vec3>(g, "set_gravity", "gravity", "2 numbers (planar) or 3 numbers (spatial)"));
           },
           py::arg("gravity"), "(gx, gy) for a planar model, (gx, gy, gz) for a spatial one (world axes)")
-      .def("find_body", &System::findBody, py::arg("name"))
-      .def("finalize", &System::finalize)
-      .def_property_readonly("is_finalized", &System::isFinalized)
-      .def_property_readonly("num_bodies", &System::numBodies)
-      .def_property_readonly("num_coordinates", [](const System& s) { return s.numCoordinates(); })
-      .def_property_readonly("num_velocities", [](const System& s) { return s.numVelocities(); })
-      .def("coordinate_names", &System::coordinateNames)
-      .def("initial_coordinates", &System::initialCoordinates)
+      .def("find_body", &System::findBody, py::arg("name"), "The BodyIndex of a body by name (InputError if none)")
+      .def("finalize", &System::finalize, "Freezes the model: numbers the coordinates and checks the attachments")
+      .def_property_readonly("is_finalized", &System::isFinalized, "True after finalize()")
+      .def_property_readonly("num_bodies", &System::numBodies, "number of bodies, the ground included")
+      .def_property_readonly("num_coordinates", [](const System& s) { return s.numCoordinates(); },
+                             "number of coordinates nq (after finalize())")
+      .def_property_readonly("num_velocities", [](const System& s) { return s.numVelocities(); },
+                             "number of velocities nv (after finalize())")
+      .def("coordinate_names", &System::coordinateNames, "\"crank.x\", ... for every coordinate, in order")
+      .def("initial_coordinates", &System::initialCoordinates, "The coordinates given at construction (nq)")
       .def(
           "coordinate_offset",
           [](const System& s, py::object b) {
@@ -406,14 +443,15 @@ PYBIND11_MODULE(_flexmbd, m) {
   bindSpatial(m, systemClass);
 
   // ----- solver settings (integrators/simulation.hpp) ------------------------------------
-  py::class_<SolverSettings>(m, "SolverSettings")
-      .def(py::init<>())
-      .def_readwrite("rtol", &SolverSettings::rtol)
-      .def_readwrite("atol", &SolverSettings::atol)
+  py::class_<SolverSettings>(m, "SolverSettings",
+                              "How a run integrates: the scene's \"solver\" object (docs/scene-format.md, \"Solver\")")
+      .def(py::init<>(), "The defaults of a scene that omits every solver key")
+      .def_readwrite("rtol", &SolverSettings::rtol, "relative tolerance")
+      .def_readwrite("atol", &SolverSettings::atol, "absolute tolerance of frame positions (m)")
       // class tolerances: None = the default relative to atol and the model's sizes
-      .def_readwrite("atol_angle", &SolverSettings::atolAngle)
-      .def_readwrite("atol_elastic", &SolverSettings::atolElastic)
-      .def_readwrite("atol_velocity", &SolverSettings::atolVelocity)
+      .def_readwrite("atol_angle", &SolverSettings::atolAngle, "absolute tolerance of angles (rad); None: atol / L")
+      .def_readwrite("atol_elastic", &SolverSettings::atolElastic, "absolute tolerance of elastic coordinates; None: atol")
+      .def_readwrite("atol_velocity", &SolverSettings::atolVelocity, "absolute tolerance of velocities (m/s); None: atol / (1 s)")
       .def(
           "override_tolerances",
           [](SolverSettings& s, std::optional<double> rtol, std::optional<double> atol) {
@@ -422,40 +460,45 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("rtol") = py::none(), py::arg("atol") = py::none(),
           "rtol and/or atol as the command line's --rtol/--atol: every absolute tolerance set is scaled by "
           "atol / self.atol (rtol alone: rtol / self.rtol), so the classes keep their ratios")
-      .def_readwrite("t_start", &SolverSettings::tStart)
-      .def_readwrite("t_end", &SolverSettings::tEnd)
-      .def_readwrite("output_step", &SolverSettings::outputStep)
-      .def_readwrite("max_step", &SolverSettings::maxStepSize)
-      .def_readwrite("max_steps", &SolverSettings::maxSteps)
-      .def_readwrite("max_total_steps", &SolverSettings::maxTotalSteps)
-      .def_readwrite("max_order", &SolverSettings::maxOrder)
-      .def_readwrite("initial_step", &SolverSettings::initialStepSize)
-      .def_readwrite("fd_jacobian", &SolverSettings::finiteDifferenceJacobian)
-      .def_readwrite("cross_singular", &SolverSettings::crossSingular)
+      .def_readwrite("t_start", &SolverSettings::tStart, "start time (s)")
+      .def_readwrite("t_end", &SolverSettings::tEnd, "end time (s)")
+      .def_readwrite("output_step", &SolverSettings::outputStep, "output interval (s)")
+      .def_readwrite("max_step", &SolverSettings::maxStepSize, "largest step (s); 0: no limit")
+      .def_readwrite("max_steps", &SolverSettings::maxSteps, "most steps per output interval")
+      .def_readwrite("max_total_steps", &SolverSettings::maxTotalSteps, "most steps of the whole run")
+      .def_readwrite("max_order", &SolverSettings::maxOrder, "highest BDF order (1..5)")
+      .def_readwrite("initial_step", &SolverSettings::initialStepSize, "first step tried (s); 0: the integrator's estimate")
+      .def_readwrite("fd_jacobian", &SolverSettings::finiteDifferenceJacobian, "iteration matrix by finite differences (dense IDA only)")
+      .def_readwrite("cross_singular", &SolverSettings::crossSingular, "cross singular positions with the augmented Lagrangian integrator")
       .def_property(
           "formulation", [](const SolverSettings& s) { return toString(s.formulation); },
-          [](SolverSettings& s, const std::string& f) { s.formulation = parseFormulation(f); })
+          [](SolverSettings& s, const std::string& f) { s.formulation = parseFormulation(f); },
+          "the DAE formulation by name (docs/formulations.md)")
       .def_property(
           "redundant_constraints", [](const SolverSettings& s) { return toString(s.redundantConstraints); },
-          [](SolverSettings& s, const std::string& r) { s.redundantConstraints = parseRedundantConstraints(r); })
+          [](SolverSettings& s, const std::string& r) { s.redundantConstraints = parseRedundantConstraints(r); },
+          "\"resolve\" (release dependent constraint equations) or \"refuse\"")
       .def_property(
           "integrator", [](const SolverSettings& s) { return toString(s.integrator); },
-          [](SolverSettings& s, const std::string& i) { s.integrator = parseIntegrator(i); })
-      .def("validate", &SolverSettings::validate);
+          [](SolverSettings& s, const std::string& i) { s.integrator = parseIntegrator(i); },
+          "the integrator by name (\"auto\": chosen from the model)")
+      .def("validate", &SolverSettings::validate, "InputError naming the setting that is out of range");
 
   // ----- scenes and runs -----------------------------------------------------------------
-  py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene")
+  py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", "The compiled scene behind flexmbd.Scene (use that class)")
       .def(py::init([](const std::string& name) {
              auto s = std::make_shared<Scene>();
              s->name = name;
              return s;
            }),
-           py::arg("name") = "")
-      .def_readwrite("name", &Scene::name)
-      .def_property_readonly("system", [](Scene& s) -> System& { return s.system; }, py::return_value_policy::reference_internal)
+           py::arg("name") = "", "An empty scene of that name")
+      .def_readwrite("name", &Scene::name, "the scene's name")
+      .def_property_readonly("system", [](Scene& s) -> System& { return s.system; }, py::return_value_policy::reference_internal,
+                             "the System")
       .def_property(
           "solver", [](Scene& s) -> SolverSettings& { return s.solver; },
-          [](Scene& s, const SolverSettings& v) { s.solver = v; }, py::return_value_policy::reference_internal)
+          [](Scene& s, const SolverSettings& v) { s.solver = v; }, py::return_value_policy::reference_internal,
+          "the SolverSettings")
       .def(
           "add_output_json",
           [](Scene& s, const std::string& text, bool spatial) {
@@ -463,7 +506,7 @@ PYBIND11_MODULE(_flexmbd, m) {
             const std::string where = "outputs[" + std::to_string(s.outputs.size()) + "]";
             s.outputs.push_back(parseOutputRequest(j, where, s.system, s.outputs, spatial, s.feBodies));
           },
-          py::arg("json"), py::arg("spatial") = false)
+          py::arg("json"), py::arg("spatial") = false, "Adds an output object of the scene format, given as JSON text")
       .def_property_readonly("output_columns", [](const Scene& s) {
         std::vector<std::string> c;
         for (const auto& o : s.outputs) {
@@ -471,7 +514,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           c.insert(c.end(), n.begin(), n.end());
         }
         return c;
-      })
+      }, "the columns the outputs add to the results")
       .def(
           "modes",
           [](Scene& s, int count, bool steady, std::optional<double> at) {
@@ -516,7 +559,7 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def_property_readonly("velocity_names", [](Scene& s) {
         if (!s.system.isFinalized()) s.system.finalize();
         return s.system.velocityNames();
-      })
+      }, "the velocities' names (finalizes the system)")
       .def(
           "_run",
           [](Scene& s, bool progress) {
@@ -656,7 +699,8 @@ PYBIND11_MODULE(_flexmbd, m) {
       [](const std::string& text, const std::string& source) {
         return std::make_shared<Scene>(parseSceneText(text, source));
       },
-      py::arg("text"), py::arg("source") = "<scene>");
+      py::arg("text"), py::arg("source") = "<scene>",
+      "A scene from its JSON text (source names it in messages): a compiled Scene (flexmbd.Scene wraps it)");
   m.def(
       "read_scene_file", [](const std::string& path) { return py::bytes(jsonread::readSceneFile(path)); },
       py::arg("path"),

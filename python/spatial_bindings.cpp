@@ -187,7 +187,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       },
       py::arg("quaternion"), "The rotation matrix of Euler parameters (e0, e1, e2, e3), normalised");
 
-  py::class_<FrameState3d>(m, "FrameState3d")
+  py::class_<FrameState3d>(m, "FrameState3d", "The state of a spatial body frame (initial values of a body)")
       .def(py::init([](const py::object& position, const py::object& orientation, const py::object& velocity,
                        const py::object& angularVelocity) {
              constexpr const char* fn = "FrameState3d";
@@ -202,12 +202,13 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            py::arg("velocity") = py::make_tuple(0, 0, 0), py::arg("angular_velocity") = py::make_tuple(0, 0, 0),
            "Initial state of a spatial body frame: position and velocity (world), orientation (a 3 x 3 rotation "
            "matrix, a quaternion (e0, e1, e2, e3) or an (axis, angle) pair), angular velocity (body axes)")
-      .def_readwrite("position", &FrameState3d::position)
-      .def_readwrite("orientation", &FrameState3d::orientation)
-      .def_readwrite("velocity", &FrameState3d::velocity)
-      .def_readwrite("angular_velocity", &FrameState3d::angularVelocity);
+      .def_readwrite("position", &FrameState3d::position, "origin of the frame, world axes (m)")
+      .def_readwrite("orientation", &FrameState3d::orientation, "rotation matrix from body to world axes")
+      .def_readwrite("velocity", &FrameState3d::velocity, "velocity of the origin, world axes (m/s)")
+      .def_readwrite("angular_velocity", &FrameState3d::angularVelocity, "angular velocity, body axes (rad/s)");
 
-  py::class_<RigidBody3dProperties>(m, "RigidBody3dProperties")
+  py::class_<RigidBody3dProperties>(m, "RigidBody3dProperties",
+                                            "Mass and inertia of a spatial rigid body (add_rigid_body_3d)")
       .def(py::init([](const py::object& mass, const py::object& inertia) {
              RigidBody3dProperties p;
              p.mass = positiveArg(mass, "RigidBody3dProperties", "mass");
@@ -216,11 +217,12 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            }),
            py::arg("mass"), py::arg("inertia"),
            "Mass (kg) and inertia about the centre of mass (body axes: 3 principal moments or a 3 x 3 tensor)")
-      .def_readwrite("mass", &RigidBody3dProperties::mass)
-      .def_readwrite("inertia", &RigidBody3dProperties::inertia);
+      .def_readwrite("mass", &RigidBody3dProperties::mass, "kg")
+      .def_readwrite("inertia", &RigidBody3dProperties::inertia, "3 x 3 inertia tensor about the centre of mass, body axes (kg m^2)");
 
   // ----- solid shapes (bodies/shape_inertia.hpp) -----------------------------------------------
-  py::class_<SolidShape>(m, "SolidShape")
+  py::class_<SolidShape>(m, "SolidShape",
+                          "A solid of simple shape (box, cylinder, tube, sphere): inertia from geometry")
       .def_static(
           "box",
           [](const py::object& size) {
@@ -240,7 +242,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             s.axis = axisIndexArg(axis, "SolidShape.cylinder");
             return s;
           },
-          py::arg("radius"), py::arg("length"), py::arg("axis") = "z")
+          py::arg("radius"), py::arg("length"), py::arg("axis") = "z",
+          "A solid cylinder of its radius and length along the body axis \"x\", \"y\" or \"z\", centred on the body frame")
       .def_static(
           "tube",
           [](const py::object& outer, const py::object& inner, const py::object& length, const py::object& axis) {
@@ -254,7 +257,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             s.axis = axisIndexArg(axis, fn);
             return s;
           },
-          py::arg("outer_radius"), py::arg("inner_radius"), py::arg("length"), py::arg("axis") = "z")
+          py::arg("outer_radius"), py::arg("inner_radius"), py::arg("length"), py::arg("axis") = "z",
+          "A tube (hollow cylinder) along the body axis \"x\", \"y\" or \"z\", centred on the body frame")
       .def_static(
           "sphere",
           [](const py::object& radius) {
@@ -263,8 +267,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             s.radius = positiveArg(radius, "SolidShape.sphere", "radius");
             return s;
           },
-          py::arg("radius"))
-      .def_property_readonly("volume", [](const SolidShape& s) { return shapeVolume(s); })
+          py::arg("radius"), "A solid sphere of its radius, centred on the body frame")
+      .def_property_readonly("volume", [](const SolidShape& s) { return shapeVolume(s); }, "the shape's volume (m^3)")
       .def_readwrite("offset", &SolidShape::offset, "the shape's centre in body axes (m)")
       .def_readwrite("orientation", &SolidShape::orientation, "the shape's axes in body axes (rotation matrix)")
       .def(
@@ -281,19 +285,19 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
     return mass.is_none() ? ShapePart{s, 0.0, positiveArg(density, fn, "density")}
                           : ShapePart{s, positiveArg(mass, fn, "mass"), 0.0};
   };
-  py::class_<ShapePart>(m, "ShapePart")
+  py::class_<ShapePart>(m, "ShapePart", "A shape of a body with its mass or density (composite_inertia, shape_properties)")
       .def(py::init([shapePart](const SolidShape& s, const py::object& mass, const py::object& density) {
              return shapePart(s, mass, density, "ShapePart");
            }),
            py::arg("shape"), py::arg("mass") = py::none(), py::arg("density") = py::none(),
            "One shape of a body with exactly one of its mass (kg) or density (kg/m^3)")
-      .def_readonly("shape", &ShapePart::shape)
-      .def_readonly("mass", &ShapePart::mass)
-      .def_readonly("density", &ShapePart::density);
-  py::class_<CompositeInertia>(m, "CompositeInertia")
-      .def_readonly("mass", &CompositeInertia::mass)
-      .def_readonly("centre_of_mass", &CompositeInertia::centreOfMass)
-      .def_readonly("inertia", &CompositeInertia::inertia);
+      .def_readonly("shape", &ShapePart::shape, "the SolidShape")
+      .def_readonly("mass", &ShapePart::mass, "kg, or 0 when the density is given")
+      .def_readonly("density", &ShapePart::density, "kg/m^3, or 0 when the mass is given");
+  py::class_<CompositeInertia>(m, "CompositeInertia", "Mass, centre of mass and inertia of several shapes together")
+      .def_readonly("mass", &CompositeInertia::mass, "kg")
+      .def_readonly("centre_of_mass", &CompositeInertia::centreOfMass, "body axes (m)")
+      .def_readonly("inertia", &CompositeInertia::inertia, "about the centre of mass, body axes (kg m^2)");
   m.def("composite_inertia", &compositeInertia, py::arg("parts"),
         "Mass, centre of mass and inertia about it (body axes) of several placed shapes");
   m.def(
@@ -305,13 +309,14 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       "RigidBody3dProperties of a body that is the shape: the mass given, or density x volume");
   m.def("shape_properties", py::overload_cast<const std::vector<ShapePart>&>(&shapeProperties), py::arg("parts"),
         "RigidBody3dProperties of a body made of several shapes whose centre of mass is the body origin");
-  m.def("shape_volume", &shapeVolume, py::arg("shape"));
+  m.def("shape_volume", &shapeVolume, py::arg("shape"), "The volume of a SolidShape (m^3)");
   m.def(
       "shape_inertia", [](const SolidShape& s, const py::object& mass) { return shapeInertia(s, positiveArg(mass, "shape_inertia", "mass")); },
-      py::arg("shape"), py::arg("mass"));
+      py::arg("shape"), py::arg("mass"),
+      "The 3 x 3 inertia tensor (kg m^2) of a shape of that mass about its centre, in body axes");
 
   // ----- joint frames (joints/frame_pair.hpp, joints/world_frames.hpp) -------------------------
-  py::class_<JointFrame>(m, "JointFrame")
+  py::class_<JointFrame>(m, "JointFrame", "A frame fixed in a body (or in the world) that a spatial joint or bushing connects")
       .def(py::init([](const py::object& point, const py::object& axis, const py::object& orientation) {
              constexpr const char* fn = "JointFrame";
              if (!axis.is_none() && !orientation.is_none()) throw InputError("JointFrame: give either axis or orientation, not both");
@@ -325,8 +330,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            py::arg("point") = py::make_tuple(0, 0, 0), py::arg("axis") = py::none(), py::arg("orientation") = py::none(),
            "A frame fixed in a body (body axes): origin point; z axis along axis (x: the body axis least aligned "
            "with it, made perpendicular), or the axes of a rotation (orientation), or the body axes")
-      .def_readwrite("point", &JointFrame::point)
-      .def_readwrite("axes", &JointFrame::axes);
+      .def_readwrite("point", &JointFrame::point, "origin (body or world axes, m)")
+      .def_readwrite("axes", &JointFrame::axes, "3 x 3 rotation matrix whose columns are the frame's x, y, z axes");
   m.def(
       "world_joint_frame",
       [](const py::object& point, const py::object& axis, const py::object& xAxis) {
@@ -338,7 +343,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       },
       py::arg("point"), py::arg("axis"), py::arg("x_axis") = py::none(),
       "A frame in world axes: origin point, z along axis, x along x_axis made perpendicular (C++ worldJointFrame)");
-  py::enum_<SpatialJointType>(m, "SpatialJointType")
+  py::enum_<SpatialJointType>(m, "SpatialJointType", "The kinds of spatial joint (add_spatial_joint; or their names as strings)")
       .value("SPHERICAL", SpatialJointType::Spherical)
       .value("REVOLUTE", SpatialJointType::Revolute)
       .value("PRISMATIC", SpatialJointType::Prismatic)
@@ -348,7 +353,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .value("PLANAR", SpatialJointType::Planar);
 
   // ----- spatial beams (elements/beam_section.hpp, bodies/ffr_beam_model_3d.hpp) -----------------
-  py::class_<BeamSection3d>(m, "BeamSection3d")
+  py::class_<BeamSection3d>(m, "BeamSection3d", "Cross-section and material of a spatial beam (section axes y, z: principal axes)")
       .def(py::init([](const py::object& area, const py::object& iy, const py::object& iz, const py::object& j,
                        const py::object& E, const py::object& G, const py::object& nu, const py::object& rho,
                        const py::object& damping, const py::object& kappaY, const py::object& kappaZ) {
@@ -370,16 +375,16 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(), py::arg("poisson_ratio") = py::none(),
            py::arg("density"), py::arg("damping") = 0.0, py::arg("shear_factor_y") = 0.0,
            py::arg("shear_factor_z") = 0.0)
-      .def_readwrite("area", &BeamSection3d::area)
-      .def_readwrite("inertia_y", &BeamSection3d::inertiaY)
-      .def_readwrite("inertia_z", &BeamSection3d::inertiaZ)
-      .def_readwrite("torsion_constant", &BeamSection3d::torsionConstant)
-      .def_readwrite("youngs_modulus", &BeamSection3d::youngsModulus)
-      .def_readwrite("shear_modulus", &BeamSection3d::shearModulus)
-      .def_readwrite("density", &BeamSection3d::density)
-      .def_readwrite("damping", &BeamSection3d::damping)
-      .def_readwrite("shear_factor_y", &BeamSection3d::shearFactorY)
-      .def_readwrite("shear_factor_z", &BeamSection3d::shearFactorZ);
+      .def_readwrite("area", &BeamSection3d::area, "A (m^2)")
+      .def_readwrite("inertia_y", &BeamSection3d::inertiaY, "Iy = int z^2 dA (m^4): bending in the x-z plane")
+      .def_readwrite("inertia_z", &BeamSection3d::inertiaZ, "Iz = int y^2 dA (m^4): bending in the x-y plane")
+      .def_readwrite("torsion_constant", &BeamSection3d::torsionConstant, "St Venant torsion constant J (m^4)")
+      .def_readwrite("youngs_modulus", &BeamSection3d::youngsModulus, "Young's modulus E (Pa)")
+      .def_readwrite("shear_modulus", &BeamSection3d::shearModulus, "G (Pa)")
+      .def_readwrite("density", &BeamSection3d::density, "rho (kg/m^3)")
+      .def_readwrite("damping", &BeamSection3d::damping, "stiffness-proportional damping beta (s): D = beta K")
+      .def_readwrite("shear_factor_y", &BeamSection3d::shearFactorY, "shear correction factor kappa_y (Timoshenko; 0: not given)")
+      .def_readwrite("shear_factor_z", &BeamSection3d::shearFactorZ, "shear correction factor kappa_z (Timoshenko; 0: not given)");
   m.def(
       "rectangular_section_3d",
       [](const py::object& w, const py::object& h, const py::object& E, const py::object& G, const py::object& nu,
@@ -403,8 +408,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                                  positiveArg(rho, fn, "density"), nonNegativeArg(damping, fn, "damping"));
       },
       py::arg("diameter"), py::arg("youngs_modulus"), py::arg("shear_modulus") = py::none(),
-      py::arg("poisson_ratio") = py::none(), py::arg("density"), py::arg("damping") = 0.0);
-  py::class_<BeamMesh3d>(m, "BeamMesh3d")
+      py::arg("poisson_ratio") = py::none(), py::arg("density"), py::arg("damping") = 0.0,
+      "A solid circular section of that diameter (m): E (Pa), G (Pa) or Poisson's ratio, density (kg/m^3)");
+  py::class_<BeamMesh3d>(m, "BeamMesh3d", "A spatial beam mesh: nodes (body frame) and 2-node elements with their sections")
       .def(py::init([](const std::vector<Vec3>& nodes, const std::vector<std::pair<int, int>>& elements,
                        const BeamSection3d& section, const py::object& yAxis) {
              BeamMesh3d mesh;
@@ -425,16 +431,18 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           },
           py::arg("length"), py::arg("elements"), py::arg("section"), py::arg("origin") = py::make_tuple(0, 0, 0),
           py::arg("y_axis") = py::make_tuple(0, 1, 0), "A straight beam along the body x axis from origin")
-      .def_readonly("nodes", &BeamMesh3d::nodes);
-  py::enum_<ReferenceConditions3d::Type>(m, "Reference3d")
+      .def_readonly("nodes", &BeamMesh3d::nodes, "the nodes' positions (body frame, m)");
+  py::enum_<ReferenceConditions3d::Type>(m, "Reference3d",
+                                            "Reference conditions of a spatial beam's body frame (default CLAMPED at node_a)")
       .value("CLAMPED", ReferenceConditions3d::Type::Clamped)
       .value("PINNED_PINNED", ReferenceConditions3d::Type::PinnedPinned)
       .value("FREE_FREE", ReferenceConditions3d::Type::FreeFree);
-  py::enum_<BeamTheory>(m, "BeamTheory")
+  py::enum_<BeamTheory>(m, "BeamTheory", "The beam theory of a spatial beam model (docs/spatial-flexible.md)")
       .value("EULER_BERNOULLI", BeamTheory::EulerBernoulli)
       .value("RAYLEIGH", BeamTheory::Rayleigh)
       .value("TIMOSHENKO", BeamTheory::Timoshenko);
-  py::class_<FfrBeamOptions3d>(m, "FfrBeamOptions3d")
+  py::class_<FfrBeamOptions3d>(m, "FfrBeamOptions3d",
+                                "Options of a spatial beam model: reference conditions, modes kept, stiffening, theory")
       .def(py::init([](ReferenceConditions3d::Type type, int nodeA, int nodeB, int modes, std::vector<int> modeSet,
                        bool stiffening, ModalReduction reduction, std::vector<int> interfaceNodes, bool inertiaModes,
                        BeamTheory theory) {
@@ -454,20 +462,24 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            py::arg("reference") = ReferenceConditions3d::Type::Clamped, py::arg("node_a") = 0, py::arg("node_b") = -1,
            py::arg("modes") = 0, py::arg("mode_set") = std::vector<int>{}, py::arg("geometric_stiffening") = false,
            py::arg("reduction") = ModalReduction::Normal, py::arg("interface_nodes") = std::vector<int>{},
-           py::arg("inertia_modes") = false, py::arg("theory") = BeamTheory::EulerBernoulli);
-  py::class_<FfrBeamModel3d, std::shared_ptr<FfrBeamModel3d>>(m, "FfrBeamModel3d")
+           py::arg("inertia_modes") = false, py::arg("theory") = BeamTheory::EulerBernoulli,
+           "reference conditions (clamped at node_a by default), modes (0: nodal), mode_set, geometric stiffening, "
+           "modal reduction (normal or Craig-Bampton with interface_nodes), inertia modes, beam theory");
+  py::class_<FfrBeamModel3d, std::shared_ptr<FfrBeamModel3d>>(
+      m, "FfrBeamModel3d", "A spatial beam mesh as a floating-frame body model (add_flexible_body_3d)")
       .def(py::init([](BeamMesh3d mesh, const FfrBeamOptions3d& o, const std::string& owner) {
              return std::make_shared<FfrBeamModel3d>(std::move(mesh), o, owner);
            }),
-           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model")
+           py::arg("mesh"), py::arg("options"), py::arg("owner") = "beam model",
+           "The model of the mesh under the options; owner names it in messages")
       .def("natural_frequencies", &FfrBeamModel3d::naturalFrequencies, "rad/s, ascending (frame held fixed)")
-      .def_property_readonly("num_elastic", &FfrBeamModel3d::numElastic)
+      .def_property_readonly("num_elastic", &FfrBeamModel3d::numElastic, "number of elastic coordinates nf")
       .def_property_readonly(
           "invariants", [](const FfrBeamModel3d& mdl) { return mdl.invariants(); },
           "A copy of the model's invariants (FfrInvariants3d), to change or to add as a body of its own");
 
   // ----- given invariants (bodies/ffr_invariants_3d.hpp): NumPy arrays in, sparse inside ----
-  py::class_<FfrPoint3d>(m, "FfrPoint3d")
+  py::class_<FfrPoint3d>(m, "FfrPoint3d", "An attachment point of given invariants (FfrInvariants3d.points)")
       .def(py::init([](const py::object& position, const py::object& shape, const py::object& rotationShape) {
              // converted to the fields' own 3 x nf types: a matrix of other rows is a
              // TypeError here (assigned as MatX it overran the field's memory)
@@ -480,9 +492,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            }),
            py::arg("position"), py::arg("shape"), py::arg("rotation_shape"),
            "An attachment point: undeformed position u0 (body axes), shape N (3 x nf), rotation shape (3 x nf)")
-      .def_readwrite("position", &FfrPoint3d::position)
-      .def_readwrite("shape", &FfrPoint3d::shape)
-      .def_readwrite("rotation_shape", &FfrPoint3d::rotationShape);
+      .def_readwrite("position", &FfrPoint3d::position, "undeformed position u0, body axes (m)")
+      .def_readwrite("shape", &FfrPoint3d::shape, "N, 3 x nf: displacement = N q_f")
+      .def_readwrite("rotation_shape", &FfrPoint3d::rotationShape, "Ntheta, 3 x nf: small rotation = Ntheta q_f");
   const auto sparseField = [](SpMat FfrInvariants3d::*field) {
     return std::make_pair([field](const FfrInvariants3d& v) { return MatX(v.*field); },
                           [field](FfrInvariants3d& v, const MatX& x) { v.*field = x.sparseView(); });
@@ -506,18 +518,19 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                               "The inertia and stiffness invariants of a spatial FFR body (docs/spatial-flexible.md); "
                               "matrices are NumPy arrays (kept sparse inside); checked when a body is added")
       .def(py::init<>())
-      .def_readwrite("mass", &FfrInvariants3d::mass)
-      .def_readwrite("first_moment", &FfrInvariants3d::firstMoment)
-      .def_readwrite("s_bar", &FfrInvariants3d::sBar)
-      .def_property("m_ff", mffGet, mffSet)
-      .def_property("k_ff", kffGet, kffSet)
-      .def_property("d_ff", dffGet, dffSet)
+      .def_readwrite("mass", &FfrInvariants3d::mass, "m = int rho dV (kg)")
+      .def_readwrite("first_moment", &FfrInvariants3d::firstMoment, "int rho u0 dV (kg m)")
+      .def_readwrite("s_bar", &FfrInvariants3d::sBar, "S-bar = int rho N dV (3 x nf)")
+      .def_property("m_ff", mffGet, mffSet, "m_ff = int rho N^T N dV (nf x nf)")
+      .def_property("k_ff", kffGet, kffSet, "stiffness under the reference conditions (nf x nf)")
+      .def_property("d_ff", dffGet, dffSet, "damping matrix (nf x nf)")
       // copies both ways, as the matrices: def_readwrite handed out references into the
       // vector, left dangling (a use after free) once the list was set again
       .def_property(
           "points", [](const FfrInvariants3d& v) { return v.points; },
-          [](FfrInvariants3d& v, const std::vector<FfrPoint3d>& x) { v.points = x; })
-      .def_readwrite("second_moment", &FfrInvariants3d::secondMoment)
+          [](FfrInvariants3d& v, const std::vector<FfrPoint3d>& x) { v.points = x; },
+          "the attachment points (FfrPoint3d), a copy")
+      .def_readwrite("second_moment", &FfrInvariants3d::secondMoment, "int rho u0 u0^T dV (3 x 3)")
       .def_property(
           "position_shape", [](const FfrInvariants3d& v) { return std::vector<MatX>(v.positionShape.begin(), v.positionShape.end()); },
           [](FfrInvariants3d& v, const std::vector<MatX>& x) {
@@ -526,23 +539,29 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
               throw InputError("FfrInvariants3d.position_shape: expected 3 matrices (x, y, z), 3 x nf each");
             }
             for (int k = 0; k < 3; ++k) v.positionShape[k] = x[k];
-          })
+          },
+          "3 matrices (x, y, z), 3 x nf: row l of k = int rho u0_k N_l dV")
       .def_property(
           "s_kl", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.sKL); },
-          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.sKL, x, "s_kl"); })
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.sKL, x, "s_kl"); },
+          "3 lists of 3 matrices: S_kl = int rho N_k^T N_l dV (nf x nf)")
       .def_property(
           "r_kl", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.rKL); },
-          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.rKL, x, "r_kl"); })
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.rKL, x, "r_kl"); },
+          "3 lists of 3 matrices R_kl: the sections' second-order rotation (empty: none)")
       .def_property(
           "h_i", [](const FfrInvariants3d& v) { return std::vector<MatX>{MatX(v.hI[0]), MatX(v.hI[1]), MatX(v.hI[2])}; },
           [](FfrInvariants3d& v, const std::vector<MatX>& x) {
             if (x.size() != 3) throw InputError("FfrInvariants3d.h_i: expected 3 matrices (x, y, z), nf x nf each");
             for (int k = 0; k < 3; ++k) v.hI[k] = x[k].sparseView();
-          })
+          },
+          "3 matrices H_i (nf x nf): coupling of the sections' second-order displacement (empty: none)")
       .def_property(
           "spin_stiffness", [pairsGet](const FfrInvariants3d& v) { return pairsGet(v.spinStiffness); },
-          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.spinStiffness, x, "spin_stiffness"); })
-      .def_property_readonly("num_elastic", [](const FfrInvariants3d& v) { return v.mff.rows(); })
+          [pairsSet](FfrInvariants3d& v, const Pairs& x) { pairsSet(v.spinStiffness, x, "spin_stiffness"); },
+          "3 lists of 3 matrices G_kl: geometric stiffness of a steady spin per w_k w_l (empty: none)")
+      .def_property_readonly("num_elastic", [](const FfrInvariants3d& v) { return v.mff.rows(); },
+                             "number of elastic coordinates nf")
       .def(
           "validate", [](const FfrInvariants3d& v, const std::string& owner) {
             v.validate(owner);
@@ -562,12 +581,12 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
 
   // ----- bodies from FE codes (bodies/fe_body_model.hpp, io/fe_abaqus.hpp, io/fe_ansys.hpp) ----
   py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
-      .def_property_readonly("num_nodes", &FeBodyData::numNodes)
-      .def_property_readonly("num_dofs", &FeBodyData::numDofs)
+      .def_property_readonly("num_nodes", &FeBodyData::numNodes, "number of nodes")
+      .def_property_readonly("num_dofs", &FeBodyData::numDofs, "number of degrees of freedom of M and K")
       .def_readonly("node_ids", &FeBodyData::nodeIds, "the FE code's node numbers")
-      .def_readonly("coordinates", &FeBodyData::coordinates)
+      .def_readonly("coordinates", &FeBodyData::coordinates, "undeformed node positions, in node order (m)")
       .def_readonly("node_sets", &FeBodyData::nodeSets, "node indices (not numbers), by set name")
-      .def_readonly("source", &FeBodyData::source);
+      .def_readonly("source", &FeBodyData::source, "the files read, for messages");
   m.def("read_abaqus_fe", &readAbaqusFe, py::arg("input"), py::arg("mass"), py::arg("stiffness"),
         "An Abaqus export: the .inp and the *MATRIX GENERATE mass and stiffness (.mtx); InputError names the file "
         "and line");
@@ -670,7 +689,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             return addRigidBody3d(s, name, props.cast<RigidBody3dProperties>(),
                                   init.is_none() ? FrameState3d{} : init.cast<FrameState3d>());
           },
-          py::arg("name"), py::arg("properties"), py::arg("initial") = py::none())
+          py::arg("name"), py::arg("properties"), py::arg("initial") = py::none(),
+          "A spatial rigid body (RigidBody3dProperties, FrameState3d; None: at rest at the origin): its BodyIndex")
       .def(
           "add_flexible_body_3d",
           [](System& s, const std::string& name, const py::object& model, const py::object& init,
@@ -731,7 +751,8 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             if (!l) badArgument(fn, "law", "a time law", law);
             return addJointAngleDriver(s, name, joint(s, j, fn, "joint"), l);
           },
-          py::arg("name"), py::arg("joint"), py::arg("law"))
+          py::arg("name"), py::arg("joint"), py::arg("law"),
+          "Drives the angle of a spatial revolute or cylindrical joint (name or index) by a time law (rad)")
       .def(
           "add_joint_displacement_driver",
           [](System& s, const std::string& name, const py::object& j, const py::object& law) {
@@ -740,11 +761,12 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             if (!l) badArgument(fn, "law", "a time law", law);
             return addJointDisplacementDriver(s, name, joint(s, j, fn, "joint"), l);
           },
-          py::arg("name"), py::arg("joint"), py::arg("law"))
+          py::arg("name"), py::arg("joint"), py::arg("law"),
+          "Drives the displacement of a spatial prismatic or cylindrical joint (name or index) by a time law (m)")
       .def(
           "initial_joint_angle",
           [](const System& s, const py::object& j) { return initialJointAngle(s, joint(s, j, "initial_joint_angle")); },
-          py::arg("joint"))
+          py::arg("joint"), "The angle of a spatial joint (name or index) at the initial coordinates (rad)")
       .def(
           "add_spatial_spring_damper",
           [](System& s, const std::string& name, const py::object& bi, const py::object& pi, const py::object& bj,
@@ -794,7 +816,9 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
                                      sixArg(c, fn, "damping"));
           },
           py::arg("name"), py::arg("body_i"), py::arg("frame_i"), py::arg("body_j"), py::arg("frame_j"),
-          py::arg("stiffness"), py::arg("damping") = py::none())
+          py::arg("stiffness"), py::arg("damping") = py::none(),
+          "A bushing between frame_i of body_i and frame_j of body_j: 6 stiffnesses and dampings (x, y, z, rx, ry, "
+          "rz; along and about frame_i's axes)")
       .def(
           "add_spatial_bushing_at_world",
           [](System& s, const std::string& name, const py::object& bi, const py::object& bj, const py::object& world,

@@ -1,6 +1,7 @@
-// Axially elastic bar (tensegrity strut) between two pin-joined nodes, in 2D or 3D.
-// Pure and const: the constant stiffness and mass are fixed at construction, the
-// geometric quantities are computed from the nodal positions passed in.
+/// @file
+/// Axially elastic bar (tensegrity strut) between two pin-joined nodes, in 2D or 3D.
+/// Pure and const: the constant stiffness and mass are fixed at construction, the
+/// geometric quantities are computed from the nodal positions passed in.
 #pragma once
 
 #include <Eigen/Core>

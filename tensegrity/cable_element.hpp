@@ -1,6 +1,7 @@
-// Tension-only cable between two nodes, in 2D or 3D. Massless. Either elastic with
-// stiffness EA (piecewise-linear law: no force when slack) or inextensible (its length
-// can never exceed the natural length; its tension is a multiplier of the time-stepper).
+/// @file
+/// Tension-only cable between two nodes, in 2D or 3D. Massless. Either elastic with
+/// stiffness EA (piecewise-linear law: no force when slack) or inextensible (its length
+/// can never exceed the natural length; its tension is a multiplier of the time-stepper).
 #pragma once
 
 #include <Eigen/Core>

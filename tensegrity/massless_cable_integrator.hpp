@@ -1,11 +1,12 @@
-// Method 2 of source document 001 (Tamba & Kanno): massless elastic cables. A cable
-// that snaps taut receives no impulse (v+ = v- when its mass m_c -> 0), so the motion
-// follows the smooth equations with the piecewise (tension-only) cable law
-//   M u'' = f(t) - g_struts(u) - sum_c b_c(u) tau_c(u),  tau_c = (EA/l0) max(l_c - l0, 0),
-// integrated as a first-order ODE y = [u_free, v_free] with CVODE. The switch functions
-// (l_c - l0)/l0 are CVODE root functions, so every slack/taut switch is located to the
-// solver's tolerance; the integration restarts at each switch (the force is only C0
-// there).
+/// @file
+/// Method 2 of source document 001 (Tamba & Kanno): massless elastic cables. A cable
+/// that snaps taut receives no impulse (v+ = v- when its mass m_c -> 0), so the motion
+/// follows the smooth equations with the piecewise (tension-only) cable law
+///   M u'' = f(t) - g_struts(u) - sum_c b_c(u) tau_c(u),  tau_c = (EA/l0) max(l_c - l0, 0),
+/// integrated as a first-order ODE y = [u_free, v_free] with CVODE. The switch functions
+/// (l_c - l0)/l0 are CVODE root functions, so every slack/taut switch is located to the
+/// solver's tolerance; the integration restarts at each switch (the force is only C0
+/// there).
 #pragma once
 
 #include "integrators/cvode_solver.hpp"

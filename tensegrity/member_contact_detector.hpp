@@ -1,7 +1,8 @@
-// Contact between tensegrity members (cylinders of given radius around their axes)
-// during a run: segment-segment closest points (tensegrity/segment_closest_points.hpp)
-// and a continuous check between two states, with the node positions moving linearly
-// in between, by conservative advancement. Members sharing a node are never checked.
+/// @file
+/// Contact between tensegrity members (cylinders of given radius around their axes)
+/// during a run: segment-segment closest points (tensegrity/segment_closest_points.hpp)
+/// and a continuous check between two states, with the node positions moving linearly
+/// in between, by conservative advancement. Members sharing a node are never checked.
 #pragma once
 
 #include <vector>

@@ -1,5 +1,6 @@
-// Closest points of two segments in 3D (planar segments: z = 0). The clamped
-// segment-segment algorithm of Ericson, "Real-Time Collision Detection" (2005), sec. 5.1.9.
+/// @file
+/// Closest points of two segments in 3D (planar segments: z = 0). The clamped
+/// segment-segment algorithm of Ericson, "Real-Time Collision Detection" (2005), sec. 5.1.9.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,9 +1,10 @@
-// Self-equilibrium of a tensegrity (source document 001, sec. 1; the force-density
-// method of Schek 1974 and Pellegrino & Calladine 1986): with force densities q_j =
-// t_j / l_j (tension positive), the equilibrium of the free node coordinates reads
-//   A q = f,   A[node i, member j] = x_i - x_k  (j joins i and k),
-// so self-stress states (f = 0) span the null space of the equilibrium matrix A,
-// computed with the SVD.
+/// @file
+/// Self-equilibrium of a tensegrity (source document 001, sec. 1; the force-density
+/// method of Schek 1974 and Pellegrino & Calladine 1986): with force densities q_j =
+/// t_j / l_j (tension positive), the equilibrium of the free node coordinates reads
+///   A q = f,   A[node i, member j] = x_i - x_k  (j joins i and k),
+/// so self-stress states (f = 0) span the null space of the equilibrium matrix A,
+/// computed with the SVD.
 #pragma once
 
 #include "tensegrity/tensegrity_structure.hpp"

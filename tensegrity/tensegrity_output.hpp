@@ -1,5 +1,6 @@
-// What the tensegrity integrators report: samples at output times, events (snaps,
-// slack and taut transitions, contacts) and a summary of the run.
+/// @file
+/// What the tensegrity integrators report: samples at output times, events (snaps,
+/// slack and taut transitions, contacts) and a summary of the run.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,6 +1,7 @@
-// Tensegrity scene files: JSON with top-level "model": "tensegrity", read strictly
-// (unknown keys, missing keys, wrong types and out-of-range numbers are errors naming
-// their location). Format: docs/tensegrity.md.
+/// @file
+/// Tensegrity scene files: JSON with top-level "model": "tensegrity", read strictly
+/// (unknown keys, missing keys, wrong types and out-of-range numbers are errors naming
+/// their location). Format: docs/tensegrity.md.
 #pragma once
 
 #include <memory>

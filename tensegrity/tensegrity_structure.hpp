@@ -1,13 +1,14 @@
-// A tensegrity (pin-jointed truss): point-mass nodes in 2D or 3D, struts (axially
-// elastic bars with their own mass), tension-only cables (elastic or inextensible),
-// fixed node coordinates, gravity and nodal loads with time laws. Tamba & Kanno,
-// source document 001 (docs/tensegrity.md).
-//
-// Build phase: add nodes and members, then finalize(); afterwards the structure is
-// frozen and its evaluations are pure functions of (t, x, v).
-// Coordinates: the full vector x has dimension() entries per node, node by node
-// ([x0, y0, (z0), x1, ...]); the free coordinates (not fixed) are the unknowns of the
-// integrators, in the order of freeCoordinates().
+/// @file
+/// A tensegrity (pin-jointed truss): point-mass nodes in 2D or 3D, struts (axially
+/// elastic bars with their own mass), tension-only cables (elastic or inextensible),
+/// fixed node coordinates, gravity and nodal loads with time laws. Tamba & Kanno,
+/// source document 001 (docs/tensegrity.md).
+///
+/// Build phase: add nodes and members, then finalize(); afterwards the structure is
+/// frozen and its evaluations are pure functions of (t, x, v).
+/// Coordinates: the full vector x has dimension() entries per node, node by node
+/// ([x0, y0, (z0), x1, ...]); the free coordinates (not fixed) are the unknowns of the
+/// integrators, in the order of freeCoordinates().
 #pragma once
 
 #include <string>

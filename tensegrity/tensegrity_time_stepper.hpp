@@ -1,18 +1,19 @@
-// Method 1 of source document 001 (Tamba & Kanno): inextensible cables, struts with
-// finite stiffness, nonsmooth time-stepping with one LCP per step (docs/tensegrity.md).
-//
-// Over [t_i, t_f], dt = t_f - t_i, with the midpoint u_m = u_i + v_i dt/2:
-//   M (v_f - v_i) = (f(t_m) - g(u_m)) dt - sum_{c in A} b_c(u_m) p_c
-//   w_c = -b_c(u_m)^T v_f >= 0,  p_c >= 0,  p_c w_c = 0          (c in A)
-//   u_f = u_m + v_f dt/2
-// where g is the elastic force of the struts (and of elastic cables), p_c the tension
-// impulse of cable c and A the cables at (or beyond) their natural length at u_m. The
-// LCP is  w = W p + q,  W = B M^-1 B^T,  q = -B v_free,  v_free = v_i + M^-1 (f - g) dt,
-// the KKT system of the document's QP  min 1/2 v^T M v + (-M v_i + ...)^T v  s.t. B v <= 0.
-// The mass matrix is constant here (point masses and bar masses do not depend on u),
-// so M^m = M. Position drift of taut cables (l > l0 at u_f) is removed by a projection,
-//   u <- u - M^-1 B^T lambda,  lambda >= 0,  l0 - l + W lambda >= 0, complementary,
-// iterated (Gauss-Newton) until the relative drift is below the projection tolerance.
+/// @file
+/// Method 1 of source document 001 (Tamba & Kanno): inextensible cables, struts with
+/// finite stiffness, nonsmooth time-stepping with one LCP per step (docs/tensegrity.md).
+///
+/// Over [t_i, t_f], dt = t_f - t_i, with the midpoint u_m = u_i + v_i dt/2:
+///   M (v_f - v_i) = (f(t_m) - g(u_m)) dt - sum_{c in A} b_c(u_m) p_c
+///   w_c = -b_c(u_m)^T v_f >= 0,  p_c >= 0,  p_c w_c = 0          (c in A)
+///   u_f = u_m + v_f dt/2
+/// where g is the elastic force of the struts (and of elastic cables), p_c the tension
+/// impulse of cable c and A the cables at (or beyond) their natural length at u_m. The
+/// LCP is  w = W p + q,  W = B M^-1 B^T,  q = -B v_free,  v_free = v_i + M^-1 (f - g) dt,
+/// the KKT system of the document's QP  min 1/2 v^T M v + (-M v_i + ...)^T v  s.t. B v <= 0.
+/// The mass matrix is constant here (point masses and bar masses do not depend on u),
+/// so M^m = M. Position drift of taut cables (l > l0 at u_f) is removed by a projection,
+///   u <- u - M^-1 B^T lambda,  lambda >= 0,  l0 - l + W lambda >= 0, complementary,
+/// iterated (Gauss-Newton) until the relative drift is below the projection tolerance.
 #pragma once
 
 #include <optional>

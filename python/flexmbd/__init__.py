@@ -110,14 +110,17 @@ class Results:
 
     @property
     def ok(self):
+        """True if the run reached t_end (summary status "ok")."""
         return self.summary["status"] == "ok"
 
     @property
     def message(self):
+        """The summary's message: "" or why the run stopped."""
         return self.summary["message"]
 
     @property
     def t(self):
+        """The output times (the first column, "t"), a NumPy array."""
         return self.data[:, 0]
 
     def __getitem__(self, column):
@@ -159,14 +162,17 @@ class Scene:
 
     @property
     def name(self):
+        """The scene's name (the scene file's "name")."""
         return self._native.name
 
     @property
     def system(self):
+        """The System: add bodies, joints, drivers and forces to it before run()."""
         return self._native.system
 
     @property
     def solver(self):
+        """The SolverSettings (t_end, output_step, rtol, ...), changed in place."""
         return self._native.solver
 
     def add_output(self, output, spatial=None):
@@ -192,6 +198,8 @@ class Scene:
 
     @property
     def velocity_names(self):
+        """The names of the system's velocities ("crank.theta_dot", ...), the order of a
+        mode shape's entries; finalizes the system."""
         return self._native.velocity_names
 
     def run(self, progress=False, raise_on_failure=True):

@@ -256,6 +256,8 @@ class Study:
         return []
 
     def overrides_of(self, point):
+        """The scene overrides of one point (a dict of axis name to value): the study's
+        fixed overrides with each axis's key set to the point's value."""
         o = dict(self.overrides)
         for a in self.axes:
             o[a["key"]] = point[a["name"]]
@@ -263,6 +265,7 @@ class Study:
 
     @property
     def columns(self):
+        """The columns of study.csv: point, the axes, status and message, the outputs."""
         return ["point"] + [a["name"] for a in self.axes] + FIXED_COLUMNS[1:] + self.output_names
 
 
@@ -287,6 +290,8 @@ def load_study(path):
 
 
 def output_names(outputs):
+    """The study.csv column names of a study's "outputs" object, in order: summary.KEY,
+    max_abs(COLUMN), max(...), min(...), final(...), the "at" names, the functions."""
     names = [f"summary.{k}" for k in outputs.get("summary", [])]
     for kind in ("max_abs", "max", "min", "final"):
         names += [f"{kind}({c})" for c in outputs.get(kind, [])]
@@ -375,10 +380,12 @@ class TableWriter:
         self.writer = csv.writer(self.file)
 
     def write(self, row):
+        """Appends one point's row (floats written exactly, repr) and flushes."""
         self.writer.writerow([repr(x) if isinstance(x, float) else x for x in row])
         self.file.flush()
 
     def close(self):
+        """Closes study.csv."""
         self.file.close()
 
 
@@ -393,6 +400,7 @@ class Progress:
         self.every = max(1, total // 10)
 
     def update(self, status):
+        """Counts one finished point of the given status ("ok" or a failure) and shows the line."""
         self.done += 1
         self.ran += 1
         self.failed += status != "ok"
@@ -408,6 +416,7 @@ class Progress:
         self.stream.flush()
 
     def finish(self):
+        """Ends the progress line (a newline on a terminal)."""
         if self.tty:
             self.stream.write("\n")
         self.stream.flush()
@@ -528,6 +537,8 @@ def plot(study, out_dir):
 
 
 def main(argv=None):
+    """The flexmbd-study command: runs the study file given in argv (default sys.argv)
+    into --out DIR; returns the exit status: 2 for an input error (named on stderr), else 0."""
     p = argparse.ArgumentParser(prog="flexmbd-study", description="Run a parameter study of a flexmbd scene.")
     p.add_argument("study", help="the study file (JSON)")
     p.add_argument("--out", required=True, help="output directory: study.csv (resumed if present), the plot")
