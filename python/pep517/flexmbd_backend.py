@@ -15,7 +15,8 @@ runs CMake there and packs a wheel from what it built:
 
 The build folder, first that applies:
   1. $FLEXMBD_BUILD_DIR: configured there if it has no CMakeCache.txt yet; refused if it
-     was configured for another Python (its Python3_EXECUTABLE).
+     was configured for another Python (its FLEXMBD_PYTHON_EXECUTABLE, the interpreter
+     python/CMakeLists.txt built the module for).
   2. build/ of the source tree when it was configured for this Python (make's default
      build): built up to date (cmake --build --target _flexmbd), not compiled again.
   3. build-pip/<python tag>-<hash of the interpreter>/: configured (Release, no tests
@@ -81,14 +82,20 @@ def _interpreter():
 
 
 def _cached_python(build_dir):
-    """Python3_EXECUTABLE of a configured build folder, or None."""
+    """The interpreter a configured build folder builds the module for (python/CMakeLists.txt
+    records it as FLEXMBD_PYTHON_EXECUTABLE), or None."""
+    found = {}
     try:
         with open(os.path.join(build_dir, "CMakeCache.txt"), encoding="utf-8", errors="replace") as f:
             for line in f:
-                if line.startswith("Python3_EXECUTABLE:"):
-                    return line.split("=", 1)[1].strip()
+                name = line.split(":", 1)[0]
+                if name in ("FLEXMBD_PYTHON_EXECUTABLE", "Python3_EXECUTABLE", "_Python3_EXECUTABLE") and "=" in line:
+                    found[name] = line.split("=", 1)[1].strip()
     except OSError:
         pass
+    for name in ("FLEXMBD_PYTHON_EXECUTABLE", "Python3_EXECUTABLE", "_Python3_EXECUTABLE"):
+        if found.get(name):
+            return found[name]
     return None
 
 
@@ -107,8 +114,8 @@ def _build_dir():
         exe = _cached_python(given)
         if exe is None:
             if os.path.exists(os.path.join(given, "CMakeCache.txt")):
-                raise RuntimeError(f"FLEXMBD_BUILD_DIR={given} has no Python module configured "
-                                   "(FLEXMBD_BUILD_PYTHON=OFF?)")
+                raise RuntimeError(f"FLEXMBD_BUILD_DIR={given} builds no Python module "
+                                   "(configured with FLEXMBD_BUILD_PYTHON=OFF?)")
             return given, True
         if not _same_python(exe):
             raise RuntimeError(f"FLEXMBD_BUILD_DIR={given} was configured for the Python {exe}, "
