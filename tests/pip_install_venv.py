@@ -34,12 +34,12 @@ def check(ok, what):
         failures.append(what)
 
 
-def run(cmd, cwd, env, timeout=600):
+def run(cmd, cwd, env, timeout=600, fails=False):
     start = time.monotonic()
     r = subprocess.run(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                        timeout=timeout)
     print(f"$ {' '.join(cmd)}  ({time.monotonic() - start:.1f} s, exit {r.returncode})", flush=True)
-    if r.returncode != 0:
+    if (r.returncode != 0) != fails:
         print(r.stdout)
     return r
 
@@ -101,6 +101,9 @@ with tempfile.TemporaryDirectory() as work:  # outside the source tree: no ./fle
     check(info.get("status") == "ok" and info.get("rows", 0) >= 2 and abs(info.get("t_end", 0) - 0.05) < 1e-12
           and info.get("array") and info.get("finite"),
           f"a short rigid slider-crank run from the venv: {info}")
+    # a Python without NumPy (pyenv, a venv without --system-site-packages): the import names it
+    r = run([py, "-c", "import sys; sys.modules['numpy'] = None; import flexmbd"], work, env, fails=True)
+    check(r.returncode != 0 and "ImportError: flexmbd needs NumPy" in r.stdout, "without NumPy, the import says so")
     study = os.path.join(VENV, "bin", "flexmbd-study")
     check(os.path.isfile(study), "venv/bin/flexmbd-study installed")
     if os.path.isfile(study):
