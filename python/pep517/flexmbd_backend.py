@@ -156,7 +156,7 @@ def _cmake_build():
         cmd += ["-j", str(os.cpu_count() or 1)]
     start = time.monotonic()
     _run(cmd)
-    _log(f"module up to date in {time.monotonic() - start:.1f} s")
+    _log(f"module built (up to date) in {time.monotonic() - start:.1f} s")
     suffix = sysconfig.get_config_var("EXT_SUFFIX")
     module = os.path.join(build, "python", "flexmbd", "_flexmbd" + suffix)
     if not os.path.isfile(module):
@@ -167,7 +167,7 @@ def _cmake_build():
 
 def _metadata():
     lines = ["Metadata-Version: 2.1", f"Name: {NAME}", f"Version: {_version()}", f"Summary: {SUMMARY}",
-             "License: see the source tree", "Requires-Python: >=3.8"]
+             "Requires-Python: >=3.8"]
     lines += [f"Requires-Dist: {r}" for r in REQUIRES]
     for extra, reqs in EXTRAS.items():
         lines.append(f"Provides-Extra: {extra}")
