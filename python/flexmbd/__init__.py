@@ -17,6 +17,12 @@ import math
 import numbers
 import os
 
+try:  # the module's arrays (it imports NumPy when it loads): named here when it is missing
+    import numpy  # noqa: F401
+except ImportError as e:
+    raise ImportError("flexmbd needs NumPy in this Python (Debian: python3-numpy, and a venv made with "
+                      "--system-site-packages sees it; elsewhere: pip install numpy)") from e
+
 from ._flexmbd import (  # noqa: F401  (the C++ API, re-exported)
     GROUND,
     BeamMesh2d,
