@@ -189,7 +189,9 @@ PYBIND11_MODULE(_flexmbd, m) {
         return py::make_tuple(seconds, sum);
       },
       py::arg("law"), py::arg("calls"), "(seconds, sum of the values) of `calls` evaluations without the GIL");
-  py::class_<SpringLaw, std::shared_ptr<SpringLaw>>(m, "SpringLaw")
+  py::class_<SpringLaw, std::shared_ptr<SpringLaw>>(m, "SpringLaw",
+                                                     "A spring-damper law f(t, x, xdot) given by a callable "
+                                                     "(flexmbd.spring_law), with its derivatives")
       .def(
           "__call__",
           [](const SpringLaw& law, double t, double x, double xdot) {
@@ -197,7 +199,8 @@ PYBIND11_MODULE(_flexmbd, m) {
             return py::make_tuple(v.f, v.dfdx, v.dfdxdot);
           },
           py::arg("t"), py::arg("x"), py::arg("xdot"), "(f, df/dx, df/dxdot) at (t, x, xdot)")
-      .def_property_readonly("has_user_derivative", &SpringLaw::hasUserDerivative);
+      .def_property_readonly("has_user_derivative", &SpringLaw::hasUserDerivative,
+                             "True if the user gave (df/dx, df/dxdot); False: central differences");
   m.def(
       "spring_law",
       [](const py::object& f, const py::object& derivative) {
