@@ -1,6 +1,7 @@
-// User functions (issue 28, item 3): time laws and spring-damper laws given as callables
-// (C++ std::function, or Python callables wrapped into one by the Python module), with
-// their derivatives from the user or by central finite differences.
+/// @file
+/// User functions (issue 28, item 3): time laws and spring-damper laws given as callables
+/// (C++ std::function, or Python callables wrapped into one by the Python module), with
+/// their derivatives from the user or by central finite differences.
 #pragma once
 
 #include <array>
