@@ -20,6 +20,14 @@
 
 namespace flexmbd::cli {
 
+// ----- exit status of every command (README, "Command line") ---------------------------
+constexpr int kExitOk = 0;
+/// The solver failed or a run stopped early (results up to there kept); a kinematic
+/// analysis stopped at a singular position; a page, plot or eigensolver failed.
+constexpr int kExitFailure = 1;
+/// Bad input: command line, scene, model, folder; nothing was computed.
+constexpr int kExitInputError = 2;
+
 // ----- SIGINT / SIGTERM during a run -----------------------------------------------------
 // The first signal sets a flag; the run finishes the row it is writing, writes its summary
 // (status "interrupted", the time reached) and exits 128 + signal (130, 143). The handler

@@ -47,9 +47,9 @@ namespace {
 using namespace flexmbd;
 using namespace flexmbd::cli;
 
-constexpr int kExitOk = 0;
-constexpr int kExitSolverFailure = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+constexpr int kExitSolverFailure = cli::kExitFailure;
+using cli::kExitInputError;
 
 const char* const kUsage =
     "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A]\n"

@@ -25,9 +25,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kExitOk = 0;
-constexpr int kExitStopped = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+constexpr int kExitStopped = cli::kExitFailure;
+using cli::kExitInputError;
 
 using cli::UsageError;
 

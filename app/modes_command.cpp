@@ -33,9 +33,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+using cli::kExitFailure;
+using cli::kExitInputError;
 /// Frames of the VTK animation of one mode shape (one period).
 constexpr int kShapeFrames = 16;
 /// Largest displacement of the drawn mode shapes, as a fraction of the model's size.

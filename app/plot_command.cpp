@@ -40,9 +40,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+using cli::kExitFailure;
+using cli::kExitInputError;
 
 const char* const kScriptName = "plot_results.py";
 

@@ -15,8 +15,8 @@ namespace flexmbd {
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+using cli::kExitInputError;
 
 /// The spatial flexible body `name` of the scene.
 /// @throws InputError naming the body: none of that name, or not a spatial flexible body.

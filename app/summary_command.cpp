@@ -25,8 +25,8 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::ordered_json;
 
-constexpr int kExitOk = 0;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+using cli::kExitInputError;
 
 std::string number(double x) {
   char buf[40];

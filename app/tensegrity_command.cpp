@@ -20,9 +20,9 @@ namespace flexmbd {
 
 namespace {
 
-constexpr int kExitOk = 0;
-constexpr int kExitSolverFailure = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+constexpr int kExitSolverFailure = cli::kExitFailure;
+using cli::kExitInputError;
 
 using cli::oneLine;
 using cli::printError;

@@ -24,9 +24,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kExitOk = 0;
-constexpr int kExitFailure = 1;
-constexpr int kExitInputError = 2;
+using cli::kExitOk;
+using cli::kExitFailure;
+using cli::kExitInputError;
 /// Frames drawn at most by default: a page of a few MB that opens in seconds.
 constexpr long kDefaultMaxFrames = 1000;
 /// Columns plotted by default at most.
