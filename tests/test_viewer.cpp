@@ -269,6 +269,24 @@ TEST_F(Browser, PlanarElasticSliderCrankRenders) { check("slider_crank_elastic_d
 
 TEST_F(Browser, SpatialElasticSliderCrankRenders) { check("spatial_slider_crank_elastic.json", 0.1, "viewer_spatial.png", 3); }
 
+TEST_F(Browser, AModelWithoutJointsRenders) {
+  // a body falling freely: no joint, so the page's joint arrays are empty (a rotor on
+  // bushings drew nothing: "Cannot read properties of null")
+  const nlohmann::json scene = nlohmann::json::parse(R"({"name": "falling box", "dimension": 3,
+    "gravity": [0, 0, -9.81],
+    "bodies": [{"name": "box", "type": "rigid", "mass": 2, "inertia": [0.1, 0.2, 0.3], "position": [0, 0, 1],
+                "angular_velocity": [1, 2, 3]}],
+    "solver": {"t_end": 0.2, "output_step": 0.01}})");
+  const fs::path s = writeScene("falling.json", scene), out = dir_ / "run";
+  ASSERT_EQ(run("run " + shellQuote(s.string()) + " --out " + shellQuote(out.string()) + " --quiet").status, 0);
+  ASSERT_EQ(run("view " + shellQuote(out.string())).status, 0);
+  const nlohmann::json st = openInBrowser(out / "view.html", artifacts() / "viewer_no_joints.png");
+  EXPECT_TRUE(st["ok"].get<bool>()) << st.dump();
+  EXPECT_EQ(st.value("joints", -1), 0) << st.dump();
+  EXPECT_EQ(st.value("frames", 0), 21) << st.dump();
+  EXPECT_GT(st.value("drawn_pixels", 0), 1000) << st.dump();
+}
+
 TEST_F(Browser, ModeShapesRender) {
   const fs::path out = dir_ / "modes";
   ASSERT_EQ(run("modes " + shellQuote(std::string(FLEXMBD_SOURCE_DIR) + "/examples/modes_blade.json") + " --out " +

@@ -72,6 +72,7 @@ function extent(data) {
   const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   for (const c of data.clips) {
     for (const arr of [c.pos, c.jpos]) {
+      if (!arr) continue;  // no joints: an empty array
       for (let i = 0; i < arr.length; i += 3) {
         for (let k = 0; k < 3; ++k) {
           lo[k] = Math.min(lo[k], arr[i + k]);
