@@ -106,19 +106,23 @@ SurfaceMesh surfaceMesh(const SolidShape& s, int segments) {
 namespace {
 
 /// The faces of a solid element as its corner nodes (0-based positions in its node list),
-/// counter-clockwise seen from outside for the codes' node order; empty for other types.
+/// counter-clockwise seen from outside for the codes' node order; a shell (Abaqus S3, S3R,
+/// S4, S4R, S8R) is its own face; empty for other types (beams, point elements).
 const std::vector<std::vector<int>>& elementFaces(const std::string& type) {
   static const std::vector<std::vector<int>> hex = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4},
                                                     {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
   static const std::vector<std::vector<int>> tet = {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}};
   static const std::vector<std::vector<int>> wedge = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4, 3}, {1, 2, 5, 4}, {2, 0, 3, 5}};
   static const std::vector<std::vector<int>> pyramid = {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}};
+  static const std::vector<std::vector<int>> shell3 = {{0, 1, 2}}, shell4 = {{0, 1, 2, 3}};
   static const std::vector<std::vector<int>> none;
   const auto starts = [&](const char* p) { return type.rfind(p, 0) == 0; };
   if (starts("C3D8") || starts("C3D20") || starts("Hex")) return hex;
   if (starts("C3D4") || starts("C3D10") || starts("Tet")) return tet;
   if (starts("C3D6") || starts("C3D15") || starts("Wedge")) return wedge;
   if (starts("Pyramid")) return pyramid;
+  if (starts("S3")) return shell3;
+  if (starts("S4") || starts("S8")) return shell4;
   return none;
 }
 

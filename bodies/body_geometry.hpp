@@ -39,8 +39,9 @@ struct FeBodyDrawing {
 /// The outer surface of a solid mesh: the element faces (corner nodes only: quadrilaterals
 /// of hexahedra, wedges and pyramids, triangles of tetrahedra, wedges and pyramids) that
 /// belong to one element only, oriented outwards as the element orders its nodes
-/// (Abaqus/CalculiX C3D4/6/8/10/15/20, Ansys Tet/Wedge/Pyramid/Hex). Points: every node.
-/// Elements of other types are skipped.
+/// (Abaqus/CalculiX C3D4/6/8/10/15/20, Ansys Tet/Wedge/Pyramid/Hex), and the shells
+/// (Abaqus S3, S3R, S4, S4R, S8R: corner nodes) as they are. Points: every node. Elements
+/// of other types (beams, MASS, ROTARYI) are skipped.
 SurfaceMesh outerSurface(const FeBodyData& data);
 
 /// The surface of the shape: a box's 6 faces; a cylinder's or a tube's `segments` side

@@ -21,10 +21,12 @@ struct FeElement {
 };
 
 /// What a global degree of freedom (a row of the matrices) moves: node index and direction
-/// (0, 1, 2: x, y, z; 3 DOF per node, translations, solid elements).
+/// (0, 1, 2: the translations along x, y, z; 3, 4, 5: the rotations about x, y, z, which
+/// the nodes of beams and shells have: 6 DOF per node).
 struct FeDof {
   int node = 0;
   int direction = 0;
+  bool isRotation() const { return direction >= 3; }
 };
 
 struct FeBodyData {
@@ -41,10 +43,15 @@ struct FeBodyData {
   int numDofs() const { return static_cast<int>(dofs.size()); }
   /// The index of node number `id`, or -1.
   int nodeIndex(int id) const;
-  /// dofIndex()[3 a + k]: the row of node a's direction k.
+  /// dofIndex()[3 a + k]: the row of node a's translation along k.
   std::vector<int> dofIndex() const;
-  /// The rows of the DOF of `nodes` (indices into nodeIds; each node's x, y, z in turn),
-  /// e.g. the held DOF of clampedModes (bodies/modal_reduction.hpp).
+  /// rotationIndex()[3 a + k]: the row of node a's rotation about k, or -1 (a solid node).
+  std::vector<int> rotationIndex() const;
+  /// True if some node has rotations (a mesh of beams or shells).
+  bool hasRotations() const;
+  /// The rows of the DOF of `nodes` (indices into nodeIds; each node's x, y, z in turn, then
+  /// its rotations, if it has them), e.g. the held DOF of clampedModes
+  /// (bodies/modal_reduction.hpp).
   std::vector<int> dofsOfNodes(const std::vector<int>& nodes) const;
 };
 

@@ -17,6 +17,16 @@
 // The cross terms (k != l) are not blocks of M (which is zero there): they need m_ab,
 // so the mass must have the solid element structure, checked below. Solid nodes carry
 // no rotation: rotation shapes zero, rKL and hI absent.
+//
+// Nodes with rotations (beams, shells: 6 DOF per node; docs/fe-import.md "Beams and
+// shells"): the shape functions are the element's own and M has no such structure. What
+// the rigid motions R (translations r_k, rotations rho_k) give holds for any M whose
+// shape functions reproduce them: m and the first moment from R^T M R, the inertia tensor
+// I_kl = rho_k^T M rho_l (second moment tr(I)/2 1 - I), S-bar row k = r_k^T M, and
+// positionShape[k] row l = g_kl^T M with g_kl the nodal interpolant of the field u0_k e_l
+// (exact for the rotations' antisymmetric parts; exact for fields the elements reproduce).
+// The S_kl are lumped: node a a rigid particle of mass m_a (HRZ: M's translational
+// diagonal scaled to m) with the inertia J_a of M's rotational node block. m_ff = M.
 #include "bodies/fe_body_model.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -86,16 +96,29 @@ struct NodeSetGeometry {
 };
 
 /// @throws InputError naming `owner` and the interface: fewer than 3 nodes, a node out of
-/// range or twice, the nodes on one line.
+/// range or twice, the nodes on one line. A rigid interface over nodes that all have
+/// rotations (beams, shells) needs one node at least: the nodes' own rotations fix the frame's.
 NodeSetGeometry nodeSetGeometry(const FeBodyData& d, const FeInterface& f, const std::string& owner) {
   const std::string who = owner + ": interface '" + f.name + "'";
-  if (f.nodes.size() < 3) throw InputError(who + " has " + std::to_string(f.nodes.size()) + " nodes; expected at least 3 not on one line");
+  const std::vector<int> rot = d.rotationIndex();
+  bool rotating = f.kind == FeInterfaceKind::Rigid && !f.nodes.empty();
+  for (int a : f.nodes) rotating = rotating && a >= 0 && a < d.numNodes() && rot[3 * a] >= 0;
+  if (f.nodes.empty() || (f.nodes.size() < 3 && !rotating)) {
+    throw InputError(who + " has " + std::to_string(f.nodes.size()) +
+                     " nodes; expected at least 3 not on one line (or, for a rigid interface, one node with "
+                     "rotations at least)");
+  }
   std::vector<char> seen(d.numNodes(), 0);
   NodeSetGeometry g;
   for (int a : f.nodes) {
     if (a < 0 || a >= d.numNodes()) throw InputError(who + ": node index " + std::to_string(a) + " is not in the mesh");
     if (seen[a]++) throw InputError(who + ": node " + std::to_string(d.nodeIds[a]) + " is given twice");
     g.centroid += d.coordinates[a];
+  }
+  if (rotating) {  // the frame's rotation is the nodes' own: no least-squares rotation needed
+    g.centroid /= static_cast<double>(f.nodes.size());
+    for (int a : f.nodes) g.r.push_back(d.coordinates[a] - g.centroid);
+    return g;
   }
   g.centroid /= static_cast<double>(f.nodes.size());
   Mat3 H = Mat3::Zero();
@@ -123,7 +146,7 @@ NodeSetGeometry nodeSetGeometry(const FeBodyData& d, const FeInterface& f, const
 SpMat rigidInterfaceMap(const FeBodyData& d, const FeBodyOptions& o, const std::vector<NodeSetGeometry>& geo,
                         std::vector<int>& masters, const std::string& owner) {
   const int nd = d.numDofs();
-  const std::vector<int> dof = d.dofIndex();
+  const std::vector<int> dof = d.dofIndex(), rot = d.rotationIndex();
   std::vector<int> slaveOf(d.numNodes(), -1);
   for (std::size_t k = 0; k < o.interfaces.size(); ++k) {
     if (o.interfaces[k].kind != FeInterfaceKind::Rigid) continue;
@@ -156,6 +179,7 @@ SpMat rigidInterfaceMap(const FeBodyData& d, const FeBodyOptions& o, const std::
           const double v = Vec3::Unit(j).cross(r)[c];  // theta_j e_j x r_a
           if (v != 0.0) t.emplace_back(row, col + 3 + j, v);
         }
+        if (rot[3 * a + c] >= 0) t.emplace_back(rot[3 * a + c], col + 3 + c, 1.0);  // theta_a = theta_I
       }
     }
     col += 6;
@@ -171,6 +195,10 @@ MatX FeBodyModel::rigidBodyModes(const FeBodyData& d) {
   MatX R = MatX::Zero(d.numDofs(), 6);
   for (int i = 0; i < d.numDofs(); ++i) {
     const FeDof& f = d.dofs[i];
+    if (f.isRotation()) {
+      R(i, f.direction) = 1.0;  // a rotation about axis k turns every node by e_k
+      continue;
+    }
     R(i, f.direction) = 1.0;
     for (int k = 0; k < 3; ++k) {
       const Vec3 r = Vec3::Unit(k).cross(d.coordinates[f.node]);  // rotation about axis k
@@ -235,48 +263,18 @@ void FeBodyModel::addInterfaces(const FeBodyData& d, const FeBodyOptions& o, Mat
   }
 }
 
-FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std::string owner)
-    : owner_(std::move(owner)) {
-  if (!(options.stiffnessScale > 0.0) || !std::isfinite(options.stiffnessScale)) {
-    throw InputError(owner_ + ": stiffness scale " + fmt(options.stiffnessScale) + "; expected a positive number");
-  }
-  if (!(options.dampingRatio >= 0.0 && options.dampingRatio <= 1.0)) {
-    throw InputError(owner_ + ": damping ratio " + fmt(options.dampingRatio) + "; expected a number in [0, 1]");
-  }
+namespace {
+
+/// The nodal invariants of a solid mesh (no rotations), exact for the mesh's mass matrix
+/// `mass` (point masses included) and node mass `m` (derivation at the top of this file).
+FfrInvariants3d solidInvariants(const FeBodyData& d, const SpMat& m, const SpMat& mass) {
   const int nn = d.numNodes(), nd = d.numDofs();
   const std::vector<int> dof = d.dofIndex();
-  SpMat m = nodeMass(d, owner_);
-  SpMat mass = d.mass;
-  for (const FePointMass& p : options.pointMasses) {
-    if (p.node < 0 || p.node >= nn) {
-      throw InputError(owner_ + ": a point mass at node index " + std::to_string(p.node) + "; the mesh has " +
-                       std::to_string(nn) + " nodes");
-    }
-    if (!(p.mass > 0.0) || !std::isfinite(p.mass)) {
-      throw InputError(owner_ + ": point mass " + fmt(p.mass) + " at node " + std::to_string(d.nodeIds[p.node]) +
-                       "; expected a positive mass");
-    }
-    m.coeffRef(p.node, p.node) += p.mass;  // lumped: m_aa += m_p
-    for (int k = 0; k < 3; ++k) mass.coeffRef(dof[3 * p.node + k], dof[3 * p.node + k]) += p.mass;
-  }
   MatX X(nn, 3);
   for (int a = 0; a < nn; ++a) X.row(a) = d.coordinates[a].transpose();
   const VecX m1 = m * VecX::Ones(nn);  // sum_a m_ab (m symmetric)
   const MatX mX = m * X;               // sum_b m_ab X_bk
-
-  // the rigid motions of the nodes must be the stiffness's null space: coordinates and DOF
-  // map are those of the matrices (measured 6e-16 and 3e-13 for the rotor's two exports)
-  constexpr double kRigidTolerance = 1e-8;
-  MatX R = rigidBodyModes(d);
-  const double kr = (d.stiffness * R).cwiseAbs().maxCoeff() / (maxAbsOf(d.stiffness) * R.cwiseAbs().maxCoeff());
-  if (kr > kRigidTolerance) {
-    throw InputError(owner_ + ": the stiffness of " + d.source +
-                     " does not vanish on the rigid motions of the nodes (" + fmt(kr, 3) +
-                     " of |K| |r|, expected <= 1e-8): the coordinates or the DOF map are not those of "
-                     "the matrices, or the export holds supports");
-  }
-
-  FfrInvariants3d& v = nodal_;
+  FfrInvariants3d v;
   v.mass = m1.sum();
   v.firstMoment = X.transpose() * m1;
   v.secondMoment = X.transpose() * mX;
@@ -297,15 +295,131 @@ FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std:
     }
   }
   v.mff = mass;
-  v.kff = options.stiffnessScale * d.stiffness;
-  v.dff.resize(nd, nd);
+  return v;
+}
+
+/// The nodal invariants of a mesh whose nodes have rotations (beams, shells; derivation at
+/// the top of this file and docs/fe-import.md "Beams and shells"): exact for the rigid
+/// motions, lumped at the nodes for the rest. `R`: rigidBodyModes(d).
+FfrInvariants3d structuralInvariants(const FeBodyData& d, const SpMat& mass, const MatX& R) {
+  const int nn = d.numNodes(), nd = d.numDofs();
+  const std::vector<int> dof = d.dofIndex(), rot = d.rotationIndex();
+  const MatX MR = mass * R;
+  const Eigen::Matrix<double, 6, 6> A = R.transpose() * MR;  // the rigid body's mass matrix about the origin
+  FfrInvariants3d v;
+  // m = r_k^T M r_k; t_k^T M rho_l = (e_l x first)_k; rho_k^T M rho_l = I_kl (Shabana 5.2)
+  v.mass = A.topLeftCorner<3, 3>().trace() / 3.0;
+  v.firstMoment = 0.5 * Vec3(A(1, 5) - A(2, 4), A(2, 3) - A(0, 5), A(0, 4) - A(1, 3));
+  const Mat3 I = 0.5 * (A.bottomRightCorner<3, 3>() + A.bottomRightCorner<3, 3>().transpose());
+  v.secondMoment = 0.5 * I.trace() * Mat3::Identity() - I;  // int rho u0 u0^T = tr(I)/2 1 - I
+  v.sBar = MR.leftCols<3>().transpose();                     // row k = r_k^T M
+  // positionShape[k] row l = g_kl^T M, g_kl the nodal interpolant of the field u0_k e_l:
+  // translations X_ak e_l, rotations its curl / 2 = (e_k x e_l) / 2 (exact for rigid rotations)
+  for (int k = 0; k < 3; ++k) {
+    v.positionShape[k] = Mat3X::Zero(3, nd);
+    for (int l = 0; l < 3; ++l) {
+      VecX g = VecX::Zero(nd);
+      const Vec3 curl = 0.5 * Vec3::Unit(k).cross(Vec3::Unit(l));
+      for (int a = 0; a < nn; ++a) {
+        g[dof[3 * a + l]] = d.coordinates[a][k];
+        for (int c = 0; c < 3; ++c) {
+          if (rot[3 * a + c] >= 0) g[rot[3 * a + c]] = curl[c];
+        }
+      }
+      v.positionShape[k].row(l) = (mass * g).transpose();
+    }
+  }
+  // S_kl lumped: node a a rigid particle of mass m_a (HRZ: M's translational diagonal scaled
+  // to the total mass) with the rotational inertia J_a of M's node block, C_a = tr(J_a)/2 1 - J_a:
+  // S_kl(t_ak, t_al) = m_a, S_kl(theta_am, theta_an) = eps_kmj eps_lni C_a(j, i)
+  VecX diag = VecX::Zero(nn);
+  double trace = 0.0;
   for (int a = 0; a < nn; ++a) {
+    for (int k = 0; k < 3; ++k) diag[a] += mass.coeff(dof[3 * a + k], dof[3 * a + k]);
+    trace += diag[a];
+  }
+  const VecX ma = diag * (v.mass / trace);
+  const auto eps = [](int i, int j, int k) { return 0.5 * (i - j) * (j - k) * (k - i); };  // Levi-Civita, 0..2
+  for (int k = 0; k < 3; ++k) {
+    for (int l = 0; l < 3; ++l) {
+      Triplets t;
+      for (int a = 0; a < nn; ++a) {
+        t.emplace_back(dof[3 * a + k], dof[3 * a + l], ma[a]);
+        if (rot[3 * a] < 0) continue;
+        Mat3 J;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) J(i, j) = mass.coeff(rot[3 * a + i], rot[3 * a + j]);
+        const Mat3 C = 0.5 * J.trace() * Mat3::Identity() - 0.5 * (J + J.transpose());
+        for (int mm = 0; mm < 3; ++mm) {
+          for (int n = 0; n < 3; ++n) {
+            double s = 0.0;
+            for (int j = 0; j < 3; ++j)
+              for (int i = 0; i < 3; ++i) s += eps(k, mm, j) * eps(l, n, i) * C(j, i);
+            if (s != 0.0) t.emplace_back(rot[3 * a + mm], rot[3 * a + n], s);
+          }
+        }
+      }
+      v.sKL[k][l].resize(nd, nd);
+      v.sKL[k][l].setFromTriplets(t.begin(), t.end());
+    }
+  }
+  v.mff = mass;
+  return v;
+}
+
+}  // namespace
+
+FeBodyModel::FeBodyModel(const FeBodyData& d, const FeBodyOptions& options, std::string owner)
+    : owner_(std::move(owner)) {
+  if (!(options.stiffnessScale > 0.0) || !std::isfinite(options.stiffnessScale)) {
+    throw InputError(owner_ + ": stiffness scale " + fmt(options.stiffnessScale) + "; expected a positive number");
+  }
+  if (!(options.dampingRatio >= 0.0 && options.dampingRatio <= 1.0)) {
+    throw InputError(owner_ + ": damping ratio " + fmt(options.dampingRatio) + "; expected a number in [0, 1]");
+  }
+  const int nn = d.numNodes(), nd = d.numDofs();
+  const std::vector<int> dof = d.dofIndex(), rot = d.rotationIndex();
+  const bool structural = d.hasRotations();
+  SpMat m = structural ? SpMat() : nodeMass(d, owner_);
+  SpMat mass = d.mass;
+  for (const FePointMass& p : options.pointMasses) {
+    if (p.node < 0 || p.node >= nn) {
+      throw InputError(owner_ + ": a point mass at node index " + std::to_string(p.node) + "; the mesh has " +
+                       std::to_string(nn) + " nodes");
+    }
+    if (!(p.mass > 0.0) || !std::isfinite(p.mass)) {
+      throw InputError(owner_ + ": point mass " + fmt(p.mass) + " at node " + std::to_string(d.nodeIds[p.node]) +
+                       "; expected a positive mass");
+    }
+    if (!structural) m.coeffRef(p.node, p.node) += p.mass;  // lumped: m_aa += m_p
+    for (int k = 0; k < 3; ++k) mass.coeffRef(dof[3 * p.node + k], dof[3 * p.node + k]) += p.mass;
+  }
+
+  // the rigid motions of the nodes must be the stiffness's null space: coordinates and DOF
+  // map are those of the matrices (measured 6e-16 and 3e-13 for the rotor's two exports)
+  constexpr double kRigidTolerance = 1e-8;
+  MatX R = rigidBodyModes(d);
+  const double kr = (d.stiffness * R).cwiseAbs().maxCoeff() / (maxAbsOf(d.stiffness) * R.cwiseAbs().maxCoeff());
+  if (kr > kRigidTolerance) {
+    throw InputError(owner_ + ": the stiffness of " + d.source +
+                     " does not vanish on the rigid motions of the nodes (" + fmt(kr, 3) +
+                     " of |K| |r|, expected <= 1e-8): the coordinates or the DOF map are not those of "
+                     "the matrices, or the export holds supports");
+  }
+
+  nodal_ = structural ? structuralInvariants(d, mass, R) : solidInvariants(d, m, mass);
+  nodal_.kff = options.stiffnessScale * d.stiffness;
+  nodal_.dff.resize(nd, nd);
+  for (int a = 0; a < nn; ++a) {  // every node an attachment point, with its rotation if it has one
     FfrPoint3d p;
     p.position = d.coordinates[a];
     p.shape = Mat3X::Zero(3, nd);
-    for (int k = 0; k < 3; ++k) p.shape(k, dof[3 * a + k]) = 1.0;
     p.rotationShape = Mat3X::Zero(3, nd);
-    v.points.push_back(std::move(p));
+    for (int k = 0; k < 3; ++k) {
+      p.shape(k, dof[3 * a + k]) = 1.0;
+      if (rot[3 * a + k] >= 0) p.rotationShape(k, rot[3 * a + k]) = 1.0;
+    }
+    nodal_.points.push_back(std::move(p));
   }
 
   if (options.spinStiffening.preloadedStiffness.size()) addSpinStiffening(d, options);

@@ -1,8 +1,10 @@
 /// @file
-/// A spatial floating-frame-of-reference body from a finite element mesh of solid elements
-/// (3 translational DOF per node, FeBodyData from io/fe_abaqus.hpp or io/fe_ansys.hpp):
-/// the inertia invariants (FfrInvariants3d) computed from the FE mass matrix and the nodal
-/// coordinates, reduced to free-free normal modes about mean axes. docs/fe-import.md.
+/// A spatial floating-frame-of-reference body from a finite element mesh (FeBodyData from
+/// io/fe_abaqus.hpp, io/fe_ansys.hpp or io/fe_calculix.hpp): the inertia invariants
+/// (FfrInvariants3d) computed from the FE mass matrix and the nodal coordinates (solid
+/// elements, 3 DOF per node: exact; beams and shells, 6 DOF per node: exact for the rigid
+/// motions, the rest lumped at the nodes), reduced to free-free normal modes about mean
+/// axes or by Craig-Bampton. docs/fe-import.md.
 #pragma once
 
 #include <string>
@@ -23,13 +25,15 @@ struct FePointMass {
 /// An interface frame over a node set (docs/fe-import.md, "Interfaces"): a point with a
 /// translation and a small rotation of its own, where joints and forces attach.
 ///  - Rigid (RBE2): the set moves rigidly with the frame, u_a = u_I + theta_I x (X_a - X_I);
-///    the set's 3 n DOF are replaced by the frame's 6 before the modes are computed (the
+///    the set's nodal DOF (nodes with rotations: theta_a = theta_I too) are replaced by the
+///    frame's 6 before the modes are computed (the
 ///    interface stiffens the body).
 ///  - Averaging (RBE3): the frame carries the set's mean translation and least-squares
 ///    rotation, u_c = sum u_a / n, theta_I = H^-1 sum r_a x u_a with r_a = X_a - X_c,
 ///    H = sum (|r_a|^2 1 - r_a r_a^T), and u_I = u_c + theta_I x (X_I - X_c); adds no
 ///    stiffness or mass.
-/// The set must not lie on one line (H singular: the rotation about the line undefined).
+/// The set must not lie on one line (H singular: the rotation about the line undefined),
+/// except a rigid set whose nodes all have rotations (one node is enough: its own frame).
 enum class FeInterfaceKind { Rigid, Averaging };
 struct FeInterface {
   std::string name;
@@ -82,9 +86,9 @@ struct FeBodyOptions {
 class FeBodyModel {
  public:
   /// @throws InputError naming `owner`: a point mass at no node or not positive, a damping
-  /// ratio outside [0, 1], a mass matrix that couples directions or differs
+  /// ratio outside [0, 1], a solid mesh's mass matrix that couples directions or differs
   /// between them (expected a solid element mass M(a k, b l) = delta_kl m_ab, to 1e-10 of
-  /// its largest entry), a stiffness that does not vanish on the nodes' rigid motions
+  /// its largest entry; meshes with rotations are lumped instead), a stiffness that does not vanish on the nodes' rigid motions
   /// (coordinates or DOF map not those of the matrices; to 1e-8), a bad scale or mode
   /// count, or the eigensolver's errors (freeFreeModes).
   FeBodyModel(const FeBodyData& data, const FeBodyOptions& options, std::string owner);

@@ -43,6 +43,10 @@ class FfrBeamModelT {
   const Mesh& mesh() const { return mesh_; }
   const std::vector<Element>& elements() const { return elements_; }
   bool geometricStiffening() const { return options_.geometricStiffening; }
+  /// The nodal invariants (kNodeDofs coordinates per node, node a's at kNodeDofs a ...;
+  /// no reference conditions, so K_ff is singular): the dimension's inertia shape
+  /// integrals, m_ff, K_ff, D_ff summed from the elements. Built on each call.
+  Invariants nodalInvariants() const;
   /// Nodal displacements (kNodeDofs per node, body frame) = basis() * q_f.
   const SpMatRow& basis() const { return basis_; }
   int numElastic() const { return static_cast<int>(basis_.cols()); }
@@ -96,9 +100,6 @@ class FfrBeamModelT {
   void buildElements(const std::string& owner);
   /// The bytes this model and a run of it take, about (requireMemory before building).
   double memoryEstimate() const;
-  /// The nodal invariants (kNodeDofs coordinates per node): the dimension's inertia
-  /// shape integrals, m_ff, K_ff, D_ff summed from the elements.
-  Invariants nodalInvariants() const;
   /// Rows C of the reference conditions C q_n = 0 (kNodeDofs x nodal coordinates).
   MatX referenceConditions(const Invariants& nodal, const std::string& owner) const;
   /// B2 times the modal basis P (normal modes or Craig-Bampton, then inertia modes), or

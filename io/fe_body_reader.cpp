@@ -52,19 +52,28 @@ FeBodyData readFeBodyFiles(const ObjectReader& r, const std::string& baseDir) {
   return readAnsysFe(files);
 }
 
-/// Key "spin_stiffening" of `r`: {"calculix": {"job"}, "spin": [wx, wy, wz]}.
+/// Key "spin_stiffening" of `r`: {"calculix": {"job"} or "abaqus": {"stiffness"}, "spin":
+/// [wx, wy, wz]}.
 FeSpinStiffening readSpinStiffening(const ObjectReader& r, const FeBodyData& data, const std::string& baseDir) {
   const ObjectReader st(r.object("spin_stiffening"), r.where() + ".spin_stiffening");
   st.allowOnly(scenekeys::kFeSpinStiffening, " for spin_stiffening");
-  if (!st.has("calculix")) {
-    st.fail("missing required key \"calculix\" {\"job\"}: the preloaded stiffness exported by ccx (docs/fe-import.md, "
-            "\"Spin stiffening\")");
+  if (st.has("calculix") == st.has("abaqus")) {
+    st.fail("give exactly one of \"calculix\" {\"job\"} or \"abaqus\" {\"stiffness\"}: the preloaded stiffness "
+            "exported by the FE code (docs/fe-import.md, \"Spin stiffening\")");
   }
-  const ObjectReader f(st.object("calculix"), st.where() + ".calculix");
-  f.allowOnly(scenekeys::kFeFilesCalculix, " for CalculiX files");
   FeSpinStiffening out;
   out.spin = st.vector("spin", 3);
   if (!(out.spin.norm() > 0.0)) st.fail("key \"spin\" must be the spin of the preload run (rad/s), not zero");
+  if (st.has("abaqus")) {
+    const ObjectReader f(st.object("abaqus"), st.where() + ".abaqus");
+    f.allowOnly(scenekeys::kFeSpinAbaqus, " for an Abaqus preloaded stiffness");
+    const std::string path = filePath(f, "stiffness", baseDir);
+    out.preloadedStiffness =
+        located(f.where(), [&] { return readAbaqusPreloadedStiffness(path, data, out.heldDofs); });
+    return out;
+  }
+  const ObjectReader f(st.object("calculix"), st.where() + ".calculix");
+  f.allowOnly(scenekeys::kFeFilesCalculix, " for CalculiX files");
   const std::string job = filePath(f, "job", baseDir);
   out.preloadedStiffness =
       located(f.where(), [&] { return readCalculixPreloadedStiffness(CalculixFeFiles::ofJob(job), data, out.heldDofs); });

@@ -69,7 +69,7 @@ std::vector<FeDof> readDofFile(const std::string& path, const FeBodyData& d, con
 }  // namespace
 
 FeBodyData readCalculixFe(const CalculixFeFiles& files) {
-  FeBodyData d = readInpMesh(files.inp);
+  FeBodyData d = readInpMesh(files.inp, InpElements::Solids);
   d.dofs = readDofFile(files.dofs, d, files.inp);
   const std::string dofWhat = "of " + files.dofs;
   d.stiffness = readRowColumnMatrix(files.stiffness, d.numDofs(), SymmetricStorage::Upper, dofWhat);
@@ -79,7 +79,7 @@ FeBodyData readCalculixFe(const CalculixFeFiles& files) {
 }
 
 SpMat readCalculixPreloadedStiffness(const CalculixFeFiles& files, const FeBodyData& body, std::vector<int>& held) {
-  const FeBodyData mesh = readInpMesh(files.inp);
+  const FeBodyData mesh = readInpMesh(files.inp, InpElements::Solids);
   if (mesh.nodeIds != body.nodeIds) {
     throw InputError(files.inp + ": its nodes are not those of " + body.source +
                      "; expected the deck of the body with the preload steps added");
@@ -93,6 +93,10 @@ SpMat readCalculixPreloadedStiffness(const CalculixFeFiles& files, const FeBodyD
   const std::vector<FeDof> dofs = readDofFile(files.dofs, body, files.inp, false);
   const SpMat K = readRowColumnMatrix(files.stiffness, static_cast<int>(dofs.size()), SymmetricStorage::Upper,
                                       "of " + files.dofs);
+  if (body.hasRotations()) {
+    throw InputError(files.stiffness + ": a CalculiX preloaded stiffness for " + body.source +
+                     ", whose nodes have rotations; expected a solid body (CalculiX exports 3 DOF per node)");
+  }
   // equation i of the export -> the body's DOF index
   std::vector<int> bodyIndex(body.numNodes() * 3, -1);
   for (int i = 0; i < body.numDofs(); ++i) bodyIndex[3 * body.dofs[i].node + body.dofs[i].direction] = i;

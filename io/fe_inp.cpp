@@ -38,10 +38,17 @@ Keyword parseKeyword(const std::string& line) {
   return k;
 }
 
-/// Nodes of the solid element types read: C3D<n> with optional suffix letters (C3D8R).
+/// Nodes of the element types read: solids C3D<n> with optional suffix letters (C3D8R);
+/// beams B31, B32, B33 (suffix H); shells S3, S3R, S4, S4R, S8R (6 DOF per node, not the
+/// 5-DOF S4R5 family); the point elements MASS and ROTARYI. -1 for other types.
 int elementNodeCount(const std::string& type) {
+  static const std::map<std::string, int> structural = {
+      {"B31", 2}, {"B32", 3}, {"B33", 2}, {"B31H", 2}, {"B32H", 3}, {"B33H", 2}, {"S3", 3},     {"S3R", 3},
+      {"S4", 4},  {"S4R", 4}, {"S8R", 8}, {"MASS", 1}, {"ROTARYI", 1}};
   static const std::map<std::string, int> counts = {{"4", 4}, {"6", 6}, {"8", 8}, {"10", 10}, {"15", 15}, {"20", 20}};
   const std::string t = upper(type);
+  const auto s = structural.find(t);
+  if (s != structural.end()) return s->second;
   if (t.rfind("C3D", 0) != 0) return -1;
   size_t e = 3;
   while (e < t.size() && std::isdigit(static_cast<unsigned char>(t[e]))) ++e;
@@ -67,7 +74,7 @@ enum class Section { None, Node, Element, Nset };
 
 class InpReader {
  public:
-  explicit InpReader(const std::string& path) : f_(path) {}
+  InpReader(const std::string& path, InpElements kinds) : f_(path), kinds_(kinds) {}
 
   FeBodyData read() {
     std::string line;
@@ -126,11 +133,17 @@ class InpReader {
       if (it == k.params.end()) f_.fail("*Element without type=; expected e.g. *Element, type=C3D8");
       elementType_ = it->second;
       elementNodes_ = elementNodeCount(elementType_);
+      const bool solid = upper(elementType_).rfind("C3D", 0) == 0;
+      if (elementNodes_ >= 0 && !solid && kinds_ == InpElements::Solids) {
+        f_.fail("element type '" + elementType_ +
+                "' is not read in a CalculiX deck; expected solids C3D4, C3D6, C3D8, C3D10, C3D15 or C3D20 (CalculiX "
+                "expands beams and shells into solids with nodes of its own, which its matrices use)");
+      }
       if (elementNodes_ < 0) {
         f_.fail(
             "element type '" + elementType_ +
-            "' is not a solid element read here; expected C3D4, C3D6, C3D8, C3D10, C3D15 or C3D20 (suffixes R, I, H, "
-            "M, T allowed)");
+            "' is not an element read here; expected a solid C3D4, C3D6, C3D8, C3D10, C3D15 or C3D20 (suffixes R, "
+            "I, H, M, T allowed), a beam B31, B32, B33 (suffix H), a shell S3, S3R, S4, S4R, S8R, MASS or ROTARYI");
       }
     } else if (k.name == "NSET") {
       section_ = Section::Nset;
@@ -227,6 +240,7 @@ class InpReader {
   }
 
   TextFile f_;
+  InpElements kinds_;
   Section section_ = Section::None;
   std::string setName_, elementType_;
   int elementNodes_ = 0;
@@ -239,8 +253,8 @@ class InpReader {
 
 }  // namespace
 
-FeBodyData readInpMesh(const std::string& path) {
-  FeBodyData d = InpReader(path).read();
+FeBodyData readInpMesh(const std::string& path, InpElements kinds) {
+  FeBodyData d = InpReader(path, kinds).read();
   d.source = path;
   return d;
 }

@@ -158,21 +158,33 @@ SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage stora
   return assembleSymmetric(entries, n, storage, path);
 }
 
+std::string dofName(const FeDof& f) {
+  static const char* const names[] = {"x", "y", "z", "rotation x", "rotation y", "rotation z"};
+  return f.direction >= 0 && f.direction < 6 ? names[f.direction] : "?";
+}
+
 void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::string& stiffnessPath) {
   const int nn = d.numNodes(), nd = d.numDofs();
   const std::string dofText = std::to_string(nd);
-  if (nd != 3 * nn) {
-    throw InputError(stiffnessPath + ": the matrices have " + dofText + " DOF map entries for " + std::to_string(nn) +
-                     " nodes; expected 3 per node (" + std::to_string(3 * nn) + ")");
-  }
-  std::vector<int> seen(3 * nn, -1);
+  std::vector<int> seen(6 * nn, -1);
   for (int i = 0; i < nd; ++i) {
     const FeDof& f = d.dofs[i];
-    if (f.node < 0 || f.node >= nn || f.direction < 0 || f.direction > 2 || seen[3 * f.node + f.direction] >= 0) {
+    if (f.node < 0 || f.node >= nn || f.direction < 0 || f.direction > 5 || seen[6 * f.node + f.direction] >= 0) {
       throw InputError(stiffnessPath + ": the DOF map gives row " + std::to_string(i + 1) +
-                       " to a node and direction already mapped or unknown; expected each node's x, y, z once");
+                       " to a node and direction already mapped or unknown; expected each node's x, y, z (and "
+                       "rotations, if any) once");
     }
-    seen[3 * f.node + f.direction] = i;
+    seen[6 * f.node + f.direction] = i;
+  }
+  for (int a = 0; a < nn; ++a) {
+    const int translations = (seen[6 * a] >= 0) + (seen[6 * a + 1] >= 0) + (seen[6 * a + 2] >= 0);
+    const int rotations = (seen[6 * a + 3] >= 0) + (seen[6 * a + 4] >= 0) + (seen[6 * a + 5] >= 0);
+    if (translations != 3 || (rotations != 0 && rotations != 3)) {
+      throw InputError(stiffnessPath + ": node " + std::to_string(d.nodeIds[a]) + " has " +
+                       std::to_string(translations) + " translations and " + std::to_string(rotations) +
+                       " rotations in the matrices; expected x, y, z (3 DOF: solids) or x, y, z and the three "
+                       "rotations (6 DOF: beams, shells)");
+    }
   }
   const auto sizeOk = [&](const SpMat& A) { return A.rows() == nd && A.cols() == nd; };
   if (!sizeOk(d.mass)) throw InputError(massPath + ": the mass matrix is not " + dofText + " x " + dofText);
@@ -183,7 +195,7 @@ void checkBodyData(const FeBodyData& d, const std::string& massPath, const std::
     if (!(kdiag[i] > 0.0)) {
       const FeDof& f = d.dofs[i];
       throw InputError(stiffnessPath + ": row " + std::to_string(i + 1) + " (node " +
-                       std::to_string(d.nodeIds[f.node]) + ", direction " + "xyz"[f.direction] +
+                       std::to_string(d.nodeIds[f.node]) + ", direction " + dofName(f) +
                        ") has the stiffness diagonal " + fmt(kdiag[i]) +
                        "; expected a positive value (a node outside every element, or matrices of another mesh?)");
     }

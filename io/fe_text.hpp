@@ -86,7 +86,11 @@ SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage stora
 /// The fields of a line separated by blanks or tabs (runs count as one), none empty.
 std::vector<std::string> words(const std::string& line);
 
-/// The checks every reader ends with: one row per (node, direction), each once, matrices
+/// "x", "y", "z", "rotation x", "rotation y", "rotation z": the direction of `f`, for messages.
+std::string dofName(const FeDof& f);
+
+/// The checks every reader ends with: one row per (node, direction), each once, every node
+/// with its three translations and either none or all three rotations, matrices
 /// numDofs() x numDofs(), every DOF with a positive stiffness diagonal (else a node outside
 /// every element, or matrices of another mesh), positive total mass r_k^T M r_k in each
 /// direction k (r_k the rigid translation along k).

@@ -103,7 +103,8 @@ inline const Keys kFeFilesAbaqus = {"input", "mass", "stiffness"};
 inline const Keys kFeFilesAnsys = {"coordinates", "elements", "dof_map", "mass", "stiffness"};
 inline const Keys kFeFilesCalculix = {"job"};
 inline const Keys kFeStresses = {"calculix_frd"};
-inline const Keys kFeSpinStiffening = {"calculix", "spin"};
+inline const Keys kFeSpinStiffening = {"calculix", "abaqus", "spin"};
+inline const Keys kFeSpinAbaqus = {"stiffness"};
 inline const Keys kFePointMass = {"node", "mass"};
 inline const Keys kFeInterface = {"name", "kind", "nodes", "node_set", "point"};
 inline const Keys kOrientation = {"quaternion", "axis", "angle", "matrix"};
@@ -200,6 +201,7 @@ inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
       {"fe.point_mass", &kFePointMass},
       {"fe.stresses", &kFeStresses},
       {"fe.spin_stiffening", &kFeSpinStiffening},
+      {"fe.spin_stiffening.abaqus", &kFeSpinAbaqus},
       {"fe.interface", &kFeInterface},
       {"joint.3d.spherical", &kSpatialJoint},
       {"joint.3d.revolute", &kSpatialJoint},

@@ -34,6 +34,7 @@
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "integrators/simulation.hpp"
+#include "io/fe_abaqus.hpp"
 #include "io/fe_calculix.hpp"
 #include "io/scene.hpp"
 #include "io/vtk_writer.hpp"
@@ -849,7 +850,8 @@ TEST_F(CalculixFiles, DeckStrictness) {
                        "18, 11, 12, 19, 20\n");
   expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 17", "element 2 names node 19"});
   write("job.inp", "*NODE\n1, 0., 0., 0.\n*ELEMENT, TYPE=S8R\n1, 1, 1, 1, 1, 1, 1, 1, 1\n");
-  expectMentions(errorOf([&] { readCalculixFe(f); }), {f.inp, "line 3", "'S8R'"});
+  expectMentions(errorOf([&] { readCalculixFe(f); }),
+                 {f.inp, "line 3", "'S8R'", "is not read in a CalculiX deck", "expands beams and shells"});
 }
 
 namespace {
@@ -987,4 +989,60 @@ TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) 
   free["bodies"][0].erase("reference");
   fetest::expectMentions(fetest::errorOf([&] { parseSceneText(free.dump(), job("scene.json")); }),
                          {"spin stiffening needs \"reduction\": \"craig_bampton\""});
+}
+
+TEST_F(CalculixBar, SpinStiffeningFromAnAbaqusMatrixInputExportIsTheSame) {
+  // Abaqus writes the prestressed stiffness of a perturbation step (after the preload step)
+  // in FORMAT=MATRIX INPUT: "node, DOF, node, DOF, value", the held DOF absent. Abaqus is
+  // not on this machine, so ccx's prestressed export is written in that format here (the
+  // upper triangle, 17 digits, node labels) and read back: the same held DOF, the same
+  // matrix exactly, the same spin stiffness through the scene key "abaqus". This checks the
+  // Abaqus path's reading and mapping; the physics is the test above.
+  const FeBodyData d = readCalculixFe(CalculixFeFiles::ofJob(job("spin_matrices")));
+  std::vector<int> heldCcx, heldAbaqus;
+  const SpMat K = readCalculixPreloadedStiffness(CalculixFeFiles::ofJob(job("spin_pre")), d, heldCcx);
+  const std::string path = job("spin_pre_abaqus.mtx");
+  {
+    std::ofstream out(path);
+    out << "** the prestressed stiffness, Abaqus MATRIX INPUT format\n";
+    char line[160];
+    for (int j = 0; j < K.outerSize(); ++j) {
+      for (SpMat::InnerIterator it(K, j); it; ++it) {
+        if (it.row() > j) continue;
+        const FeDof &a = d.dofs[it.row()], &b = d.dofs[j];
+        std::snprintf(line, sizeof line, "%d, %d, %d, %d, %.17g\n", d.nodeIds[a.node], a.direction + 1,
+                      d.nodeIds[b.node], b.direction + 1, it.value());
+        out << line;
+      }
+    }
+  }
+  const SpMat Ka = readAbaqusPreloadedStiffness(path, d, heldAbaqus);
+  EXPECT_EQ(heldAbaqus, heldCcx);
+  EXPECT_EQ(MatX(Ka - K).cwiseAbs().maxCoeff(), 0.0);
+  const nlohmann::json scene = {
+      {"dimension", 3},
+      {"bodies",
+       {{{"name", "bar"},
+         {"type", "fe_body"},
+         {"calculix", {{"job", "spin_matrices"}}},
+         {"modes", 10},
+         {"reduction", "craig_bampton"},
+         {"reference", "root"},
+         {"interfaces", {{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}}}},
+         {"spin_stiffening", {{"calculix", {{"job", "spin_pre"}}}, {"spin", {0, 0, 100}}}}}}}};
+  nlohmann::json abaqus = scene;
+  abaqus["bodies"][0]["spin_stiffening"] = {{"abaqus", {{"stiffness", "spin_pre_abaqus.mtx"}}}, {"spin", {0, 0, 100}}};
+  const Scene a = parseSceneText(scene.dump(), job("scene.json")), b = parseSceneText(abaqus.dump(), job("scene.json"));
+  const auto& ba = dynamic_cast<const FfrBody3d&>(a.system.body(BodyIndex(1)));
+  const auto& bb = dynamic_cast<const FfrBody3d&>(b.system.body(BodyIndex(1)));
+  EXPECT_EQ(MatX(ba.invariants().spinStiffness[2][2] - bb.invariants().spinStiffness[2][2]).cwiseAbs().maxCoeff(), 0.0);
+  // both files, or a DOF the body does not have: refused, named
+  nlohmann::json both = abaqus;
+  both["bodies"][0]["spin_stiffening"]["calculix"] = {{"job", "spin_pre"}};
+  fetest::expectMentions(fetest::errorOf([&] { parseSceneText(both.dump(), job("scene.json")); }),
+                         {"spin_stiffening", "give exactly one of \"calculix\"", "or \"abaqus\""});
+  const std::string bad = job("spin_pre_bad.mtx");
+  std::ofstream(bad) << "1, 1, 1, 1, 1.0\n1, 4, 1, 4, 1.0\n";
+  fetest::expectMentions(fetest::errorOf([&] { readAbaqusPreloadedStiffness(bad, d, heldAbaqus); }),
+                         {bad, "line 2", "node 1, DOF 4 is not a DOF of"});
 }

@@ -401,9 +401,9 @@ TEST_F(FeFiles, AbaqusElementOfAnUndefinedNodeOrUnknownType) {
                     q = inp("1, 0., 0., 0.\n2, 1., 0., 0.\n3, 0., 1., 0.\n4, 0., 0., 1.\n", "1, 1, 2, 3, 9\n");
   expectMentions(errorOf([&] { readAbaqusFe(q, mtx("m.mtx", 1.0), mtx("k.mtx", 1.0)); }),
                  {"line 9", "element 1 names node 9"});
-  const std::string r = write("s4.inp", "*Node\n1, 0., 0., 0.\n*Element, type=S4R\n1, 1, 1, 1, 1\n");
+  const std::string r = write("s4.inp", "*Node\n1, 0., 0., 0.\n*Element, type=S9R5\n1, 1, 1, 1, 1\n");
   expectMentions(errorOf([&] { readAbaqusFe(r, mtx("m.mtx", 1.0), mtx("k.mtx", 1.0)); }),
-                 {r, "line 3", "'S4R'", "expected C3D4"});
+                 {r, "line 3", "'S9R5'", "expected a solid C3D4"});
 }
 
 TEST_F(FeFiles, AbaqusNonSymmetricMatrix) {
