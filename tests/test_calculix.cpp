@@ -926,6 +926,25 @@ TEST(CalculixModes, ClampedModesRefuseAFreeBodyAndBadArguments) {
 // ----- spin stiffening from a prestressed export -----------------------------------
 
 
+namespace {
+
+/// The bar clamped at its root interface, 10 Craig-Bampton modes, spin-stiffened by ccx's
+/// export of the 100 rad/s preload (jobs spin_matrices and spin_pre), as a scene.
+nlohmann::json spinningBarScene() {
+  return {{"dimension", 3},
+          {"bodies",
+           {{{"name", "bar"},
+             {"type", "fe_body"},
+             {"calculix", {{"job", "spin_matrices"}}},
+             {"modes", 10},
+             {"reduction", "craig_bampton"},
+             {"reference", "root"},
+             {"interfaces", {{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}}}},
+             {"spin_stiffening", {{"calculix", {{"job", "spin_pre"}}}, {"spin", {0, 0, 100}}}}}}}};
+}
+
+}  // namespace
+
 TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) {
   // The bar clamped at its root (a rigid interface, the Craig-Bampton reference), spinning
   // about z through the root's centre. Its stress stiffness comes from ccx's export of the
@@ -969,17 +988,7 @@ TEST_F(CalculixBar, SpinStiffeningFromAPrestressedExportFollowsCcxAndSouthwell) 
               "worst %.1e; Southwell coefficients %.4f (in plane, beam %.4f), %.4f (out of plane, beam %.4f)\n",
               worst, coefficient(0), southwell - 1.0, coefficient(1), southwell);
   // the scene key gives the same body
-  const nlohmann::json scene = {
-      {"dimension", 3},
-      {"bodies",
-       {{{"name", "bar"},
-         {"type", "fe_body"},
-         {"calculix", {{"job", "spin_matrices"}}},
-         {"modes", 10},
-         {"reduction", "craig_bampton"},
-         {"reference", "root"},
-         {"interfaces", {{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}}}},
-         {"spin_stiffening", {{"calculix", {{"job", "spin_pre"}}}, {"spin", {0, 0, 100}}}}}}}};
+  const nlohmann::json scene = spinningBarScene();
   const Scene sc = parseSceneText(scene.dump(), job("scene.json"));
   const auto& body = dynamic_cast<const FfrBody3d&>(sc.system.body(BodyIndex(1)));
   EXPECT_EQ(MatX(body.invariants().spinStiffness[2][2] - model.invariants().spinStiffness[2][2]).norm(), 0.0);
@@ -1019,17 +1028,7 @@ TEST_F(CalculixBar, SpinStiffeningFromAnAbaqusMatrixInputExportIsTheSame) {
   const SpMat Ka = readAbaqusPreloadedStiffness(path, d, heldAbaqus);
   EXPECT_EQ(heldAbaqus, heldCcx);
   EXPECT_EQ(MatX(Ka - K).cwiseAbs().maxCoeff(), 0.0);
-  const nlohmann::json scene = {
-      {"dimension", 3},
-      {"bodies",
-       {{{"name", "bar"},
-         {"type", "fe_body"},
-         {"calculix", {{"job", "spin_matrices"}}},
-         {"modes", 10},
-         {"reduction", "craig_bampton"},
-         {"reference", "root"},
-         {"interfaces", {{{"name", "root"}, {"kind", "rigid"}, {"node_set", "FIX"}}}},
-         {"spin_stiffening", {{"calculix", {{"job", "spin_pre"}}}, {"spin", {0, 0, 100}}}}}}}};
+  const nlohmann::json scene = spinningBarScene();
   nlohmann::json abaqus = scene;
   abaqus["bodies"][0]["spin_stiffening"] = {{"abaqus", {{"stiffness", "spin_pre_abaqus.mtx"}}}, {"spin", {0, 0, 100}}};
   const Scene a = parseSceneText(scene.dump(), job("scene.json")), b = parseSceneText(abaqus.dump(), job("scene.json"));
