@@ -59,6 +59,7 @@ struct IdaSolver::Impl {
   VecX cacheY, cacheYp;
   double cacheT = 0.0;
   bool cacheValid = false;
+  double rtol = 0.0;  ///< the state's relative tolerance (the sensitivities' too)
 
   ~Impl() {
     if (yS) N_VDestroyVectorArray(yS, ns);
@@ -214,6 +215,7 @@ IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const Vec
   d.check(IDASetErrHandlerFn(d.mem, &Impl::errorHandler, &d), "IDASetErrHandlerFn");
   d.check(IDAInit(d.mem, &Impl::residual, t0, d.yy, d.yp), "IDAInit");
   d.check(IDASVtolerances(d.mem, o.rtol, d.atol), "IDASVtolerances");
+  d.rtol = o.rtol;
   d.check(IDASetUserData(d.mem, &d), "IDASetUserData");
   d.check(IDASetId(d.mem, d.id), "IDASetId");
   d.check(IDASetSuppressAlg(d.mem, SUNTRUE), "IDASetSuppressAlg");
@@ -263,8 +265,8 @@ void IdaSolver::startSensitivities(const SensitivityProblem& sp) {
   if (!sp.derivatives) throw InputError("IdaSolver: sensitivities without their parameter derivatives");
   const int ns = sp.derivatives->count();
   if (ns < 1 || sp.s0.rows() != n || sp.sp0.rows() != n || sp.s0.cols() != ns || sp.sp0.cols() != ns ||
-      sp.scales.size() != ns) {
-    throw InputError("IdaSolver: initial sensitivities must be n x count and scales of size count");
+      sp.scales.size() != ns || sp.atolS.rows() != n || sp.atolS.cols() != ns) {
+    throw InputError("IdaSolver: initial sensitivities and their tolerances must be n x count, scales of size count");
   }
   if (!(sp.scales.cwiseAbs().minCoeff() > 0.0)) throw InputError("IdaSolver: parameter scales must be non-zero");
   d.derivatives = sp.derivatives;
@@ -283,10 +285,15 @@ void IdaSolver::startSensitivities(const SensitivityProblem& sp) {
   d.cacheYp = VecX::Zero(n);
   d.check(IDASensInit(d.mem, ns, IDA_STAGGERED, &Impl::sensitivityResidual, d.yS, d.ypS), "IDASensInit");
   // p = NULL: the parameters enter through the user's sensitivity residual; pbar scales
-  // the estimated sensitivity tolerances atol_j / |pbar_i| (IDAS guide, IDASensEEtolerances).
+  // the error weights of the sensitivities (IDAS guide, IDASetSensParams).
   std::vector<realtype> pbar(sp.scales.data(), sp.scales.data() + ns);
   d.check(IDASetSensParams(d.mem, nullptr, pbar.data(), nullptr), "IDASetSensParams");
-  d.check(IDASensEEtolerances(d.mem), "IDASensEEtolerances");
+  N_Vector* atolS = N_VCloneVectorArray(ns, d.yy);
+  if (!atolS) throw SolverError("IDAS sensitivities: out of memory", 0.0, 0.0);
+  for (int i = 0; i < ns; ++i) Eigen::Map<VecX>(N_VGetArrayPointer(atolS[i]), n) = sp.atolS.col(i);
+  const int flag = IDASensSVtolerances(d.mem, d.rtol, atolS);  // IDAS copies them
+  N_VDestroyVectorArray(atolS, ns);
+  d.check(flag, "IDASensSVtolerances");
   d.check(IDASetSensErrCon(d.mem, sp.errorControl ? SUNTRUE : SUNFALSE), "IDASetSensErrCon");
   s_ = sp.s0;
   sp_ = sp.sp0;

@@ -25,9 +25,12 @@ struct SensitivityProblem {
   MatX s0;   ///< consistent initial sensitivities dy0/dp (n x count)
   MatX sp0;  ///< their rates dy0'/dp (n x count)
   /// Typical magnitude of each parameter (count): the sensitivity s_i enters the error
-  /// test with the state's tolerances divided by |scale_i| (IDAS "estimated" tolerances),
-  /// so that p_i s_i is controlled like y.
+  /// test with the state's relative tolerance and absolute tolerances atolS.col(i), the
+  /// state's ones divided by |scale_i| (IDAS guide, "estimated" sensitivity tolerances), so
+  /// that p_i s_i is controlled like y.
   VecX scales;
+  /// Absolute tolerances of the sensitivities (n x count).
+  MatX atolS;
   /// The sensitivities take part in the local error test (IDASetSensErrCon). Off: the
   /// steps are those of the plain run and the sensitivities follow them uncontrolled.
   bool errorControl = true;

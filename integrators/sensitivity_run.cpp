@@ -21,6 +21,13 @@ double parameterStep(double p) {
   return shifted - p;
 }
 
+MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize, const VecX& scales) {
+  const double factor = std::max(1.0, kSensitivityNoiseFloor * modelSize / frameAtol);
+  MatX out(atol.size(), scales.size());
+  for (Eigen::Index i = 0; i < scales.size(); ++i) out.col(i) = atol * (factor / std::fabs(scales[i]));
+  return out;
+}
+
 // ----- dF/dp by central differences of the perturbed residuals ------------------------
 
 ResidualDifferences::ResidualDifferences(std::vector<Pair> pairs) : pairs_(std::move(pairs)) {
@@ -186,7 +193,10 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
 
   // integrate output by output
   ResidualDifferences derivatives(pairs);
-  const SensitivityProblem problem{&derivatives, s0.s0, s0.sp0, scales, sensitivity.errorControl};
+  const SensitivityProblem problem{&derivatives, s0.s0, s0.sp0, scales,
+                                   sensitivityTolerances(choice.options.atol, choice.tolerances.position,
+                                                         start.modelSize, scales),
+                                   sensitivity.errorControl};
   RunState state;
   state.kind = IntegratorKind::Ida;
   auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, problem);

@@ -23,6 +23,17 @@ inline const double kParameterStepFraction = std::cbrt(2.220446049250313e-16);
 /// Magnitude below which a parameter's step is taken from 1 (SI units of the key): a
 /// parameter at 0 (an offset, an initial velocity) still gets a step of 6e-6.
 inline constexpr double kParameterTypicalMagnitude = 1.0;
+/// Relative noise floor of the sensitivities: dF/dp by central differences carries the
+/// round-off eps |F| / (2 h) = eps^(2/3) / 2 ~ 2e-11 of the residual's scale, so p s is
+/// known to about that fraction of the state's scale; the sensitivities' absolute
+/// tolerances are held above 5 times it (otherwise the error test chases the noise: rtol
+/// 1e-11, atol 1e-13 failed at the first steps of a pendulum).
+inline constexpr double kSensitivityNoiseFloor = 1e-10;
+/// The sensitivities' absolute tolerances (n x count): atol_j max(1, floor L / atol) /
+/// |scale_i|, atol_j the state's, L the model size, `atol` the frame positions' tolerance
+/// (the class tolerances are atol times the class's scale over L, so the factor holds each
+/// class at kSensitivityNoiseFloor of its scale).
+MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize, const VecX& scales);
 /// The step h = eps^(1/3) max(|p|, 1) of a parameter of value p, rounded so that p + h
 /// and p - h are exact in floating point.
 double parameterStep(double p);
