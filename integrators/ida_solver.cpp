@@ -155,8 +155,8 @@ struct IdaSolver::Impl {
     }
   }
 
-  /// The sensitivity residuals F_y s_i + F_y' s_i' + F_p_i (IDAS guide, the forward
-  /// sensitivity system of F(t, y, y', p) = 0).
+  /// The sensitivity residuals F_y s_i + F_y' s_i' + F_p_i: the forward sensitivity system
+  /// of F(t, y, y', p) = 0 (Hindmarsh et al. 2005, ACM TOMS 31(3); docs/sensitivities.md).
   static int sensitivityResidual(int ns, realtype t, N_Vector y, N_Vector yp, N_Vector, N_Vector* yS,
                                  N_Vector* ypS, N_Vector* resS, void* user, N_Vector, N_Vector, N_Vector) {
     auto* self = static_cast<Impl*>(user);

@@ -16,7 +16,7 @@ namespace flexmbd {
 
 double parameterStep(double p) {
   const double h = kParameterStepFraction * std::max(std::fabs(p), kParameterTypicalMagnitude);
-  // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, eq. 5.7.4)
+  // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, sec. 5.7)
   const volatile double shifted = p + h;
   return shifted - p;
 }
@@ -43,7 +43,7 @@ void ResidualDifferences::residualDerivative(int i, double t, const double* y, c
   p.plus->residual(t, y, yp, dFdp, *plusScratch_[static_cast<std::size_t>(i)]);
   p.minus->residual(t, y, yp, minusResidual_.data(), *minusScratch_[static_cast<std::size_t>(i)]);
   const auto n = minusResidual_.size();
-  // dF/dp = (F(p + h) - F(p - h)) / (2 h) + O(h^2) (central difference)
+  // dF/dp = (F(p + h) - F(p - h)) / (2 h) + O(h^2) (central difference, Nocedal & Wright 2006, sec. 8.1)
   Eigen::Map<VecX> d(dFdp, n);
   d = (d - minusResidual_) / (2.0 * p.step);
 }
@@ -86,7 +86,8 @@ InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vect
       const ConsistentState c = computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
       dae->packState(c.q, c.v, c.a, c.lambda, *y, *yp);
     }
-    // s0 = dy0/dp, s0' = dy0'/dp by central differences of the consistent initialisation
+    // s0 = dy0/dp, s0' = dy0'/dp: central differences (Nocedal & Wright 2006, sec. 8.1) of the
+    // consistent initialisation (docs/sensitivities.md, "Consistent initial sensitivities")
     s.s0.col(static_cast<Eigen::Index>(i)) = (yPlus - yMinus) / (2.0 * pairs[i].step);
     s.sp0.col(static_cast<Eigen::Index>(i)) = (ypPlus - ypMinus) / (2.0 * pairs[i].step);
   }

@@ -78,7 +78,7 @@ void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::stri
     resultRow(*scenes.plus[i], columns, sample.perturbed[i].plus, plus);
     resultRow(*scenes.minus[i], columns, sample.perturbed[i].minus, minus);
     const double h = scenes.parameters[i].step;
-    // dc/dp = (c(p + h, y + h s) - c(p - h, y - h s)) / (2 h) + O(h^2)
+    // dc/dp = (c(p + h, y + h s) - c(p - h, y - h s)) / (2 h) + O(h^2) (docs/sensitivities.md, "Output derivatives")
     for (std::size_t c = 1; c < columns.size(); ++c) values.push_back((plus[c] - minus[c]) / (2.0 * h));
   }
 }
