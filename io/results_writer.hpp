@@ -76,7 +76,7 @@ class ResultsWriter {
   /// @throws NonFiniteResult for an added value that is inf or NaN, std::invalid_argument
   /// if `added` does not match the added columns.
   void write(const OutputSample& sample, const std::vector<double>& added);
-  /// Adds columns after those of the scene (a sensitivity run's d<column>/d<parameter>),
+  /// Adds columns after those of the scene (a sensitivity run's d\<column\>/d\<parameter\>),
   /// before the first row. @throws std::logic_error after it.
   void addColumns(const std::vector<std::string>& names);
   /// The values of the last row written (all columns).

@@ -1,7 +1,7 @@
 /// @file
 /// The scene side of a sensitivity run (docs/sensitivities.md): the parameters named by
 /// scene paths, the scenes rebuilt with each parameter a step up and down, the results
-/// columns d<column>/d<parameter> and the gradients of the summary's scalars.
+/// columns d\<column\>/d\<parameter\> and the gradients of the summary's scalars.
 #pragma once
 
 #include <memory>
@@ -30,7 +30,7 @@ struct SensitivityScenes {
 SensitivityScenes buildSensitivityScenes(const std::string& sceneText, const std::string& source, const Scene& base,
                                          const std::vector<std::string>& paths);
 
-/// "d<column>/d<parameter>" for every column but t, parameter by parameter.
+/// "d\<column\>/d\<parameter\>" for every column but t, parameter by parameter.
 std::vector<std::string> sensitivityColumns(const std::vector<std::string>& columns,
                                             const std::vector<SensitivityParameter>& parameters);
 
