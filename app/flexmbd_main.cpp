@@ -1,5 +1,6 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
+//                                    [--sensitivity PATH ...] [--no-sensitivity-error-control]
 //     (scenes with "model": "tensegrity": app/tensegrity_command.cpp)
 //   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
@@ -18,6 +19,7 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,8 +36,10 @@
 #include "core/number_text.hpp"
 #include "integrators/simulation.hpp"
 #include "io/output_lock.hpp"
+#include "io/json_reader.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "io/sensitivity_results.hpp"
 #include "io/vtk_writer.hpp"
 
 #ifndef FLEXMBD_VERSION
@@ -54,6 +58,7 @@ using cli::kExitInputError;
 const char* const kUsage =
     "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A]\n"
     "                   [--format csv|hdf5] [--vtk] [--quiet]\n"
+    "                   [--sensitivity PATH ...] [--no-sensitivity-error-control]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
     "                          [--corrector newton|modified_newton] [--quiet]\n"
     "       flexmbd summary DIR\n"
@@ -90,6 +95,12 @@ const char* const kUsage =
     "  --vtk        also write DIR/vtk/bodies_NNNNNN.vtu per output and bodies.pvd (ParaView;\n"
     "               bodies, or the nodes and members of a tensegrity scene)\n"
     "  --quiet, -q  no progress display\n"
+    "  --sensitivity PATH  (repeatable) forward sensitivities with respect to the scene's\n"
+    "               number at PATH (a dotted path such as bodies[1].mass or\n"
+    "               forces[0].stiffness): results get a column d<column>/d<PATH> per\n"
+    "               column, summary.json \"sensitivities\" the gradients of the final and\n"
+    "               largest values (IDAS; docs/sensitivities.md)\n"
+    "  --no-sensitivity-error-control  the sensitivities out of the local error test\n"
     "  --help, -h   this text\n"
     "\n"
     "kinematics analyses the linkage of SCENE.json (see docs/kinematics.md) step by step in\n"
@@ -150,7 +161,31 @@ struct Options {
   bool quiet = false;
   bool vtk = false;  ///< also write DIR/vtk/bodies_*.vtu and bodies.pvd
   ResultsFormat format = ResultsFormat::Csv;  ///< --format
+  std::vector<std::string> sensitivities;  ///< --sensitivity PATH (repeatable), in order
+  bool sensitivityErrorControl = true;     ///< off with --no-sensitivity-error-control
 };
+
+/// Takes the repeatable --sensitivity PATH (or --sensitivity=PATH) out of `args` into `o`.
+void takeSensitivityOptions(std::vector<std::string>& args, Options& o) {
+  std::vector<std::string> rest;
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (a == "--sensitivity") {
+      if (k + 1 >= args.size() || args[k + 1].empty()) {
+        throw UsageError("option --sensitivity needs a scene path (e.g. --sensitivity bodies[1].mass)");
+      }
+      o.sensitivities.push_back(args[++k]);
+    } else if (a.rfind("--sensitivity=", 0) == 0) {
+      if (a.size() == 14) throw UsageError("option --sensitivity needs a scene path (e.g. --sensitivity bodies[1].mass)");
+      o.sensitivities.push_back(a.substr(14));
+    } else if (a == "--no-sensitivity-error-control") {
+      o.sensitivityErrorControl = false;
+    } else {
+      rest.push_back(a);
+    }
+  }
+  args = rest;
+}
 
 /// Significant digits of times and CPU seconds in messages (fmt, core/number_text.hpp).
 constexpr int kNumberDigits = 6;
@@ -178,6 +213,7 @@ Options parseCommandLine(int argc, char** argv) {
     throw UsageError("unknown command '" + args[0] +
                      "' (expected 'run', 'kinematics', 'summary', 'plot', 'modes', 'sid', 'view', '--help' or '--version')");
   }
+  takeSensitivityOptions(args, o);
   const cli::SplitArguments split =
       cli::splitArguments({args.begin() + 1, args.end()},
                           cli::withCommon(cli::kCommonValueOptions, {"--t-end", "--rtol", "--atol", "--format"}),
@@ -226,8 +262,47 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
   return kExitInputError;
 }
 
+/// The run with forward sensitivities (docs/sensitivities.md): each output row with its
+/// d<column>/d<parameter> values, their gradients summarised; a failure after the input
+/// was accepted returns a failed summary (rows kept), as simulateKeepingFailures.
+SimulationSummary runWithSensitivities(const Scene& scene, const SensitivityScenes& sensitivities, bool errorControl,
+                                       ResultsWriter& writer, std::optional<VtkWriter>& vtk,
+                                       SensitivitySummary& gradients) {
+  const std::clock_t start = std::clock();
+  double lastDone = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> derivatives;
+  const std::vector<std::string> columns = resultColumns(scene);
+  try {
+    return simulateWithSensitivities(
+        scene.system, sensitivities.parameters, scene.solver, SensitivitySettings{errorControl},
+        [&](const OutputSample& sample, const SensitivitySample& sensitivity) {
+          sensitivityRow(sensitivities, columns, sensitivity, derivatives);
+          writer.write(sample, derivatives);
+          gradients.add(writer.lastRow(), derivatives);
+          if (vtk) vtk->write(sample);
+          lastDone = sample.t;
+          if (sample.t < scene.solver.tEnd) stopIfSignalled(sample.t);
+        });
+  } catch (const InputError&) {  // includes ModelError: nothing was integrated
+    throw;
+  } catch (const std::exception& e) {  // IDAS could not start, ...: a failed run
+    SimulationSummary summary;
+    summary.ok = false;
+    summary.message = e.what();
+    const auto* solver = dynamic_cast<const SolverError*>(&e);
+    summary.tReached = solver ? solver->time() : lastDone;
+    summary.cpuSeconds = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
+    return summary;
+  }
+}
+
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
+    if (!o.sensitivities.empty()) {
+      printError("--sensitivity is not available for tensegrity scenes (forward sensitivities run on the DAE "
+                 "integrator IDAS: multibody scenes only)");
+      return kExitInputError;
+    }
     if (o.format != ResultsFormat::Csv) {
       printError("--format hdf5 is not available for tensegrity scenes (their results are results.csv and "
                  "events.csv)");
@@ -247,6 +322,7 @@ int runCommand(const Options& o) {
 
   // ----- input: scene, overrides, settings (exit 2 on any error) -----
   std::optional<Scene> scene;
+  std::optional<SensitivityScenes> sensitivities;
   try {
     scene.emplace(loadScene(o.scenePath));
     SolverSettings& s = scene->solver;
@@ -260,14 +336,21 @@ int runCommand(const Options& o) {
     overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (integrators/tolerances.hpp)
     s.progress = !o.quiet;
     checkSolverSettings(s);
+    if (!o.sensitivities.empty()) {  // the scene read again with each parameter a step up and down
+      sensitivities.emplace(
+          buildSensitivityScenes(jsonread::readSceneFile(o.scenePath), o.scenePath, *scene, o.sensitivities));
+    }
   } catch (const std::exception& e) {
     return reportInputError(outDir, e.what());
   }
 
   std::optional<ResultsWriter> writer;
   std::optional<VtkWriter> vtk;
+  std::vector<std::string> sceneColumns;
   try {
     writer.emplace(outDir, *scene, o.format);
+    sceneColumns = writer->columns();
+    if (sensitivities) writer->addColumns(sensitivityColumns(sceneColumns, sensitivities->parameters));
     if (o.vtk) {
       vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system, "bodies", 4, scene->geometry, scene->feBodies);
       for (const std::string& b : vtk->bodiesNotDrawn()) {
@@ -286,13 +369,19 @@ int runCommand(const Options& o) {
 
   // ----- the run -----
   SimulationSummary summary;
+  std::optional<SensitivitySummary> gradients;
   try {
     const StopOnSignals stop;  // a signal stops the run within its step
-    summary = simulateKeepingFailures(scene->system, scene->solver, [&](const OutputSample& sample) {
-      writer->write(sample);
-      if (vtk) vtk->write(sample);
-      if (sample.t < scene->solver.tEnd) stopIfSignalled(sample.t);  // the last row: the run is complete
-    });
+    if (sensitivities) {
+      gradients.emplace(sceneColumns, sensitivities->parameters);
+      summary = runWithSensitivities(*scene, *sensitivities, o.sensitivityErrorControl, *writer, vtk, *gradients);
+    } else {
+      summary = simulateKeepingFailures(scene->system, scene->solver, [&](const OutputSample& sample) {
+        writer->write(sample);
+        if (vtk) vtk->write(sample);
+        if (sample.t < scene->solver.tEnd) stopIfSignalled(sample.t);  // the last row: the run is complete
+      });
+    }
   } catch (const InputError& e) {
     // Includes ModelError: the model cannot be set up (assembly, redundant or
     // conflicting constraints). Nothing was integrated.
@@ -311,7 +400,9 @@ int runCommand(const Options& o) {
   const std::string what = summary.interruptedBySignal || summary.outputFailed ? summary.message
                                                                                : "solver failure: " + summary.message;
   try {
-    writeSummary(outDir, summary, *scene, o.scenePath);
+    const nlohmann::json sensitivitySummary =
+        gradients ? gradients->toJson(o.sensitivityErrorControl) : nlohmann::json();
+    writeSummary(outDir, summary, *scene, o.scenePath, gradients ? &sensitivitySummary : nullptr);
   } catch (const std::exception& e) {
     printError((summary.ok ? std::string() : what + " (" + kept + "); ") + "cannot write the summary: " + e.what());
     return summary.ok ? kExitSolverFailure : failureStatus;

@@ -6,7 +6,7 @@
 // elastic coordinates (amplitude and energy per mode of K_ff phi = omega^2 M_ff phi).
 //
 //   diag_steps SCENE.json [--t-end T] [--rtol R] [--atol A] [--every N]
-#include <ida/ida.h>
+#include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>

@@ -1,6 +1,6 @@
 #include "integrators/ida_solver.hpp"
 
-#include <ida/ida.h>
+#include <idas/idas.h>
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
@@ -46,7 +46,24 @@ struct IdaSolver::Impl {
   std::exception_ptr pending;
   std::string lastIdaMessage;  // last message of IDA's error handler
 
+  // forward sensitivities (docs/sensitivities.md); ns = 0 without
+  ParameterDerivatives* derivatives = nullptr;
+  int ns = 0;
+  N_Vector* yS = nullptr;
+  N_Vector* ypS = nullptr;
+  // dF/dy and dF/dy' (CSC values on the DAE's pattern) and dF/dp (n x ns) at the state
+  // (cacheT, cacheY, cacheYp): the staggered corrector calls the sensitivity residual
+  // several times at one converged state, the matrices are made once per state.
+  std::vector<double> jy, jyp;
+  MatX dFdp;
+  VecX cacheY, cacheYp;
+  double cacheT = 0.0;
+  bool cacheValid = false;
+  double rtol = 0.0;  ///< the state's relative tolerance (the sensitivities' too)
+
   ~Impl() {
+    if (yS) N_VDestroyVectorArray(yS, ns);
+    if (ypS) N_VDestroyVectorArray(ypS, ns);
     if (mem) IDAFree(&mem);
     if (LS) SUNLinSolFree(LS);
     if (A) SUNMatDestroy(A);
@@ -105,6 +122,63 @@ struct IdaSolver::Impl {
     }
   }
 
+  /// dF/dy = J(cj = 0), dF/dy' = J(1) - J(0) (DaeProblem::jacobian) and dF/dp at (t, y, y'),
+  /// unless they are those of the last call.
+  void updateSensitivityMatrices(double t, const double* y, const double* yp) {
+    const auto n = static_cast<Eigen::Index>(cacheY.size());
+    const Eigen::Map<const VecX> Y(y, n), Yp(yp, n);
+    if (cacheValid && t == cacheT && Y == cacheY && Yp == cacheYp) return;
+    const SparsePattern& p = dae->pattern();
+    std::fill(jy.begin(), jy.end(), 0.0);
+    JacobianSink sy = JacobianSink::sparse(jy.data(), p);
+    dae->jacobian(t, y, yp, 0.0, sy, *scratch);
+    std::fill(jyp.begin(), jyp.end(), 0.0);
+    JacobianSink syp = JacobianSink::sparse(jyp.data(), p);
+    dae->jacobian(t, y, yp, 1.0, syp, *scratch);
+    for (std::size_t k = 0; k < jyp.size(); ++k) jyp[k] -= jy[k];
+    for (int i = 0; i < ns; ++i) derivatives->residualDerivative(i, t, y, yp, dFdp.col(i).data());
+    cacheT = t;
+    cacheY = Y;
+    cacheYp = Yp;
+    cacheValid = true;
+  }
+
+  /// r += A x for A in CSC values on the DAE's pattern.
+  void addProduct(const std::vector<double>& A, const double* x, double* r) const {
+    const SparsePattern& p = dae->pattern();
+    const auto& cs = p.colStart();
+    const auto& ri = p.rowIndex();
+    for (int c = 0; c < p.size(); ++c) {
+      const double xc = x[c];
+      if (xc == 0.0) continue;
+      for (int64_t k = cs[c]; k < cs[c + 1]; ++k) r[ri[k]] += A[k] * xc;
+    }
+  }
+
+  /// The sensitivity residuals F_y s_i + F_y' s_i' + F_p_i: the forward sensitivity system
+  /// of F(t, y, y', p) = 0 (Hindmarsh et al. 2005, ACM TOMS 31(3); docs/sensitivities.md).
+  static int sensitivityResidual(int ns, realtype t, N_Vector y, N_Vector yp, N_Vector, N_Vector* yS,
+                                 N_Vector* ypS, N_Vector* resS, void* user, N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      self->updateSensitivityMatrices(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
+      const auto n = static_cast<Eigen::Index>(self->cacheY.size());
+      for (int i = 0; i < ns; ++i) {
+        double* r = N_VGetArrayPointer(resS[i]);
+        Eigen::Map<VecX>(r, n) = self->dFdp.col(i);
+        self->addProduct(self->jy, N_VGetArrayPointer(yS[i]), r);
+        self->addProduct(self->jyp, N_VGetArrayPointer(ypS[i]), r);
+        for (Eigen::Index k = 0; k < n; ++k) {
+          if (!std::isfinite(r[k])) return 1;  // recoverable: a smaller step
+        }
+      }
+      return 0;
+    } catch (...) {
+      self->pending = std::current_exception();
+      return -1;
+    }
+  }
+
   static void errorHandler(int, const char* module, const char* function, char* msg, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->lastIdaMessage = std::string(module) + "/" + function + ": " + msg;
@@ -141,6 +215,7 @@ IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const Vec
   d.check(IDASetErrHandlerFn(d.mem, &Impl::errorHandler, &d), "IDASetErrHandlerFn");
   d.check(IDAInit(d.mem, &Impl::residual, t0, d.yy, d.yp), "IDAInit");
   d.check(IDASVtolerances(d.mem, o.rtol, d.atol), "IDASVtolerances");
+  d.rtol = o.rtol;
   d.check(IDASetUserData(d.mem, &d), "IDASetUserData");
   d.check(IDASetId(d.mem, d.id), "IDASetId");
   d.check(IDASetSuppressAlg(d.mem, SUNTRUE), "IDASetSuppressAlg");
@@ -178,6 +253,58 @@ IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const Vec
   yp_ = yp0;
 }
 
+IdaSolver::IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, const IntegratorOptions& o,
+                     const SensitivityProblem& sensitivity)
+    : IdaSolver(dae, t0, y0, yp0, o) {
+  startSensitivities(sensitivity);
+}
+
+void IdaSolver::startSensitivities(const SensitivityProblem& sp) {
+  Impl& d = *impl_;
+  const int n = d.dae->size();
+  if (!sp.derivatives) throw InputError("IdaSolver: sensitivities without their parameter derivatives");
+  const int ns = sp.derivatives->count();
+  if (ns < 1 || sp.s0.rows() != n || sp.sp0.rows() != n || sp.s0.cols() != ns || sp.sp0.cols() != ns ||
+      sp.scales.size() != ns || sp.atolS.rows() != n || sp.atolS.cols() != ns) {
+    throw InputError("IdaSolver: initial sensitivities and their tolerances must be n x count, scales of size count");
+  }
+  if (!(sp.scales.cwiseAbs().minCoeff() > 0.0)) throw InputError("IdaSolver: parameter scales must be non-zero");
+  d.derivatives = sp.derivatives;
+  d.yS = N_VCloneVectorArray(ns, d.yy);
+  d.ypS = N_VCloneVectorArray(ns, d.yy);
+  if (!d.yS || !d.ypS) throw SolverError("IDAS sensitivities: out of memory", 0.0, 0.0);
+  d.ns = ns;
+  for (int i = 0; i < ns; ++i) {
+    Eigen::Map<VecX>(N_VGetArrayPointer(d.yS[i]), n) = sp.s0.col(i);
+    Eigen::Map<VecX>(N_VGetArrayPointer(d.ypS[i]), n) = sp.sp0.col(i);
+  }
+  d.jy.assign(static_cast<std::size_t>(d.dae->pattern().nonZeros()), 0.0);
+  d.jyp = d.jy;
+  d.dFdp = MatX::Zero(n, ns);
+  d.cacheY = VecX::Zero(n);
+  d.cacheYp = VecX::Zero(n);
+  d.check(IDASensInit(d.mem, ns, IDA_STAGGERED, &Impl::sensitivityResidual, d.yS, d.ypS), "IDASensInit");
+  // p = NULL: the parameters enter through the user's sensitivity residual; pbar scales
+  // the error weights of the sensitivities (IDAS guide, IDASetSensParams).
+  std::vector<realtype> pbar(sp.scales.data(), sp.scales.data() + ns);
+  d.check(IDASetSensParams(d.mem, nullptr, pbar.data(), nullptr), "IDASetSensParams");
+  N_Vector* atolS = N_VCloneVectorArray(ns, d.yy);
+  if (!atolS) throw SolverError("IDAS sensitivities: out of memory", 0.0, 0.0);
+  for (int i = 0; i < ns; ++i) Eigen::Map<VecX>(N_VGetArrayPointer(atolS[i]), n) = sp.atolS.col(i);
+  const int flag = IDASensSVtolerances(d.mem, d.rtol, atolS);  // IDAS copies them
+  N_VDestroyVectorArray(atolS, ns);
+  d.check(flag, "IDASensSVtolerances");
+  d.check(IDASetSensErrCon(d.mem, sp.errorControl ? SUNTRUE : SUNFALSE), "IDASetSensErrCon");
+  s_ = sp.s0;
+  sp_ = sp.sp0;
+}
+
+long IdaSolver::sensitivityResidualEvals() const {
+  long v = 0;
+  if (impl_->ns > 0) IDAGetSensNumResEvals(impl_->mem, &v);
+  return v;
+}
+
 IdaSolver::~IdaSolver() = default;
 
 double IdaSolver::advance(double tout, double tStop) {
@@ -204,6 +331,15 @@ double IdaSolver::advance(double tout, double tStop) {
   }
   y_ = Eigen::Map<const VecX>(N_VGetArrayPointer(d.yy), n);
   yp_ = Eigen::Map<const VecX>(N_VGetArrayPointer(d.yp), n);
+  if (d.ns > 0) {
+    realtype ts = 0.0;
+    d.check(IDAGetSens(d.mem, &ts, d.yS), "IDAGetSens");
+    d.check(IDAGetSensDky(d.mem, tret, 1, d.ypS), "IDAGetSensDky");
+    for (int i = 0; i < d.ns; ++i) {
+      s_.col(i) = Eigen::Map<const VecX>(N_VGetArrayPointer(d.yS[i]), n);
+      sp_.col(i) = Eigen::Map<const VecX>(N_VGetArrayPointer(d.ypS[i]), n);
+    }
+  }
   return tret;
 }
 

@@ -118,6 +118,7 @@ ResultsWriter::ResultsWriter(const std::filesystem::path& dir, const Scene& scen
   reserveSummary(dir);
 
   columns_ = resultColumns(scene);
+  sceneColumns_ = columns_;
   joints_ = std::make_unique<SpatialJointOutputs>(scene.system);
 }
 
@@ -223,10 +224,28 @@ void ResultsWriter::open() {
   bytes_ = static_cast<long long>(header.size());
 }
 
-void ResultsWriter::write(const OutputSample& s) {
+void ResultsWriter::addColumns(const std::vector<std::string>& names) {
+  if (rows_ > 0 || fd_ >= 0 || h5_) throw std::logic_error("ResultsWriter::addColumns after the first row");
+  columns_.insert(columns_.end(), names.begin(), names.end());
+}
+
+void ResultsWriter::write(const OutputSample& s) { write(s, {}); }
+
+void ResultsWriter::write(const OutputSample& s, const std::vector<double>& added) {
+  if (added.size() != columns_.size() - sceneColumns_.size()) {
+    throw std::invalid_argument("ResultsWriter::write: " + std::to_string(added.size()) + " added values for " +
+                                std::to_string(columns_.size() - sceneColumns_.size()) + " added columns");
+  }
   // The whole row first: a row with a non-finite value is not written (the run stops).
-  std::vector<double> values;
-  resultRow(scene_, columns_, s, values, *joints_);
+  std::vector<double>& values = row_;
+  resultRow(scene_, sceneColumns_, s, values, *joints_);
+  for (std::size_t k = 0; k < added.size(); ++k) {
+    if (!std::isfinite(added[k])) {
+      throw NonFiniteResult("non-finite value " + std::string(std::isnan(added[k]) ? "nan" : "inf") + " in column \"" +
+                            columns_[sceneColumns_.size() + k] + "\" at t = " + timeText(s.t));
+    }
+    values.push_back(added[k]);
+  }
   if (format_ == ResultsFormat::Hdf5) {
     if (!h5_) {
       auto file = std::make_unique<Hdf5RowFile>();
@@ -437,13 +456,14 @@ std::string summaryJson(const SimulationSummary& summary, const Scene& scene) {
 }
 
 void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene,
-                  const std::string& sceneFile) {
+                  const std::string& sceneFile, const nlohmann::json* sensitivities) {
   nlohmann::ordered_json j = summaryObject(summary, scene);
   if (!sceneFile.empty()) {
     std::error_code ec;
     const std::filesystem::path absolute = std::filesystem::absolute(sceneFile, ec);
     j["scene_file"] = ec ? sceneFile : absolute.lexically_normal().string();
   }
+  if (sensitivities) j["sensitivities"] = nlohmann::ordered_json::parse(sensitivities->dump());
   writeJsonFile(dir, j);
 }
 

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "integrators/simulation.hpp"
 #include "io/scene.hpp"
 #include "joints/joint_outputs.hpp"
@@ -70,6 +72,15 @@ class ResultsWriter {
   /// OutputWriteError (naming the file, the time and the system's reason) if the file
   /// cannot be written, std::runtime_error if the sample has the wrong sizes.
   void write(const OutputSample& sample);
+  /// The same with the values of the columns added by addColumns() (in their order).
+  /// @throws NonFiniteResult for an added value that is inf or NaN, std::invalid_argument
+  /// if `added` does not match the added columns.
+  void write(const OutputSample& sample, const std::vector<double>& added);
+  /// Adds columns after those of the scene (a sensitivity run's d\<column\>/d\<parameter\>),
+  /// before the first row. @throws std::logic_error after it.
+  void addColumns(const std::vector<std::string>& names);
+  /// The values of the last row written (all columns).
+  const std::vector<double>& lastRow() const { return row_; }
 
   const std::vector<std::string>& columns() const { return columns_; }
   const std::filesystem::path& resultsPath() const { return path_; }
@@ -85,6 +96,8 @@ class ResultsWriter {
   std::filesystem::path path_;
   std::unique_ptr<Hdf5RowFile> h5_;  ///< results.h5, opened at the first row
   std::vector<std::string> columns_;
+  std::vector<std::string> sceneColumns_;  ///< resultColumns(scene): the first columns
+  std::vector<double> row_;                ///< the last row
   std::unique_ptr<SpatialJointOutputs> joints_;  ///< unwraps the joint angles over the rows
   int fd_ = -1;                ///< results.csv, opened at the first row
   long long bytes_ = 0;        ///< size of results.csv up to its last complete row
@@ -142,8 +155,10 @@ void writeSummaryText(const std::filesystem::path& dir, const std::string& text)
 /// scene_file (the absolute path of the scene file, when `sceneFile` is given: `flexmbd
 /// view` reads the scene from it).
 /// Creates `dir` if needed; the file is replaced atomically (written beside, renamed).
+/// `sensitivities` (a sensitivity run, io/sensitivity_results.hpp): written as the key
+/// "sensitivities" after the others.
 void writeSummary(const std::filesystem::path& dir, const SimulationSummary& summary, const Scene& scene,
-                  const std::string& sceneFile = "");
+                  const std::string& sceneFile = "", const nlohmann::json* sensitivities = nullptr);
 
 /// Writes DIR/summary.json for a run that stopped on an input or model error before
 /// integrating: {"status": "failed", "message": ..., "error": "input"}.

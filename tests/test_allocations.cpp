@@ -29,6 +29,9 @@
 #include "io/scene.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/radau_solver.hpp"
+#include "integrators/sensitivity_run.hpp"
+#include "io/json_reader.hpp"
+#include "io/sensitivity_results.hpp"
 #include "integrators/simulation.hpp"
 
 // AddressSanitizer replaces the allocation functions itself: under it (make sanitize)
@@ -154,6 +157,25 @@ Scene loadExample(const std::string& name) {
 TEST(Allocations, RigidSliderCrank) {
   const Scene s = loadExample("slider_crank_rigid.json");
   expectAllocationFree(s.system, "rigid slider crank");
+}
+
+// dF/dp of a sensitivity run (integrators/sensitivity_run.hpp): the perturbed systems'
+// residuals with their own scratch, no allocation per call.
+TEST(Allocations, SensitivityResidualDerivative) {
+  if (!FLEXMBD_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  const std::string path = std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_elastic.json";
+  const std::string text = jsonread::readSceneFile(path);
+  const Scene base = parseSceneText(text, path);
+  const SensitivityScenes sc = buildSensitivityScenes(text, path, base, {"bodies[1].section.density"});
+  const DaeSystem dae(base.system, Formulation::Ggl), plus(sc.plus[0]->system, Formulation::Ggl),
+      minus(sc.minus[0]->system, Formulation::Ggl);
+  ResidualDifferences d({{&plus, &minus, sc.parameters[0].step}});
+  VecX y, yp, dFdp(dae.size());
+  genericState(dae, y, yp);
+  d.residualDerivative(0, 0.01, y.data(), yp.data(), dFdp.data());
+  EXPECT_EQ(allocationsIn([&] { d.residualDerivative(0, 0.02, y.data(), yp.data(), dFdp.data()); }), 0)
+      << "heap allocations in one dF/dp";
+  EXPECT_GT(dFdp.cwiseAbs().maxCoeff(), 0.0);  // M(q) v' depends on the density
 }
 
 TEST(Allocations, NodalElasticSliderCrank) {

@@ -1,0 +1,109 @@
+// Benchmark (issue 29): the cost of forward sensitivities. CPU of a plain IDA run and of
+// runs with p = 1, 2, 4 parameters (IDAS, staggered corrector, sensitivity error control
+// on), each as a ratio to the plain run, against the issue's target of about 1 + 0.5 p
+// runs. Models: the rigid slider crank (examples/slider_crank_rigid.json, 10 revolutions)
+// and the elastic one (examples/slider_crank_elastic.json, 8 nodal beam elements, 1
+// revolution at 150 rad/s). Each figure is the smallest CPU time of `--repeat` runs (the
+// machine is shared: the minimum is the least disturbed); outputs are formed as the
+// command line forms them (results row, and its derivative columns).
+//
+// Usage: bench_sensitivities [--repeat N]
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "integrators/sensitivity_run.hpp"
+#include "io/results_writer.hpp"
+#include "io/sensitivity_results.hpp"
+
+using namespace flexmbd;
+
+namespace {
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+double cpuSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
+
+struct Figures {
+  double seconds = 0.0;
+  long steps = 0;
+};
+
+Figures plainRun(const std::string& text) {
+  Scene s = parseSceneText(text);
+  s.solver.progress = false;
+  s.solver.integrator = IntegratorKind::Ida;
+  const std::vector<std::string> columns = resultColumns(s);
+  std::vector<double> row;
+  const std::clock_t start = std::clock();
+  const SimulationSummary summary =
+      simulate(s.system, s.solver, [&](const OutputSample& o) { resultRow(s, columns, o, row); });
+  return {cpuSince(start), summary.stats.steps};
+}
+
+Figures sensitivityRun(const std::string& text, const std::vector<std::string>& paths) {
+  Scene s = parseSceneText(text);
+  s.solver.progress = false;
+  const SensitivityScenes perturbed = buildSensitivityScenes(text, "<scene>", s, paths);
+  const std::vector<std::string> columns = resultColumns(s);
+  std::vector<double> row, d;
+  const std::clock_t start = std::clock();
+  const SimulationSummary summary = simulateWithSensitivities(
+      s.system, perturbed.parameters, s.solver, {}, [&](const OutputSample& o, const SensitivitySample& sens) {
+        resultRow(s, columns, o, row);
+        sensitivityRow(perturbed, columns, sens, d);
+      });
+  return {cpuSince(start), summary.stats.steps};
+}
+
+template <class Run>
+Figures best(int repeat, Run run) {
+  Figures b;
+  for (int k = 0; k < repeat; ++k) {
+    const Figures f = run();
+    if (k == 0 || f.seconds < b.seconds) b = f;
+  }
+  return b;
+}
+
+void benchmark(const char* name, const std::string& text, const std::vector<std::string>& parameters, int repeat) {
+  const Figures plain = best(repeat, [&] { return plainRun(text); });
+  std::printf("%-22s p = 0: %8.4f s CPU, %6ld steps (plain IDA run)\n", name, plain.seconds, plain.steps);
+  for (const std::size_t p : {1u, 2u, 4u}) {
+    const std::vector<std::string> paths(parameters.begin(), parameters.begin() + static_cast<long>(p));
+    const Figures f = best(repeat, [&] { return sensitivityRun(text, paths); });
+    std::printf("%-22s p = %zu: %8.4f s CPU, %6ld steps, %5.2f plain runs (target 1 + 0.5 p = %.1f)\n", name, p,
+                f.seconds, f.steps, f.seconds / plain.seconds, 1.0 + 0.5 * static_cast<double>(p));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int repeat = 3;
+  for (int k = 1; k + 1 < argc; ++k) {
+    if (std::strcmp(argv[k], "--repeat") == 0) repeat = std::max(1, std::atoi(argv[k + 1]));
+  }
+  nlohmann::json rigid = nlohmann::json::parse(readText(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_rigid.json"));
+  rigid["solver"]["t_end"] = 10 * 6.283185307179586;
+  benchmark("rigid slider crank", rigid.dump(), {"bodies[2].mass", "joints[2].points[0][0]", "bodies[1].mass", "bodies[1].inertia"},
+            repeat);
+  nlohmann::json elastic =
+      nlohmann::json::parse(readText(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_elastic.json"));
+  elastic["solver"]["t_end"] = 0.041887902047863905;
+  benchmark("elastic slider crank", elastic.dump(),
+            {"bodies[2].mass", "bodies[1].section.youngs_modulus", "bodies[1].section.height", "bodies[0].mass"}, repeat);
+  return 0;
+}

@@ -1,0 +1,231 @@
+#include "integrators/sensitivity_run.hpp"
+
+#include <cmath>
+#include <ctime>
+#include <exception>
+
+#include "core/errors.hpp"
+#include "core/linear_algebra.hpp"
+#include "core/system_evaluation.hpp"
+#include "integrators/ida_solver.hpp"
+#include "integrators/output_recorder.hpp"
+#include "integrators/run_stages.hpp"
+#include "integrators/run_state.hpp"
+
+namespace flexmbd {
+
+double parameterStep(double p) {
+  const double h = kParameterStepFraction * std::max(std::fabs(p), kParameterTypicalMagnitude);
+  // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, sec. 5.7)
+  const volatile double shifted = p + h;
+  return shifted - p;
+}
+
+MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize, const VecX& scales) {
+  const double factor = std::max(1.0, kSensitivityNoiseFloor * modelSize / frameAtol);
+  MatX out(atol.size(), scales.size());
+  for (Eigen::Index i = 0; i < scales.size(); ++i) out.col(i) = atol * (factor / std::fabs(scales[i]));
+  return out;
+}
+
+// ----- dF/dp by central differences of the perturbed residuals ------------------------
+
+ResidualDifferences::ResidualDifferences(std::vector<Pair> pairs) : pairs_(std::move(pairs)) {
+  for (const Pair& p : pairs_) {
+    plusScratch_.push_back(p.plus->makeScratch());
+    minusScratch_.push_back(p.minus->makeScratch());
+  }
+  if (!pairs_.empty()) minusResidual_ = VecX::Zero(pairs_.front().plus->size());
+}
+
+void ResidualDifferences::residualDerivative(int i, double t, const double* y, const double* yp, double* dFdp) {
+  const Pair& p = pairs_[static_cast<std::size_t>(i)];
+  p.plus->residual(t, y, yp, dFdp, *plusScratch_[static_cast<std::size_t>(i)]);
+  p.minus->residual(t, y, yp, minusResidual_.data(), *minusScratch_[static_cast<std::size_t>(i)]);
+  const auto n = minusResidual_.size();
+  // dF/dp = (F(p + h) - F(p - h)) / (2 h) + O(h^2) (central difference, Nocedal & Wright 2006, sec. 8.1)
+  Eigen::Map<VecX> d(dFdp, n);
+  d = (d - minusResidual_) / (2.0 * p.step);
+}
+
+// ----- structure and initial sensitivities ------------------------------------------
+
+void requireSameStructure(const DaeSystem& base, const DaeSystem& perturbed, const std::string& parameter) {
+  const auto refuse = [&](const std::string& what, long a, long b) {
+    throw InputError("sensitivity parameter '" + parameter + "': changing it changes " + what + " (" +
+                     std::to_string(a) + " at its value, " + std::to_string(b) +
+                     " a step away): expected a parameter that keeps the model's structure (a mass, a length, a "
+                     "stiffness, ...; not a count of elements or modes)");
+  };
+  const System& a = base.system();
+  const System& b = perturbed.system();
+  if (a.numCoordinates() != b.numCoordinates()) refuse("the number of coordinates", a.numCoordinates(), b.numCoordinates());
+  if (a.numVelocities() != b.numVelocities()) refuse("the number of velocities", a.numVelocities(), b.numVelocities());
+  if (a.numConstraintEquations() != b.numConstraintEquations()) {
+    refuse("the number of constraint equations", a.numConstraintEquations(), b.numConstraintEquations());
+  }
+  if (base.size() != perturbed.size()) refuse("the number of unknowns", base.size(), perturbed.size());
+  const SparsePattern& pa = base.pattern();
+  const SparsePattern& pb = perturbed.pattern();
+  if (pa.colStart() != pb.colStart() || pa.rowIndex() != pb.rowIndex()) {
+    refuse("the Jacobian's sparsity pattern (non-zeros)", pa.nonZeros(), pb.nonZeros());
+  }
+}
+
+InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
+                                          const ConsistentState& init, double t0) {
+  const int n = base.size();
+  InitialSensitivities s{MatX::Zero(n, static_cast<Eigen::Index>(pairs.size())),
+                         MatX::Zero(n, static_cast<Eigen::Index>(pairs.size()))};
+  const ReleasedEquations released{false, init.released};
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    VecX yPlus, ypPlus, yMinus, ypMinus;
+    for (const auto& [dae, y, yp] : {std::tuple{pairs[i].plus, &yPlus, &ypPlus}, std::tuple{pairs[i].minus, &yMinus, &ypMinus}}) {
+      const System& sys = dae->system();
+      // the perturbed system's own consistent state from its own initial values (q0(p), v0(p))
+      const ConsistentState c = computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
+      dae->packState(c.q, c.v, c.a, c.lambda, *y, *yp);
+    }
+    // s0 = dy0/dp, s0' = dy0'/dp: central differences (Nocedal & Wright 2006, sec. 8.1) of the
+    // consistent initialisation (docs/sensitivities.md, "Consistent initial sensitivities")
+    s.s0.col(static_cast<Eigen::Index>(i)) = (yPlus - yMinus) / (2.0 * pairs[i].step);
+    s.sp0.col(static_cast<Eigen::Index>(i)) = (ypPlus - ypMinus) / (2.0 * pairs[i].step);
+  }
+  return s;
+}
+
+// ----- the run ----------------------------------------------------------------------
+
+namespace {
+
+/// The sample of the system `sys` at (q, v) as the recorder makes it (accelerations and
+/// multipliers from the state; minimum-norm multipliers of a released set).
+OutputSample perturbedSample(const System& sys, double t, VecX q, VecX v, const std::vector<int>& released) {
+  OutputSample s;
+  s.t = t;
+  s.q = std::move(q);
+  s.v = std::move(v);
+  computeAccelerations(sys, t, s.q, s.v, s.a, s.lambda, released);
+  if (!released.empty()) {
+    MatX G;
+    evaluateConstraints(sys, s.q, t, nullptr, &G);
+    s.lambda = minimumNormMultipliers(G, s.lambda);
+  }
+  return s;
+}
+
+/// The sensitivities of positions and velocities at an output, and the perturbed samples.
+SensitivitySample sensitivitySample(const DaeLayout& L, const MatX& S, const std::vector<SensitivityParameter>& params,
+                                    const OutputSample& base, const std::vector<int>& released) {
+  SensitivitySample out;
+  out.q = S.middleRows(L.q, L.nq);
+  out.v = S.middleRows(L.v, L.nv);
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const auto c = static_cast<Eigen::Index>(i);
+    const double h = params[i].step;
+    out.perturbed.push_back({perturbedSample(*params[i].plus, base.t, base.q + h * out.q.col(c),
+                                             base.v + h * out.v.col(c), released),
+                             perturbedSample(*params[i].minus, base.t, base.q - h * out.q.col(c),
+                                             base.v - h * out.v.col(c), released)});
+  }
+  return out;
+}
+
+}  // namespace
+
+SimulationSummary simulateWithSensitivities(const System& sys, const std::vector<SensitivityParameter>& params,
+                                            const SolverSettings& given, const SensitivitySettings& sensitivity,
+                                            const SensitivityCallback& onOutput) {
+  given.validate();
+  if (params.empty()) throw InputError("sensitivities: no parameter given");
+  if (given.integrator != IntegratorKind::Automatic && given.integrator != IntegratorKind::Ida) {
+    throw InputError("solver.integrator: sensitivities are computed by IDAS only: expected \"ida\" or \"auto\", got \"" +
+                     toString(given.integrator) + "\"");
+  }
+  if (given.elasticStart != ElasticStart::Given) {
+    throw InputError("solver.elastic_start: sensitivities need the elastic start \"given\", got \"" +
+                     toString(given.elasticStart) + "\"");
+  }
+  if (given.finiteDifferenceJacobian) {
+    throw InputError("solver.fd_jacobian: sensitivities use the analytic Jacobian: expected false");
+  }
+  SolverSettings settings = given;
+  settings.integrator = IntegratorKind::Ida;
+  const std::clock_t cpuStart = std::clock();
+  const double t0 = settings.tStart, tEnd = settings.tEnd;
+
+  // start: the consistent state, the perturbed DAEs (same structure), s0 and s0'
+  ReleasedEquations released;
+  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
+  const ConsistentState init =
+      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
+  const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
+  std::vector<std::unique_ptr<DaeSystem>> perturbed;
+  std::vector<ResidualDifferences::Pair> pairs;
+  VecX scales(static_cast<Eigen::Index>(params.size()));
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const SensitivityParameter& p = params[i];
+    for (const System* s : {p.plus, p.minus}) {
+      if (!s || !s->isFinalized()) throw InputError("sensitivity parameter '" + p.name + "': no finalized system");
+      perturbed.push_back(std::make_unique<DaeSystem>(*s, settings.formulation, defaultStabilisationMetric(*s),
+                                                      init.released));
+      requireSameStructure(dae, *perturbed.back(), p.name);
+    }
+    pairs.push_back({perturbed[perturbed.size() - 2].get(), perturbed.back().get(), p.step});
+    scales[static_cast<Eigen::Index>(i)] = std::max(std::fabs(p.value), kParameterTypicalMagnitude);
+  }
+  const InitialSensitivities s0 = initialSensitivities(dae, pairs, init, t0);
+  const RunStart start = startRun(dae, init, t0);
+
+  // the outputs: the recorder's sample with the sensitivities of the state it was made from
+  const MatX* currentS = &s0.s0;
+  const OutputCallback withSensitivities = [&](const OutputSample& s) {
+    if (onOutput) onOutput(s, sensitivitySample(dae.layout(), *currentS, params, s, dae.releasedEquations()));
+  };
+  OutputRecorder recorder(sys, start.modelSize, withSensitivities, dae.releasedEquations());
+  if (const std::optional<RunFailure> stop = recordInitialOutput(recorder, dae.layout(), start, t0)) {
+    return summaryAtStart(start, recorder.recorded(), *stop);
+  }
+
+  // choose: IDA's options as a plain run with "ida" would take them
+  const ModelScales modelScale = modelScales(sys, init.v, t0, tEnd);
+  ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings, &modelScale);
+  choice.reason = "forward sensitivities are computed by IDAS";
+
+  // integrate output by output
+  ResidualDifferences derivatives(pairs);
+  const SensitivityProblem problem{&derivatives, s0.s0, s0.sp0, scales,
+                                   sensitivityTolerances(choice.options.atol, choice.tolerances.position,
+                                                         start.modelSize, scales),
+                                   sensitivity.errorControl};
+  RunState state;
+  state.kind = IntegratorKind::Ida;
+  auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, problem);
+  IdaSolver& solver = *ida;
+  state.usedKlu = solver.usesKlu();
+  state.integrator = std::move(ida);
+  currentS = &solver.sensitivity();
+  const OutputSchedule outputs(t0, tEnd, settings.outputStep);
+  ProgressReporter progress(settings.progress, t0, tEnd, "ida+sensitivities");
+  const DaeLayout& L = dae.layout();
+  const RunContext ctx{sys, dae, settings, choice.options, outputs, start.modelSize, start.startRatio, false};
+  std::optional<RunFailure> failure;
+  try {
+    for (long k = 1; k <= outputs.count; ++k) {
+      const double t = solver.advance(outputs.time(k), tEnd);
+      requireStepBudget(ctx, state, t);
+      recorder.record(t, solver.y().segment(L.q, L.nq), solver.y().segment(L.v, L.nv));
+      progress.update(t, solver.stats().steps);
+    }
+  } catch (...) {
+    const FailureContext failed{sys, recorder.recorded(), start.modelSize, start.startRatio,
+                             solver.stats().currentTime, &dae.releasedEquations()};
+    failure = diagnoseFailure(std::current_exception(), failed);
+  }
+  SimulationSummary summary = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
+  for (const int r : dae.releasedEquations()) summary.redundantConstraints.push_back(sys.describeEquation(r));
+  summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
+  return summary;
+}
+
+}  // namespace flexmbd

@@ -1,0 +1,145 @@
+#include "io/sensitivity_results.hpp"
+
+#include <cmath>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "core/errors.hpp"
+#include "core/number_text.hpp"
+#include "io/results_writer.hpp"
+#include "io/scene_path.hpp"
+
+namespace flexmbd {
+namespace {
+
+using nlohmann::json;
+
+/// The scene with the parameter at `value`, read by the scene reader.
+std::unique_ptr<Scene> sceneAt(const json& base, const std::string& source, const std::string& path, double value) {
+  json j = base;
+  setSceneNumber(j, path, value);
+  try {
+    // dump() writes the shortest text that reads back the same double (nlohmann: Grisu2)
+    return std::make_unique<Scene>(parseSceneText(j.dump(), source));
+  } catch (const InputError& e) {
+    throw InputError("sensitivity parameter '" + path + "': the scene with " + path + " = " + fmt(value) +
+                     " (a step of the central difference) is not valid: " + e.what());
+  }
+}
+
+}  // namespace
+
+SensitivityScenes buildSensitivityScenes(const std::string& sceneText, const std::string& source, const Scene& base,
+                                         const std::vector<std::string>& paths) {
+  const json j = json::parse(sceneText);
+  const std::vector<std::string> columns = resultColumns(base);
+  SensitivityScenes out;
+  std::set<std::string> seen;
+  for (const std::string& path : paths) {
+    if (!seen.insert(path).second) {
+      throw InputError("sensitivity parameter '" + path + "': given twice (expected each parameter once)");
+    }
+    double p = 0.0;
+    try {
+      p = sceneNumber(j, path);
+    } catch (const InputError& e) {
+      throw InputError("sensitivity parameter: " + std::string(e.what()));
+    }
+    const double h = parameterStep(p);
+    out.plus.push_back(sceneAt(j, source, path, p + h));
+    out.minus.push_back(sceneAt(j, source, path, p - h));
+    for (const Scene* s : {out.plus.back().get(), out.minus.back().get()}) {
+      if (resultColumns(*s) != columns) {
+        throw InputError("sensitivity parameter '" + path +
+                         "': changing it changes the results columns: expected a parameter that keeps the model's "
+                         "structure");
+      }
+    }
+    out.parameters.push_back({path, p, h, &out.plus.back()->system, &out.minus.back()->system});
+  }
+  return out;
+}
+
+std::vector<std::string> sensitivityColumns(const std::vector<std::string>& columns,
+                                            const std::vector<SensitivityParameter>& parameters) {
+  std::vector<std::string> names;
+  for (const SensitivityParameter& p : parameters) {
+    for (std::size_t c = 1; c < columns.size(); ++c) names.push_back("d" + columns[c] + "/d" + p.name);
+  }
+  return names;
+}
+
+void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::string>& columns,
+                    const SensitivitySample& sample, std::vector<double>& values) {
+  values.clear();
+  std::vector<double> plus, minus;
+  for (std::size_t i = 0; i < scenes.parameters.size(); ++i) {
+    resultRow(*scenes.plus[i], columns, sample.perturbed[i].plus, plus);
+    resultRow(*scenes.minus[i], columns, sample.perturbed[i].minus, minus);
+    const double h = scenes.parameters[i].step;
+    // dc/dp = (c(p + h, y + h s) - c(p - h, y - h s)) / (2 h) + O(h^2) (docs/sensitivities.md, "Output derivatives")
+    for (std::size_t c = 1; c < columns.size(); ++c) values.push_back((plus[c] - minus[c]) / (2.0 * h));
+  }
+}
+
+SensitivitySummary::SensitivitySummary(std::vector<std::string> columns,
+                                       const std::vector<SensitivityParameter>& parameters)
+    : columns_(std::move(columns)) {
+  for (const SensitivityParameter& p : parameters) {
+    names_.push_back(p.name);
+    values_.push_back(p.value);
+    steps_.push_back(p.step);
+  }
+  const std::size_t nc = columns_.size() - 1, np = names_.size();
+  finalValues_.assign(nc, 0.0);
+  maxAbs_.assign(nc, -1.0);
+  maxTime_.assign(nc, 0.0);
+  finalDerivatives_.assign(nc * np, 0.0);
+  maxDerivatives_.assign(nc * np, 0.0);
+}
+
+void SensitivitySummary::add(const std::vector<double>& row, const std::vector<double>& d) {
+  const std::size_t nc = columns_.size() - 1, np = names_.size();
+  any_ = true;
+  for (std::size_t c = 0; c < nc; ++c) {
+    const double v = row[c + 1];
+    finalValues_[c] = v;
+    const bool larger = std::fabs(v) > maxAbs_[c];
+    if (larger) {
+      maxAbs_[c] = std::fabs(v);
+      maxTime_[c] = row[0];
+    }
+    for (std::size_t i = 0; i < np; ++i) {
+      const double dv = d[i * nc + c];
+      finalDerivatives_[c * np + i] = dv;
+      // d max|c| / dp = sign(c) dc/dp at the output of the maximum
+      if (larger) maxDerivatives_[c * np + i] = (v < 0.0 ? -dv : dv);
+    }
+  }
+}
+
+json SensitivitySummary::toJson(bool errorControl) const {
+  json out;
+  out["parameters"] = json::array();
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    out["parameters"].push_back({{"path", names_[i]}, {"value", values_[i]}, {"step", steps_[i]}});
+  }
+  out["error_control"] = errorControl;
+  json finals = json::object(), maxima = json::object();
+  const std::size_t nc = columns_.size() - 1, np = names_.size();
+  for (std::size_t c = 0; any_ && c < nc; ++c) {
+    json f = json::object(), g = json::object();
+    for (std::size_t i = 0; i < np; ++i) {
+      f[names_[i]] = finalDerivatives_[c * np + i];
+      g[names_[i]] = maxDerivatives_[c * np + i];
+    }
+    finals[columns_[c + 1]] = {{"value", finalValues_[c]}, {"gradient", f}};
+    maxima[columns_[c + 1]] = {{"value", maxAbs_[c]}, {"t", maxTime_[c]}, {"gradient", g}};
+  }
+  out["final"] = finals;
+  out["max_abs"] = maxima;
+  return out;
+}
+
+}  // namespace flexmbd
