@@ -11,12 +11,12 @@ using nlohmann::json;
 
 constexpr const char* kExpected = "expected a scene key such as 'solver.t_end' or 'bodies[1].mass'";
 
-[[noreturn]] void badPath(const std::string& path, const std::string& what) {
-  throw InputError("scene path '" + path + "': " + what);
+[[noreturn]] void badPath(const std::string& path, const std::string& what, const char* role = "scene path") {
+  throw InputError(std::string(role) + " '" + path + "': " + what);
 }
 
 /// The integer between '[' and ']', or the error naming it.
-long parseIndex(const std::string& path, const std::string& text) {
+long parseIndex(const std::string& path, const std::string& text, const char* role) {
   std::size_t used = 0;
   long k = 0;
   try {
@@ -24,7 +24,7 @@ long parseIndex(const std::string& path, const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (text.empty() || used != text.size()) badPath(path, "[" + text + "] is not an index (" + kExpected + ")");
+  if (text.empty() || used != text.size()) badPath(path, "[" + text + "] is not an index (" + kExpected + ")", role);
   return k;
 }
 
@@ -70,25 +70,25 @@ Json& numberAt(Json& root, const std::string& path) {
 
 }  // namespace
 
-std::vector<ScenePathPart> parseScenePath(const std::string& path) {
-  if (path.empty()) badPath(path, std::string("the key is empty (") + kExpected + ")");
+std::vector<ScenePathPart> parseScenePath(const std::string& path, const char* role) {
+  if (path.empty()) badPath(path, std::string("the key is empty (") + kExpected + ")", role);
   std::vector<ScenePathPart> parts;
   std::size_t start = 0;
   while (true) {  // one piece between dots: name[k][k]...
     const std::size_t dot = path.find('.', start);
     std::string piece = path.substr(start, dot == std::string::npos ? std::string::npos : dot - start);
-    if (piece.empty()) badPath(path, std::string("an empty name between dots (") + kExpected + ")");
+    if (piece.empty()) badPath(path, std::string("an empty name between dots (") + kExpected + ")", role);
     std::size_t open = piece.find('[');
     const std::string name = piece.substr(0, open);
-    if (name.find(']') != std::string::npos) badPath(path, std::string("']' without its '[' (") + kExpected + ")");
+    if (name.find(']') != std::string::npos) badPath(path, std::string("']' without its '[' (") + kExpected + ")", role);
     if (!name.empty()) parts.push_back({false, name, 0});
     while (open != std::string::npos) {
       const std::size_t close = piece.find(']', open);
-      if (close == std::string::npos) badPath(path, std::string("'[' without its ']' (") + kExpected + ")");
-      parts.push_back({true, "", parseIndex(path, piece.substr(open + 1, close - open - 1))});
+      if (close == std::string::npos) badPath(path, std::string("'[' without its ']' (") + kExpected + ")", role);
+      parts.push_back({true, "", parseIndex(path, piece.substr(open + 1, close - open - 1), role)});
       const std::size_t next = close + 1;
       if (next < piece.size() && piece[next] != '[') {
-        badPath(path, "text after ']' that is not another [index] (" + std::string(kExpected) + ")");
+        badPath(path, "text after ']' that is not another [index] (" + std::string(kExpected) + ")", role);
       }
       open = next < piece.size() ? next : std::string::npos;
     }

@@ -19,9 +19,11 @@ struct ScenePathPart {
 };
 
 /// The keys and indices of `path`: names separated by dots, each followed by any number of
-/// [k] (k an integer, negative from the end). @throws InputError naming the path and what
-/// is wrong (empty, an empty name between dots, '[' without ']', an index that is not an integer).
-std::vector<ScenePathPart> parseScenePath(const std::string& path);
+/// [k] (k an integer, negative from the end). The one parser of the syntax: Python's
+/// apply_overrides calls it too (role "override").
+/// @throws InputError "<role> '<path>': <what>" (empty, an empty name between dots, '['
+/// without ']', an index that is not an integer, text after ']').
+std::vector<ScenePathPart> parseScenePath(const std::string& path, const char* role = "scene path");
 
 /// The number at `path` in a scene's JSON. @throws InputError naming the path: the key or
 /// element that does not exist, a value that is not a number (booleans are not numbers).

@@ -26,6 +26,7 @@
 #include "io/json_reader.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "io/scene_path.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
 #include "bindings_support.hpp"
@@ -709,4 +710,20 @@ PYBIND11_MODULE(_flexmbd, m) {
       py::arg("path"),
       "The bytes of a scene file by the command line's rules (a regular file of at most 64 MiB; InputError "
       "naming the path otherwise)");
+  m.def(
+      "parse_scene_path",
+      [](const std::string& path) {
+        py::list out;
+        for (const ScenePathPart& p : parseScenePath(path, "override")) {
+          if (p.isIndex) {
+            out.append(py::int_(p.index));
+          } else {
+            out.append(py::str(p.key));
+          }
+        }
+        return out;
+      },
+      py::arg("path"),
+      "The keys (str) and list indices (int) of a dotted scene path 'bodies[1].section.area', parsed by the "
+      "engine's one parser of the syntax (io/scene_path.hpp); InputError \"override '<path>': ...\" otherwise");
 }

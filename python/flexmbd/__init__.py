@@ -285,30 +285,10 @@ def _merge(target, value):
 
 
 def _path_parts(path):
-    """The names and indices of a dotted path "bodies[1].section.area", or InputError."""
-    expected = "expected a scene key such as 'solver.t_end' or 'bodies[1].mass'"
-    if not path:
-        raise InputError(f"override {path!r}: the key is empty ({expected})")
-    parts = []
-    for piece in path.split("."):
-        if not piece:
-            raise InputError(f"override {path!r}: an empty name between dots ({expected})")
-        while "[" in piece:
-            name, rest = piece.split("[", 1)
-            if name:
-                parts.append(name)
-            if "]" not in rest:
-                raise InputError(f"override {path!r}: '[' without its ']' ({expected})")
-            index, piece = rest.split("]", 1)
-            try:
-                parts.append(int(index))
-            except ValueError:
-                raise InputError(f"override {path!r}: [{index}] is not an index ({expected})") from None
-        if "]" in piece:
-            raise InputError(f"override {path!r}: ']' without its '[' ({expected})")
-        if piece:
-            parts.append(piece)
-    return parts
+    """The names and indices of a dotted path "bodies[1].section.area", or InputError
+    (parsed by the engine, io/scene_path.hpp: the one parser of the syntax, which
+    sensitivity parameters use too)."""
+    return _flexmbd.parse_scene_path(path)
 
 
 def _set_path(root, path, value):
