@@ -263,37 +263,17 @@ int reportInputError(const std::filesystem::path& outDir, const std::string& mes
 }
 
 /// The run with forward sensitivities (docs/sensitivities.md): each output row with its
-/// d<column>/d<parameter> values, their gradients summarised; a failure after the input
-/// was accepted returns a failed summary (rows kept), as simulateKeepingFailures.
+/// d<column>/d<parameter> values, their gradients summarised (runSensitivityScene).
 SimulationSummary runWithSensitivities(const Scene& scene, const SensitivityScenes& sensitivities, bool errorControl,
                                        ResultsWriter& writer, std::optional<VtkWriter>& vtk,
                                        SensitivitySummary& gradients) {
-  const std::clock_t start = std::clock();
-  double lastDone = std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> derivatives;
-  const std::vector<std::string> columns = resultColumns(scene);
-  try {
-    return simulateWithSensitivities(
-        scene.system, sensitivities.parameters, scene.solver, SensitivitySettings{errorControl},
-        [&](const OutputSample& sample, const SensitivitySample& sensitivity) {
-          sensitivityRow(sensitivities, columns, sensitivity, derivatives);
-          writer.write(sample, derivatives);
-          gradients.add(writer.lastRow(), derivatives);
-          if (vtk) vtk->write(sample);
-          lastDone = sample.t;
-          if (sample.t < scene.solver.tEnd) stopIfSignalled(sample.t);
-        });
-  } catch (const InputError&) {  // includes ModelError: nothing was integrated
-    throw;
-  } catch (const std::exception& e) {  // IDAS could not start, ...: a failed run
-    SimulationSummary summary;
-    summary.ok = false;
-    summary.message = e.what();
-    const auto* solver = dynamic_cast<const SolverError*>(&e);
-    summary.tReached = solver ? solver->time() : lastDone;
-    summary.cpuSeconds = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
-    return summary;
-  }
+  return runSensitivityScene(scene, sensitivities, errorControl,
+                             [&](const OutputSample& sample, const std::vector<double>& derivatives) {
+                               writer.write(sample, derivatives);
+                               gradients.add(writer.lastRow(), derivatives);
+                               if (vtk) vtk->write(sample);
+                               if (sample.t < scene.solver.tEnd) stopIfSignalled(sample.t);
+                             });
 }
 
 int runCommand(const Options& o) {

@@ -1,6 +1,8 @@
 #include "io/sensitivity_results.hpp"
 
 #include <cmath>
+#include <ctime>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -80,6 +82,33 @@ void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::stri
     const double h = scenes.parameters[i].step;
     // dc/dp = (c(p + h, y + h s) - c(p - h, y - h s)) / (2 h) + O(h^2) (docs/sensitivities.md, "Output derivatives")
     for (std::size_t c = 1; c < columns.size(); ++c) values.push_back((plus[c] - minus[c]) / (2.0 * h));
+  }
+}
+
+SimulationSummary runSensitivityScene(const Scene& scene, const SensitivityScenes& sensitivities, bool errorControl,
+                                      const SensitivityRowCallback& onRow) {
+  const std::clock_t start = std::clock();
+  double lastDone = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> derivatives;
+  const std::vector<std::string> columns = resultColumns(scene);
+  try {
+    return simulateWithSensitivities(
+        scene.system, sensitivities.parameters, scene.solver, SensitivitySettings{errorControl},
+        [&](const OutputSample& sample, const SensitivitySample& sensitivity) {
+          sensitivityRow(sensitivities, columns, sensitivity, derivatives);
+          onRow(sample, derivatives);
+          lastDone = sample.t;
+        });
+  } catch (const InputError&) {  // includes ModelError: nothing was integrated
+    throw;
+  } catch (const std::exception& e) {  // IDAS could not start, ...: a failed run
+    SimulationSummary summary;
+    summary.ok = false;
+    summary.message = e.what();
+    const auto* solver = dynamic_cast<const SolverError*>(&e);
+    summary.tReached = solver ? solver->time() : lastDone;
+    summary.cpuSeconds = static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC;
+    return summary;
   }
 }
 

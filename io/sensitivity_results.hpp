@@ -4,6 +4,7 @@
 /// columns d\<column\>/d\<parameter\> and the gradients of the summary's scalars.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,6 +39,18 @@ std::vector<std::string> sensitivityColumns(const std::vector<std::string>& colu
 /// (c(plus) - c(minus)) / (2 h), c evaluated by resultRow on the perturbed scenes.
 void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::string>& columns,
                     const SensitivitySample& sample, std::vector<double>& values);
+
+/// One output of a sensitivity run: the sample and the derivatives of its row
+/// (sensitivityColumns' order).
+using SensitivityRowCallback = std::function<void(const OutputSample&, const std::vector<double>&)>;
+
+/// The run of `scene` with forward sensitivities (simulateWithSensitivities), each output's
+/// derivative row made by sensitivityRow; a failure after the input was accepted (IDAS
+/// could not start, ...) returns a failed summary, its rows kept, as
+/// simulateKeepingFailures does. The command line and Python both run this.
+/// @throws InputError (ModelError included): nothing was integrated.
+SimulationSummary runSensitivityScene(const Scene& scene, const SensitivityScenes& sensitivities, bool errorControl,
+                                      const SensitivityRowCallback& onRow);
 
 /// The gradients of the scalar summaries of the results columns: the final value and the
 /// largest magnitude max_k |c(t_k)| (derivative sign(c) dc/dp at the output where it is

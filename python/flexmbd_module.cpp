@@ -27,6 +27,7 @@
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_path.hpp"
+#include "io/sensitivity_results.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
 #include "bindings_support.hpp"
@@ -70,6 +71,38 @@ RunOutput runScene(Scene& scene, bool progress) {
   });
   out.ok = summary.ok;
   out.summary = summaryJson(summary, scene);
+  return out;
+}
+
+/// The run of the scene `text` with forward sensitivities with respect to `paths`
+/// (io/sensitivity_results.hpp): the table holds the scene's columns, then the
+/// d<column>/d<path> columns, as results.csv of `flexmbd run --sensitivity`; the summary
+/// has the "sensitivities" gradients.
+RunOutput runSceneWithSensitivities(const std::string& text, const std::string& source,
+                                    const std::vector<std::string>& paths, bool errorControl, bool progress) {
+  Scene scene = parseSceneText(text, source);
+  scene.solver.progress = progress;
+  checkSolverSettings(scene.solver);
+  const SensitivityScenes sensitivities = buildSensitivityScenes(text, source, scene, paths);
+  RunOutput out;
+  out.columns = resultColumns(scene);
+  SensitivitySummary gradients(out.columns, sensitivities.parameters);
+  const std::vector<std::string> added = sensitivityColumns(out.columns, sensitivities.parameters);
+  SpatialJointOutputs joints(scene.system);
+  std::vector<double> row;
+  const SimulationSummary summary =
+      runSensitivityScene(scene, sensitivities, errorControl, [&](const OutputSample& s, const std::vector<double>& d) {
+        resultRow(scene, out.columns, s, row, joints);
+        gradients.add(row, d);
+        row.insert(row.end(), d.begin(), d.end());
+        out.data.insert(out.data.end(), row.begin(), row.end());
+        ++out.rows;
+      });
+  nlohmann::json json = nlohmann::json::parse(summaryJson(summary, scene));
+  json["sensitivities"] = gradients.toJson(errorControl);
+  out.columns.insert(out.columns.end(), added.begin(), added.end());
+  out.ok = summary.ok;
+  out.summary = json.dump();
   return out;
 }
 
@@ -710,6 +743,24 @@ PYBIND11_MODULE(_flexmbd, m) {
       py::arg("path"),
       "The bytes of a scene file by the command line's rules (a regular file of at most 64 MiB; InputError "
       "naming the path otherwise)");
+  m.def(
+      "_run_scene_text_with_sensitivities",
+      [](const std::string& text, const std::string& source, const std::vector<std::string>& paths, bool errorControl,
+         bool progress) {
+        RunOutput r;
+        {
+          py::gil_scoped_release release;
+          const PythonSignalCheck ctrlC;
+          r = runSceneWithSensitivities(text, source, paths, errorControl, progress);
+        }
+        PythonSignalCheck::raiseIfInterrupted();
+        return py::make_tuple(r.columns, table(r), r.summary, r.ok);
+      },
+      py::arg("text"), py::arg("source"), py::arg("paths"), py::arg("error_control") = true,
+      py::arg("progress") = false,
+      "Runs the scene text with forward sensitivities with respect to the dotted scene paths "
+      "(docs/sensitivities.md): (columns, table, summary JSON, ok), the table's columns those of a plain run "
+      "then d<column>/d<path>");
   m.def(
       "parse_scene_path",
       [](const std::string& path) {

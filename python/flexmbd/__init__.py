@@ -138,6 +138,11 @@ class Results:
     def __contains__(self, column):
         return column in self._index
 
+    def derivative(self, column, parameter):
+        """d column / d parameter over the rows, a NumPy array: the sensitivity column
+        "d<column>/d<parameter>" of a run with ``sensitivities`` (KeyError without it)."""
+        return self[f"d{column}/d{parameter}"]
+
     def __len__(self):
         return self.data.shape[0]
 
@@ -163,8 +168,10 @@ class Scene:
         res = scene.run()
     """
 
-    def __init__(self, name="", _native=None):
+    def __init__(self, name="", _native=None, _text=None, _source=None):
         self._native = _native if _native is not None else _flexmbd.Scene(name)
+        self._text = _text  # the scene JSON it was read from (sensitivities rebuild it)
+        self._source = _source
 
     @property
     def name(self):
@@ -208,13 +215,29 @@ class Scene:
         mode shape's entries; finalizes the system."""
         return self._native.velocity_names
 
-    def run(self, progress=False, raise_on_failure=True):
+    def run(self, progress=False, raise_on_failure=True, sensitivities=None, sensitivity_error_control=True):
         """Runs the model (the GIL is released: runs in threads go on in parallel).
 
         Returns Results. A solver failure raises SolverFailure (its ``results`` hold the
         rows up to the failure) unless raise_on_failure is False; input and model errors
-        raise InputError / ModelError (ValueError) with the engine's message."""
-        columns, data, summary_text, ok = self._native._run(progress)
+        raise InputError / ModelError (ValueError) with the engine's message.
+
+        ``sensitivities``: dotted scene paths ("bodies[1].mass", ...) of parameters whose
+        forward sensitivities IDAS integrates with the run (docs/sensitivities.md): the
+        table then also has a column "d<column>/d<path>" per column and parameter
+        (``Results.derivative``) and the summary the gradients of the final and largest
+        values (``summary["sensitivities"]``). Needs a scene read from a file or a dict
+        (load_scene, scene_from_dict): each parameter's scene is read again a step away."""
+        if sensitivities:
+            if self._text is None:
+                raise InputError("sensitivities need a scene read from a file or a dict (load_scene, "
+                                 "scene_from_dict): each parameter's scene is read again a step away")
+            if isinstance(sensitivities, str):
+                sensitivities = [sensitivities]
+            columns, data, summary_text, ok = _flexmbd._run_scene_text_with_sensitivities(
+                self._text, self._source, list(sensitivities), bool(sensitivity_error_control), progress)
+        else:
+            columns, data, summary_text, ok = self._native._run(progress)
         results = Results(columns, data, json.loads(summary_text))
         if not ok and raise_on_failure:
             s = results.summary
@@ -318,7 +341,7 @@ def _set_path(root, path, value):
 def scene_from_dict(scene_dict, overrides=None, source="<scene>"):
     """A Scene from a scene-format dict (with overrides applied)."""
     text = json.dumps(apply_overrides(scene_dict, overrides))
-    return Scene(_native=_flexmbd.parse_scene_text(text, source))
+    return Scene(_native=_flexmbd.parse_scene_text(text, source), _text=text, _source=source)
 
 
 def read_scene_file(path):
@@ -336,7 +359,7 @@ def load_scene(path, overrides=None):
     """A Scene from a scene file, with any key overridden (apply_overrides). Errors are
     InputError with the engine's message, starting with the path."""
     text, source = _scene_text(path, overrides)
-    return Scene(_native=_flexmbd.parse_scene_text(text, source))
+    return Scene(_native=_flexmbd.parse_scene_text(text, source), _text=text, _source=source)
 
 
 def _scene_text(scene, overrides):
