@@ -13,15 +13,6 @@ using namespace feread;
 
 namespace {
 
-/// The fields of a matrix line: blanks, tabs or commas between, none empty.
-std::vector<std::string> matrixFields(const std::string& t) {
-  std::vector<std::string> fields;
-  for (const std::string& s : splitFields(t, " \t,")) {
-    if (!s.empty()) fields.push_back(s);
-  }
-  return fields;
-}
-
 /// The number of fields of the first data line of `path` (3: FORMAT=COORDINATE, 5:
 /// FORMAT=MATRIX INPUT), or 0 for a file without data lines.
 int fieldsOfFirstLine(const std::string& path) {
@@ -107,8 +98,7 @@ SpMat assembleNodeDof(const std::vector<NodeDofEntry>& in, const std::vector<int
 /// FORMAT=MATRIX INPUT: the DOF are those the two files name, node by node in ascending
 /// label order, each node's directions in order.
 void readMatrixInput(FeBodyData& d, const std::string& massPath, const std::string& stiffnessPath) {
-  std::map<long, int> index;
-  for (int a = 0; a < d.numNodes(); ++a) index[d.nodeIds[a]] = a;
+  const std::map<long, int> index = labelIndex(d);
   const std::vector<NodeDofEntry> m = readNodeDofEntries(massPath, d, index);
   const std::vector<NodeDofEntry> k = readNodeDofEntries(stiffnessPath, d, index);
   std::vector<int> row(6 * static_cast<size_t>(d.numNodes()), -1);
@@ -154,8 +144,7 @@ SpMat readAbaqusPreloadedStiffness(const std::string& path, const FeBodyData& bo
     throw InputError(path + ": the preloaded stiffness is not in FORMAT=MATRIX INPUT; expected lines 'node, DOF, "
                      "node, DOF, value', which name the DOF the preload run kept");
   }
-  std::map<long, int> index;
-  for (int a = 0; a < body.numNodes(); ++a) index[body.nodeIds[a]] = a;
+  const std::map<long, int> index = labelIndex(body);
   const std::vector<NodeDofEntry> entries = readNodeDofEntries(path, body, index);
   std::vector<int> row(6 * static_cast<size_t>(body.numNodes()), -1);
   for (int i = 0; i < body.numDofs(); ++i) row[6 * body.dofs[i].node + body.dofs[i].direction] = i;

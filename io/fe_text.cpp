@@ -133,6 +133,20 @@ std::vector<std::string> words(const std::string& line) {
   return out;
 }
 
+std::vector<std::string> matrixFields(const std::string& line) {
+  std::vector<std::string> out;
+  for (const std::string& s : splitFields(line, " \t,")) {
+    if (!s.empty()) out.push_back(s);
+  }
+  return out;
+}
+
+std::map<long, int> labelIndex(const FeBodyData& d) {
+  std::map<long, int> index;
+  for (int a = 0; a < d.numNodes(); ++a) index[d.nodeIds[a]] = a;
+  return index;
+}
+
 SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage storage, const std::string& dofWhat) {
   TextFile f(path);
   std::vector<MatrixEntry> entries;
@@ -140,10 +154,7 @@ SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage stora
   while (f.next(line)) {
     const std::string t = trimmed(line);
     if (t.empty()) continue;
-    std::vector<std::string> fields;
-    for (const std::string& s : splitFields(t, " \t,")) {
-      if (!s.empty()) fields.push_back(s);
-    }
+    const std::vector<std::string> fields = matrixFields(t);
     if (fields.size() != 3)
       f.fail("the line has " + std::to_string(fields.size()) + " fields; expected 'row column value'");
     const long r = integerField(f, fields[0], "the row"), c = integerField(f, fields[1], "the column");

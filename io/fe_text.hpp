@@ -6,6 +6,7 @@
 #pragma once
 
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -85,6 +86,11 @@ SpMat readRowColumnMatrix(const std::string& path, int n, SymmetricStorage stora
 
 /// The fields of a line separated by blanks or tabs (runs count as one), none empty.
 std::vector<std::string> words(const std::string& line);
+/// The fields of a matrix line separated by blanks, tabs or commas (runs count as one),
+/// none empty: "1, 2, 3.5" and "1 2 3.5" alike.
+std::vector<std::string> matrixFields(const std::string& line);
+/// Node label -> index into d.nodeIds.
+std::map<long, int> labelIndex(const FeBodyData& d);
 
 /// "x", "y", "z", "rotation x", "rotation y", "rotation z": the direction of `f`, for messages.
 std::string dofName(const FeDof& f);
