@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "core/sparse_pattern.hpp"
@@ -46,6 +47,16 @@ class DaeProblem {
   /// J(1) - J(0) is dF/dy' (used by integrators that need the two apart).
   virtual void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
                         DaeScratch& scratch) const = 0;
+
+  /// Whether addRateJacobianProduct() is provided (otherwise an integrator that needs
+  /// dF/dy' x forms it from J(1) - J(0)).
+  virtual bool providesRateJacobianProduct() const { return false; }
+  /// r += dF/dy' x at (t, y, y'), without assembling a Jacobian; x and r of size n.
+  /// Allocates nothing. Only where providesRateJacobianProduct().
+  virtual void addRateJacobianProduct(double /*t*/, const double* /*y*/, const double* /*yp*/,
+                                      const double* /*x*/, double* /*r*/, DaeScratch& /*scratch*/) const {
+    throw std::logic_error("DaeProblem::addRateJacobianProduct: not provided by this problem");
+  }
 
   /// The same with a scratch made for the call (tests, tools; allocates).
   void residual(double t, const double* y, const double* yp, double* F) const {

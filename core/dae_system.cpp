@@ -1,8 +1,8 @@
 #include "core/dae_system.hpp"
 
-
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/stop_request.hpp"
 #include "core/errors.hpp"
@@ -426,10 +426,36 @@ void DaeSystem::packState(const VecX& q, const VecX& v, const VecX& a, const Vec
 void DaeSystem::residual(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
   pollStop(t);  // a SIGINT does not wait for the next output (core/stop_request.hpp)
   if (sys_.velocitiesAreCoordinateRates()) {
-    residualImpl<true>(t, y, yp, F, scratch);
+    residualImpl<true>(t, y, yp, F, scratch, nullptr);
   } else {
-    residualImpl<false>(t, y, yp, F, scratch);
+    residualImpl<false>(t, y, yp, F, scratch, nullptr);
   }
+}
+
+void DaeSystem::residualOfParts(double t, const double* y, const double* yp, double* F, const ResidualParts& parts,
+                                DaeScratch& scratch) const {
+  if (parts.bodies.size() != static_cast<size_t>(sys_.numBodies()) ||
+      parts.forces.size() != static_cast<size_t>(sys_.numForces()) ||
+      parts.constraints.size() != static_cast<size_t>(sys_.numConstraints())) {
+    throw std::logic_error("DaeSystem::residualOfParts: parts of another system");
+  }
+  if (sys_.velocitiesAreCoordinateRates()) {
+    residualImpl<true>(t, y, yp, F, scratch, &parts);
+  } else {
+    residualImpl<false>(t, y, yp, F, scratch, &parts);
+  }
+}
+
+ResidualParts ResidualParts::all(const System& sys) {
+  return {std::vector<char>(static_cast<size_t>(sys.numBodies()), 1),
+          std::vector<char>(static_cast<size_t>(sys.numForces()), 1),
+          std::vector<char>(static_cast<size_t>(sys.numConstraints()), 1)};
+}
+
+ResidualParts ResidualParts::none(const System& sys) {
+  return {std::vector<char>(static_cast<size_t>(sys.numBodies()), 0),
+          std::vector<char>(static_cast<size_t>(sys.numForces()), 0),
+          std::vector<char>(static_cast<size_t>(sys.numConstraints()), 0)};
 }
 
 void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
@@ -441,8 +467,29 @@ void DaeSystem::jacobian(double t, const double* y, const double* yp, double cj,
   }
 }
 
+void DaeSystem::addRateJacobianProduct(double, const double* y, const double*, const double* x, double* r,
+                                       DaeScratch&) const {
+  if (formulation_ == Formulation::Index1) {
+    throw std::logic_error("DaeSystem::addRateJacobianProduct: not provided for the index-1 form");
+  }
+  const DaeLayout& L = layout_;
+  const System& sys = sys_;
+  // dF_q/dq' = I and dF_v/dv' = M(q) of the GGL residual (class comment); nothing else holds y'
+  Eigen::Map<VecX>(r + L.q, L.nq) += ConstMap(x + L.q, L.nq);
+  const ConstMap q(y + L.q, L.nq), xv(x + L.v, L.nv);
+  Eigen::Map<VecX> rv(r + L.v, L.nv);
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    const BodyIndex bi(b);
+    const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
+    if (nqb == 0) continue;
+    const int voff = sys.velocityOffset(bi);
+    sys.body(bi).addMassTimes(q.segment(sys.coordinateOffset(bi), nqb), xv.segment(voff, nvb), rv.segment(voff, nvb));
+  }
+}
+
 template <bool IdentityT>
-void DaeSystem::residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const {
+void DaeSystem::residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch,
+                             const ResidualParts* parts) const {
   const DaeLayout& L = layout_;
   const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
@@ -463,7 +510,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
   for (int b = 0; b < sys.numBodies(); ++b) {
     const BodyIndex bi(b);
     const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
-    if (nqb == 0) continue;
+    if (nqb == 0 || (parts && !parts->bodies[b])) continue;
     const Body& body = sys.body(bi);
     const int voff = sys.velocityOffset(bi);
     const auto qb = q.segment(sys.coordinateOffset(bi), nqb);
@@ -475,6 +522,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     body.addMassTimes(qb, vp.segment(voff, nvb), Fv.segment(voff, nvb));
   }
   for (int f = 0; f < sys.numForces(); ++f) {
+    if (parts && !parts->forces[f]) continue;
     const ForceIndex fi(f);
     const auto& cols = sys.forceColumns(fi);
     ForceScratch& fs = S.forces[f];
@@ -490,6 +538,11 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     const Constraint& con = sys.constraint(ci);
     const auto& cols = sys.constraintColumns(ci);
     const int row = sys.constraintOffset(ci), me = con.numEquations(), nl = static_cast<int>(cols.size());
+    if (parts && !parts->constraints[c]) {  // left out: its rows zero, nothing into F_q and F_v
+      std::fill(F + L.lambda + row, F + L.lambda + row + me, 0.0);
+      if (L.mu >= 0) std::fill(F + L.mu + row, F + L.mu + row + me, 0.0);
+      continue;
+    }
     ConstraintScratch& cs = S.constraints[c];
     const ConstraintEvaluation& ev = cs.ev;
     con.evaluate(sys.constraintStates(ci, q.data()), needH, cs.ev);

@@ -49,6 +49,14 @@ VecX defaultStabilisationMetric(const System& sys);
 ///   F_gv = G v + g_t,
 /// G the velocity Jacobian (m x nv). Index 3 drops mu and F_gv; index 1 replaces F_g by
 /// G v' + (G v)_q T v + g_tt. With T = I (planar models), F_q = q' - v + D G^T mu.
+/// Which components' terms a residual evaluation takes (DaeSystem::residualOfParts): one
+/// flag per body, force and constraint of the system.
+struct ResidualParts {
+  std::vector<char> bodies, forces, constraints;
+  static ResidualParts all(const System& sys);
+  static ResidualParts none(const System& sys);
+};
+
 class DaeSystem final : public DaeProblem {
  public:
   /// @throws InputError if the system is not finalized.
@@ -84,6 +92,22 @@ class DaeSystem final : public DaeProblem {
   void jacobian(double t, const double* y, const double* yp, double cj, JacobianSink& J,
                 DaeScratch& scratch) const override;
 
+  /// The residual with only the terms of the components in `parts`: a left-out body adds
+  /// no mass, internal or gravity terms to F_v, a left-out force nothing, a left-out
+  /// constraint neither its rows (zero) nor its G^T lambda, D G^T mu terms; the terms of no
+  /// component (q' - T v, released rows) stay. The difference of two systems that differ
+  /// only in the components in `parts` is thus their full residuals' difference (ResidualDifferences).
+  /// Allocates nothing. @throws std::logic_error if `parts` does not fit the system.
+  void residualOfParts(double t, const double* y, const double* yp, double* F, const ResidualParts& parts,
+                       DaeScratch& scratch) const;
+
+  /// dF/dy' of the GGL and index-3 forms is I on the q rows and M(q) on the v rows (the
+  /// constraint rows hold no rates): the product costs one mass-matrix product per body.
+  /// Index 1 (G on the multiplier rows) is not provided.
+  bool providesRateJacobianProduct() const override { return formulation_ != Formulation::Index1; }
+  void addRateJacobianProduct(double t, const double* y, const double* yp, const double* x, double* r,
+                              DaeScratch& scratch) const override;
+
   /// Elimination groups for a fill-reducing ordering of the Jacobian (size of y): 0 for
   /// the positions and velocities of elastic coordinates, 1 for frame coordinates
   /// (coupled to their whole body), 2 for multipliers (zero diagonal); KluOrdering
@@ -98,7 +122,8 @@ class DaeSystem final : public DaeProblem {
   // One source for both: instantiated with IdentityT = true for models whose velocities are
   // all coordinate rates (planar), where the T(q) terms compile away, and false otherwise.
   template <bool IdentityT>
-  void residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch) const;
+  void residualImpl(double t, const double* y, const double* yp, double* F, DaeScratch& scratch,
+                    const ResidualParts* parts) const;
   template <bool IdentityT>
   void jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& J,
                     DaeScratch& scratch) const;

@@ -55,6 +55,7 @@ struct IdaSolver::Impl {
   // (cacheT, cacheY, cacheYp): the staggered corrector calls the sensitivity residual
   // several times at one converged state, the matrices are made once per state.
   std::vector<double> jy, jyp;
+  bool rateProduct = false;  ///< dF/dy' s' from DaeProblem::addRateJacobianProduct (jyp unused)
   MatX dFdp;
   VecX cacheY, cacheYp;
   double cacheT = 0.0;
@@ -122,8 +123,8 @@ struct IdaSolver::Impl {
     }
   }
 
-  /// dF/dy = J(cj = 0), dF/dy' = J(1) - J(0) (DaeProblem::jacobian) and dF/dp at (t, y, y'),
-  /// unless they are those of the last call.
+  /// dF/dy = J(cj = 0) (DaeProblem::jacobian) and dF/dp at (t, y, y'), unless they are those
+  /// of the last call; dF/dy' = J(1) - J(0) too where the problem has no product of its own.
   void updateSensitivityMatrices(double t, const double* y, const double* yp) {
     const auto n = static_cast<Eigen::Index>(cacheY.size());
     const Eigen::Map<const VecX> Y(y, n), Yp(yp, n);
@@ -132,10 +133,12 @@ struct IdaSolver::Impl {
     std::fill(jy.begin(), jy.end(), 0.0);
     JacobianSink sy = JacobianSink::sparse(jy.data(), p);
     dae->jacobian(t, y, yp, 0.0, sy, *scratch);
-    std::fill(jyp.begin(), jyp.end(), 0.0);
-    JacobianSink syp = JacobianSink::sparse(jyp.data(), p);
-    dae->jacobian(t, y, yp, 1.0, syp, *scratch);
-    for (std::size_t k = 0; k < jyp.size(); ++k) jyp[k] -= jy[k];
+    if (!rateProduct) {
+      std::fill(jyp.begin(), jyp.end(), 0.0);
+      JacobianSink syp = JacobianSink::sparse(jyp.data(), p);
+      dae->jacobian(t, y, yp, 1.0, syp, *scratch);
+      for (std::size_t k = 0; k < jyp.size(); ++k) jyp[k] -= jy[k];
+    }
     for (int i = 0; i < ns; ++i) derivatives->residualDerivative(i, t, y, yp, dFdp.col(i).data());
     cacheT = t;
     cacheY = Y;
@@ -167,7 +170,12 @@ struct IdaSolver::Impl {
         double* r = N_VGetArrayPointer(resS[i]);
         Eigen::Map<VecX>(r, n) = self->dFdp.col(i);
         self->addProduct(self->jy, N_VGetArrayPointer(yS[i]), r);
-        self->addProduct(self->jyp, N_VGetArrayPointer(ypS[i]), r);
+        if (self->rateProduct) {
+          self->dae->addRateJacobianProduct(t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
+                                            N_VGetArrayPointer(ypS[i]), r, *self->scratch);
+        } else {
+          self->addProduct(self->jyp, N_VGetArrayPointer(ypS[i]), r);
+        }
         for (Eigen::Index k = 0; k < n; ++k) {
           if (!std::isfinite(r[k])) return 1;  // recoverable: a smaller step
         }
@@ -279,7 +287,8 @@ void IdaSolver::startSensitivities(const SensitivityProblem& sp) {
     Eigen::Map<VecX>(N_VGetArrayPointer(d.ypS[i]), n) = sp.sp0.col(i);
   }
   d.jy.assign(static_cast<std::size_t>(d.dae->pattern().nonZeros()), 0.0);
-  d.jyp = d.jy;
+  d.rateProduct = d.dae->providesRateJacobianProduct();
+  if (!d.rateProduct) d.jyp = d.jy;
   d.dFdp = MatX::Zero(n, ns);
   d.cacheY = VecX::Zero(n);
   d.cacheYp = VecX::Zero(n);

@@ -71,7 +71,12 @@ struct SensitivitySettings {
 };
 
 /// dF/dp_i = (F_{p+h}(t, y, y') - F_{p-h}(t, y, y')) / (2 h): error h^2 |F_ppp| / 6 plus
-/// eps |F| / h; each system with its scratch, so evaluations allocate nothing.
+/// eps |F| / h; each system with its scratch, so evaluations allocate nothing. Only the
+/// terms that can differ are evaluated (DaeSystem::residualOfParts): every force and
+/// constraint, and the bodies whose terms differ between the two systems at two test
+/// states (body terms depend on the state only, not on time: a body whose terms agree to
+/// the last bit at a generic state is the same body). A section dimension of one beam
+/// body thus costs that body's terms, not the whole model's; an initial condition none.
 class ResidualDifferences final : public ParameterDerivatives {
  public:
   /// One pair of systems per parameter (the DAEs outlive this object).
@@ -80,12 +85,16 @@ class ResidualDifferences final : public ParameterDerivatives {
     const DaeSystem* minus = nullptr;
     double step = 0.0;
   };
-  explicit ResidualDifferences(std::vector<Pair> pairs);
+  /// The test states are (y0, y0') and a generic state near it (every entry moved).
+  ResidualDifferences(std::vector<Pair> pairs, double t0, const VecX& y0, const VecX& yp0);
   int count() const override { return static_cast<int>(pairs_.size()); }
   void residualDerivative(int i, double t, const double* y, const double* yp, double* dFdp) override;
+  /// The terms evaluated for parameter i.
+  const ResidualParts& parts(int i) const { return parts_[static_cast<std::size_t>(i)]; }
 
  private:
   std::vector<Pair> pairs_;
+  std::vector<ResidualParts> parts_;
   std::vector<std::unique_ptr<DaeScratch>> plusScratch_, minusScratch_;
   VecX minusResidual_;
 };

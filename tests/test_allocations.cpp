@@ -169,9 +169,9 @@ TEST(Allocations, SensitivityResidualDerivative) {
   const SensitivityScenes sc = buildSensitivityScenes(text, path, base, {"bodies[1].section.density"});
   const DaeSystem dae(base.system, Formulation::Ggl), plus(sc.plus[0]->system, Formulation::Ggl),
       minus(sc.minus[0]->system, Formulation::Ggl);
-  ResidualDifferences d({{&plus, &minus, sc.parameters[0].step}});
   VecX y, yp, dFdp(dae.size());
   genericState(dae, y, yp);
+  ResidualDifferences d({{&plus, &minus, sc.parameters[0].step}}, 0.0, y, yp);
   d.residualDerivative(0, 0.01, y.data(), yp.data(), dFdp.data());
   EXPECT_EQ(allocationsIn([&] { d.residualDerivative(0, 0.02, y.data(), yp.data(), dFdp.data()); }), 0)
       << "heap allocations in one dF/dp";

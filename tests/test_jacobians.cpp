@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <ostream>
 #include <random>
@@ -674,6 +675,40 @@ TEST_P(DaeJacobian, SparseSinkEqualsDenseSinkAndStaysInPattern) {
       }
     }
     EXPECT_EQ(mismatches, 0) << at;
+  }
+}
+
+// dF/dy' x from the model's structure (the sensitivity residual's product) against the
+// assembled J(1) - J(0): both exact, so they agree to the round-off of the difference,
+// bounded per row by kRoundOff (|J(0)| + |J(1)|) |x| (a few operations per entry).
+TEST_P(DaeJacobian, RateJacobianProductEqualsAssembledRateJacobian) {
+  const System sys = makeEverythingSystem();
+  const DaeSystem dae(sys, GetParam());
+  if (GetParam() == Formulation::Index1) {
+    EXPECT_FALSE(dae.providesRateJacobianProduct());  // G on the multiplier rows: not provided
+    return;
+  }
+  ASSERT_TRUE(dae.providesRateJacobianProduct());
+  constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
+  const int n = dae.layout().size;
+  Random rnd(kSeed + 50 + static_cast<unsigned>(GetParam()));
+  for (int s = 0; s < kSamples / 2; ++s) {
+    VecX y, yp;
+    randomDaeState(rnd, sys, dae, y, yp);
+    const double t = rnd.uniform(0.0, 2.0);
+    MatX J0 = MatX::Zero(n, n), J1 = MatX::Zero(n, n);
+    JacobianSink s0 = JacobianSink::dense(J0.data(), n), s1 = JacobianSink::dense(J1.data(), n);
+    dae.jacobian(t, y.data(), yp.data(), 0.0, s0);
+    dae.jacobian(t, y.data(), yp.data(), 1.0, s1);
+    const VecX x = rnd.vector(n, -1.0, 1.0);
+    VecX r = VecX::Constant(n, 0.5);  // the product is added to r
+    dae.addRateJacobianProduct(t, y.data(), yp.data(), x.data(), r.data(), *dae.makeScratch());
+    const VecX expected = VecX::Constant(n, 0.5) + (J1 - J0) * x;
+    const VecX bound = kRoundOff * ((J0.cwiseAbs() + J1.cwiseAbs()) * x.cwiseAbs() + VecX::Ones(n));
+    for (int i = 0; i < n; ++i) {
+      EXPECT_LE(std::abs(r[i] - expected[i]), bound[i])
+          << toString(GetParam()) << ", sample " << s << ", row " << i << ": " << r[i] << " vs " << expected[i];
+    }
   }
 }
 

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -291,6 +293,58 @@ TEST(Sensitivities, InitialSensitivitiesSatisfyTheDifferentiatedConstraints) {
 }
 
 // ----- scene paths ---------------------------------------------------------------------
+
+// dF/dp from the parts that differ (ResidualDifferences, DaeSystem::residualOfParts): a
+// section dimension of the rod takes the rod's terms only, the slider's mass the slider's,
+// a joint point and a drive speed no body's; and the derivative equals the central
+// difference of the whole residuals to the latter's round-off, kRoundOff (|F+| + |F-|) / (2 h)
+// per row (the parts' difference leaves out terms that cancel, so it is the more exact).
+TEST(Sensitivities, ParameterDerivativeTakesOnlyTheBodiesThatDiffer) {
+  constexpr double kRoundOff = 8.0 * std::numeric_limits<double>::epsilon();
+  const std::string path = std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_elastic.json";
+  const std::string text = json::parse(readFile(path)).dump();
+  const Scene base = parseSceneText(text, path);
+  const std::vector<std::string> paths{"bodies[1].section.height", "bodies[2].mass", "joints[1].points[0][0]",
+                                       "drivers[0].law.speed"};
+  const std::vector<std::vector<std::string>> expectedBodies{{"rod"}, {"slider"}, {}, {}};
+  const SensitivityScenes sc = buildSensitivityScenes(text, path, base, paths);
+  const DaeSystem dae(base.system, Formulation::Ggl);
+  std::vector<std::unique_ptr<DaeSystem>> systems;
+  std::vector<ResidualDifferences::Pair> pairs;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    systems.push_back(std::make_unique<DaeSystem>(sc.plus[i]->system, Formulation::Ggl));
+    systems.push_back(std::make_unique<DaeSystem>(sc.minus[i]->system, Formulation::Ggl));
+    pairs.push_back({systems[systems.size() - 2].get(), systems.back().get(), sc.parameters[i].step});
+  }
+  // a generic state: every entry non-zero
+  const int n = dae.size();
+  VecX y(n), yp(n);
+  for (int k = 0; k < n; ++k) {
+    y[k] = 0.3 * std::cos(1.7 * k) + 0.01 * k;
+    yp[k] = 0.5 * std::sin(2.3 * k + 0.4);
+  }
+  ResidualDifferences d(pairs, 0.0, y, yp);
+  const System& sys = base.system;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    std::vector<std::string> taken;
+    for (int b = 0; b < sys.numBodies(); ++b) {
+      if (d.parts(static_cast<int>(i)).bodies[static_cast<std::size_t>(b)]) taken.push_back(sys.body(BodyIndex(b)).name());
+    }
+    EXPECT_EQ(taken, expectedBodies[i]) << paths[i];
+    VecX dFdp(n), Fplus(n), Fminus(n);
+    const double t = 0.013;
+    d.residualDerivative(static_cast<int>(i), t, y.data(), yp.data(), dFdp.data());
+    pairs[i].plus->residual(t, y.data(), yp.data(), Fplus.data());
+    pairs[i].minus->residual(t, y.data(), yp.data(), Fminus.data());
+    const double h = sc.parameters[i].step;
+    const VecX whole = (Fplus - Fminus) / (2.0 * h);
+    EXPECT_GT(whole.cwiseAbs().maxCoeff(), 0.0) << paths[i] << ": the residual depends on it";
+    for (int k = 0; k < n; ++k) {
+      const double bound = kRoundOff * (std::fabs(Fplus[k]) + std::fabs(Fminus[k])) / (2.0 * h);
+      EXPECT_LE(std::fabs(dFdp[k] - whole[k]), bound) << paths[i] << ", row " << k;
+    }
+  }
+}
 
 TEST(ScenePath, ReadsAndSetsNumbersAndNamesWhatIsWrong) {
   json j = json::parse(R"({"bodies": [{"mass": 2, "name": "a"}, {"section": {"area": 1e-4}}], "solver": {"rtol": 1e-8}})");

@@ -4,6 +4,8 @@
 // iteration matrix of a spatial model in all three formulations).
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "bodies/rigid_body_3d.hpp"
 #include "core/dae_system.hpp"
 #include "core/rotation_3d.hpp"
@@ -306,6 +308,40 @@ TEST_P(SpatialDaeJacobian, IterationMatrixMatchesFiniteDifferencesAndStaysInTheP
     JacobianSink recorder = JacobianSink::recorder(&written);
     dae.jacobian(t, y.data(), yp.data(), cj, recorder);
     for (const auto& e : written) EXPECT_GE(dae.pattern().find(e.row(), e.col()), 0) << at << ": (" << e.row() << ", " << e.col() << ")";
+  }
+}
+
+// dF/dy' x from the model's structure (I on the q rows, M(q) on the v rows) against the
+// assembled J(1) - J(0), to the round-off of that difference (kRoundOff per row, as the
+// planar test in test_jacobians.cpp).
+TEST_P(SpatialDaeJacobian, RateJacobianProductEqualsAssembledRateJacobian) {
+  Random rnd(kSeed + 50 + static_cast<unsigned>(GetParam()));
+  const System sys = makeSpatialSystem(rnd);
+  const DaeSystem dae(sys, GetParam());
+  if (GetParam() == Formulation::Index1) {
+    EXPECT_FALSE(dae.providesRateJacobianProduct());
+    return;
+  }
+  constexpr double kRoundOff = 64.0 * std::numeric_limits<double>::epsilon();
+  const DaeLayout& L = dae.layout();
+  for (int s = 0; s < kSamples / 2; ++s) {
+    VecX y = rnd.vector(L.size, -2.0, 2.0), yp = rnd.vector(L.size, -2.0, 2.0);
+    for (int b = 1; b < sys.numBodies(); ++b) {
+      y.segment(L.q + sys.coordinateOffset(BodyIndex(b)), 7) = randomCoordinates(rnd);
+    }
+    const double t = rnd.uniform(0.0, 2.0);
+    MatX J0 = MatX::Zero(L.size, L.size), J1 = MatX::Zero(L.size, L.size);
+    JacobianSink s0 = JacobianSink::dense(J0.data(), L.size), s1 = JacobianSink::dense(J1.data(), L.size);
+    dae.jacobian(t, y.data(), yp.data(), 0.0, s0);
+    dae.jacobian(t, y.data(), yp.data(), 1.0, s1);
+    const VecX x = rnd.vector(L.size, -1.0, 1.0);
+    VecX r = VecX::Zero(L.size);
+    dae.addRateJacobianProduct(t, y.data(), yp.data(), x.data(), r.data(), *dae.makeScratch());
+    const VecX expected = (J1 - J0) * x;
+    const VecX bound = kRoundOff * ((J0.cwiseAbs() + J1.cwiseAbs()) * x.cwiseAbs() + VecX::Ones(L.size));
+    for (int i = 0; i < L.size; ++i) {
+      EXPECT_LE(std::abs(r[i] - expected[i]), bound[i]) << toString(GetParam()) << ", sample " << s << ", row " << i;
+    }
   }
 }
 
