@@ -1,0 +1,125 @@
+// Forward sensitivities of the elastic and spatial models against central differences of
+// whole runs (issue 29, "Validation"; docs/sensitivities.md, "Accuracy"): the elastic
+// slider crank with a nodal rod and with a modal rod (the rod's Young's modulus and section
+// height, the crank's speed, the slider's mass; outputs the rod's midpoint deflection and
+// the slider's position) and the spatial slider crank (the slider's mass, the rod's
+// attachment point).
+//
+// How each tolerance is made: the difference of whole runs at p (1 +- d) differs from the
+// exact derivative by (1) its truncation error, O(d^2), measured by halving d (the ratio
+// of the differences at d and d / 2 is 4 where truncation dominates) and (2) the runs'
+// global errors e, which do not cancel between the two runs (other step sequences): at most
+// 2 e / (2 d |p|) in the quotient. The sensitivity itself is integrated with the run's
+// tolerances: its own error is of the order of e / |p| relative to the largest derivative.
+// The tolerance is their sum with a margin of 2, relative to the largest |derivative| of
+// the output over the run; the measured figures are in docs/sensitivities.md.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_fixture.hpp"
+#include "sensitivity_test_support.hpp"
+
+namespace {
+
+/// One comparison: parameter (its index in the run and its path), output column, and the
+/// tolerance relative to the largest |derivative| of the column over the run.
+struct Check {
+  std::size_t parameter;
+  std::string path, column;
+  double relativeTolerance;
+};
+
+/// Runs `scene` with sensitivities to `paths`, and for every check the central difference
+/// of whole runs at relative step `relStep` (one pair of runs per parameter); prints and
+/// asserts worst |sensitivity - difference| < tolerance x largest |difference|.
+void checkAgainstWholeRuns(const std::string& label, const json& scene, const std::vector<std::string>& paths,
+                           const std::vector<Check>& checks, double relStep) {
+  const SensitivityRun run = runWithSensitivities(scene, paths);
+  ASSERT_TRUE(run.summary.ok) << run.summary.message;
+  std::vector<std::vector<std::vector<double>>> fd(paths.size());
+  for (const Check& c : checks) {
+    if (fd[c.parameter].empty()) fd[c.parameter] = wholeRunDifference(scene, c.path, relStep);
+    const auto [worst, largest] = compareWithDifference(run, c.parameter, fd[c.parameter], c.column);
+    std::printf("%s d%s/d%s: worst %.3g of the largest %.3g (tolerance %.3g)\n", label.c_str(), c.column.c_str(),
+                c.path.c_str(), worst / largest, largest, c.relativeTolerance);
+    EXPECT_GT(largest, 0.0) << c.column << " / " << c.path << ": the output does not depend on the parameter";
+    EXPECT_LT(worst, c.relativeTolerance * largest) << c.column << " / " << c.path << ": largest " << largest;
+  }
+}
+
+/// The elastic slider crank of examples/slider_crank_elastic.json (steel rod 0.30 m, 8 x 8
+/// mm, crank 150 rad/s) with `elements` nodal beam elements, or `modes` normal modes of
+/// them, over `tEnd` (the rod's first bending period is about 5 ms), tolerances rtol, atol.
+json elasticSliderCrank(int elements, int modes, double tEnd, double rtol, double atol) {
+  json j = json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_elastic.json"));
+  json& rod = j["bodies"][1];
+  EXPECT_EQ(rod["name"], "rod");
+  rod["beam"]["elements"] = elements;
+  if (modes > 0) rod["modes"] = modes;
+  j["solver"]["rtol"] = rtol;
+  j["solver"]["atol"] = atol;
+  j["solver"]["t_end"] = tEnd;
+  j["solver"]["output_step"] = tEnd / 20;
+  return j;
+}
+
+const std::vector<std::string> kElasticParameters = {"bodies[1].section.youngs_modulus", "bodies[1].section.height",
+                                                     "drivers[0].law.speed", "bodies[2].mass"};
+
+/// The four parameters against the midpoint deflection and the slider's position.
+std::vector<Check> elasticChecks(double deflectionTolerance, double positionTolerance) {
+  std::vector<Check> checks;
+  for (std::size_t i = 0; i < kElasticParameters.size(); ++i) {
+    checks.push_back({i, kElasticParameters[i], "mid.uy", deflectionTolerance});
+    // the slider's position depends on the rod's elasticity through its axial strain only
+    checks.push_back({i, kElasticParameters[i], "slider.x", positionTolerance});
+  }
+  return checks;
+}
+
+TEST(SensitivitiesElastic, NodalRodMatchesWholeRuns) {
+  // 2 nodal elements, 5 ms (a bending period), rtol 1e-9: the runs' global error e is some
+  // 1e-9 of the state (the deflection ~1e-5 m: e ~ 1e-14 m); d = 1e-4 gives truncation
+  // ~1e-8 relative and run noise e / (d |p| |dc/dp|) ~ 1e-5 relative to the derivative.
+  const json scene = elasticSliderCrank(2, 0, 0.005, 1e-9, 1e-11);
+  const double kDeflectionTolerance = 1e-4;  // run noise 1e-5 (above) x 2, plus the sensitivity's own error
+  const double kPositionTolerance = 1e-4;    // the same budget
+  checkAgainstWholeRuns("nodal rod", scene, kElasticParameters, elasticChecks(kDeflectionTolerance, kPositionTolerance),
+                        1e-4);
+}
+
+TEST(SensitivitiesElastic, ModalRodMatchesWholeRuns) {
+  // 8 elements reduced to 2 normal modes (examples/slider_crank_elastic_demo_modal.json),
+  // 5 ms, rtol 1e-10: no axial stiffness left, so the runs are cheap and tight.
+  const json scene = elasticSliderCrank(8, 2, 0.005, 1e-10, 1e-12);
+  const double kDeflectionTolerance = 1e-5;  // run noise ~1e-10 / 1e-4 = 1e-6, x 2, plus truncation ~1e-8
+  const double kPositionTolerance = 1e-5;
+  checkAgainstWholeRuns("modal rod", scene, kElasticParameters, elasticChecks(kDeflectionTolerance, kPositionTolerance),
+                        1e-4);
+}
+
+TEST(SensitivitiesSpatial, RigidSliderCrankMatchesWholeRuns) {
+  // examples/spatial_slider_crank.json (crank 1 rev/s, rod on a spherical and a universal
+  // joint, slider on a rail) over 0.5 s at rtol 1e-10.
+  json scene = json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_slider_crank.json"));
+  scene["solver"]["rtol"] = 1e-10;
+  scene["solver"]["atol"] = 1e-12;
+  scene["solver"]["t_end"] = 0.5;
+  scene["solver"]["output_step"] = 0.025;
+  // the slider's mass, and the rod's end at the crank pin along the rod (its length)
+  const std::vector<std::string> paths = {"bodies[2].mass", "joints[1].frames[1].point[0]"};
+  const double kTolerance = 1e-5;  // run noise ~1e-10 / 1e-4 = 1e-6, x 2, plus truncation ~1e-8
+  checkAgainstWholeRuns("spatial slider crank", scene, paths,
+                        {{0, paths[0], "bearing.mz", kTolerance},
+                         {0, paths[0], "rail.fy", kTolerance},
+                         {1, paths[1], "slider.x", kTolerance},
+                         {1, paths[1], "bearing.mz", kTolerance}},
+                        1e-4);
+}
+
+}  // namespace
