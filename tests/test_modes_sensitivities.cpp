@@ -68,18 +68,20 @@ TEST_F(Cli, ModesSensitivityOfACantileverMatchesTheClosedForms) {
   }
   const std::vector<double>& f = modes["frequency_hz"];
   // The lowest three modes are the first three bending modes (the first axial one,
-  // c / 4L = 1294 Hz, is above the third bending one, 228 Hz): f = lambda_k sqrt(E I /
+  // c / 4L = 1294 Hz, is above the third bending one, 147 Hz): f = lambda_k sqrt(E I /
   // (rho A)) of the discretised beam, I = b h^3 / 12, A = b h (e.g. Meirovitch, Elements of
   // Vibration Analysis, sec. 5.x), so f ∝ sqrt(E) and f ∝ h:
   //   df/dE = f / (2 E),   df/dh = f / h   (exact for the discrete model too).
   // Tolerances: E enters K linearly, so dK/dE by central differences is exact up to the
-  // round-off eps |K| / (2 step) ~ 2e-11 relative (step 6.1e-6 E); the null vectors of the
-  // inverse iteration are accurate to ~1e-12; 1e-8 of the derivative holds both.
-  const double kYoungsTolerance = 1e-8;
-  // h enters K as h^3 (bending) and h (axial), M as h: the central difference's truncation
-  // is step^2 |d3(h^3)/dh3| / 6 / |d(h^3)/dh| = step^2 / (3 h^2), with the step 6.1e-6 m
-  // (parameterStep: eps^(1/3) max(|h|, 1), the parameter below 1 m): 1.2e-7 relative at
-  // h = 0.01; 1e-6 holds it.
+  // round-off eps |K| / (2 step) ~ 2e-11 relative (step 6.1e-6 E); the quotient
+  // x^T K x / x^T M x of the lowest mode loses eps (omega_max / omega_1)^2 to cancellation
+  // (|K| ~ omega_max^2 |M|, the axial modes of 6 elements up to ~1e5 rad/s against 52 rad/s:
+  // 1e-9; measured 9.3e-9, 3.2e-10, 8.4e-11 for modes 1-3); 1e-7 holds it.
+  const double kYoungsTolerance = 1e-7;
+  // h enters K as h^3 (bending) and h (axial), M as h: the central difference of h^3 with
+  // the step d is 3 h^2 + d^2, so d(omega^2)/dh = omega^2 (3 (1 + d^2 / 3 h^2) - 1) / h and
+  // df/dh carries the relative error d^2 / (2 h^2) = 1.9e-7 with d = 6.1e-6 m
+  // (parameterStep: eps^(1/3) max(|h|, 1), the parameter below 1 m); 1e-6 holds it.
   const double kHeightTolerance = 1e-6;
   const double Ev = 2.1e11, hv = 0.01;
   for (std::size_t k = 0; k < 3; ++k) {
@@ -89,10 +91,12 @@ TEST_F(Cli, ModesSensitivityOfACantileverMatchesTheClosedForms) {
     EXPECT_NEAR(dfdh / (f[k] / hv), 1.0, kHeightTolerance) << "mode " << k + 1;
     std::printf("cantilever mode %zu (%.6g Hz): df/dE error %.3g, df/dh error %.3g (relative)\n", k + 1, f[k],
                 dfdE / (f[k] / (2 * Ev)) - 1.0, dfdh / (f[k] / hv) - 1.0);
-    // undamped: the eigenvalue stays imaginary and the damping ratio 0
-    EXPECT_EQ(modes["ddamping_ratio/d" + E][k], 0.0);
-    EXPECT_NEAR(modes["domega_rad_s/d" + E][k], 2 * M_PI * dfdE, 1e-12 * std::fabs(2 * M_PI * dfdE));
-    EXPECT_NEAR(modes["dimag/d" + E][k], 2 * M_PI * dfdE, 1e-9 * std::fabs(2 * M_PI * dfdE));
+    // undamped: the eigenvalue stays imaginary (its real part is round-off, eps omega_max
+    // ~ 2e-11 rad/s) and the damping ratio 0: it changes by less than 1e-12 per unit of
+    // relative change of E; omega and Im s are 2 pi f (the columns' 12 digits: 1e-10)
+    EXPECT_LT(std::fabs(modes["ddamping_ratio/d" + E][k] * Ev), 1e-12);
+    EXPECT_NEAR(modes["domega_rad_s/d" + E][k], 2 * M_PI * dfdE, 1e-10 * std::fabs(2 * M_PI * dfdE));
+    EXPECT_NEAR(modes["dimag/d" + E][k], 2 * M_PI * dfdE, 1e-10 * std::fabs(2 * M_PI * dfdE));
   }
 }
 
@@ -119,11 +123,11 @@ TEST_F(Cli, ModesSensitivityOfTheElasticSliderCrankMatchesTwoModesRuns) {
   ASSERT_EQ(r.status, 0) << r.err;
   auto base = readModes(dir_ / "base" / "modes.csv");
   // Runs at p (1 +- 1e-4): truncation d^2 |f'''| p^3 / 6 ~ 1e-8 relative for these smooth
-  // dependences; the frequencies are written with 12 digits (round-off 1e-12 f / 2e-4 =
-  // 5e-9 f per unit p) and the reference state is solved to 1e-10 (its Newton tolerance)
-  // in each run: 1e-10 / 2e-4 = 5e-7 of the derivative's scale. 2e-6 of the largest
-  // derivative holds them.
-  const double kRelStep = 1e-4, kRelativeTolerance = 2e-6;
+  // dependences, and the reference state is projected to its Newton tolerance in each run
+  // (1e-13 of the state): 2e-6 of the largest derivative holds both. The columns are
+  // written with 12 significant digits: each value carries 5e-12 of the column's largest,
+  // which the quotient turns into 2 x 5e-12 max |c| / (2e-4 p) (kDigitsNoise).
+  const double kRelStep = 1e-4, kRelativeTolerance = 2e-6, kDigitsNoise = 5e-12;
   for (const std::string& p : paths) {
     const double value = flexmbd::sceneNumber(j, p);
     ASSERT_NE(value, 0.0) << p;
@@ -138,8 +142,12 @@ TEST_F(Cli, ModesSensitivityOfTheElasticSliderCrankMatchesTwoModesRuns) {
       ASSERT_EQ(r.status, 0) << r.err;
       side[s] = readModes(dir_ / name / "modes.csv");
     }
-    for (const std::string c : {"frequency_hz", "real", "imag"}) {
+    // (the real parts are round-off: the model is undamped, its modes' Re s ~ eps omega_max)
+    for (const std::string c : {"frequency_hz", "imag"}) {
       Comparison cmp;
+      double scale = 0.0;
+      for (int k = 0; k < count; ++k) scale = std::max(scale, std::fabs(base[c][k]));
+      const double noise = 2 * kDigitsNoise * scale / (2 * kRelStep * std::fabs(value));
       for (int k = 0; k < count; ++k) {
         const double fd = (side[0][c][k] - side[1][c][k]) / (2 * kRelStep * value);
         cmp.worst = std::max(cmp.worst, std::fabs(base["d" + c + "/d" + p][k] - fd));
@@ -150,7 +158,7 @@ TEST_F(Cli, ModesSensitivityOfTheElasticSliderCrankMatchesTwoModesRuns) {
       if (c == "frequency_hz") {
         EXPECT_GT(cmp.largest, 0.0) << p;
       }
-      EXPECT_LE(cmp.worst, kRelativeTolerance * cmp.largest) << c << " / " << p;
+      EXPECT_LE(cmp.worst, kRelativeTolerance * cmp.largest + noise) << c << " / " << p << ": noise " << noise;
     }
   }
 }
