@@ -1,18 +1,18 @@
 // Forward sensitivities of the elastic and spatial models against central differences of
 // whole runs (issue 29, "Validation"; docs/sensitivities.md, "Accuracy"): the elastic
-// slider crank with a nodal rod and with a modal rod (the rod's Young's modulus and section
-// height, the crank's speed, the slider's mass; outputs the rod's midpoint deflection and
-// the slider's position) and the spatial slider crank (the slider's mass, the rod's
-// attachment point).
+// slider crank with a nodal rod (the rod's Young's modulus and section height, the slider's
+// mass) and with a modal rod (the crank's speed), outputs the rod's midpoint deflection and
+// the slider's position; the spatial slider crank (the slider's mass, the rod's attachment
+// point; the motor's torque, a reaction, the slider's position).
 //
 // How each tolerance is made: the difference of whole runs at p (1 +- d) differs from the
-// exact derivative by (1) its truncation error, O(d^2), measured by halving d (the ratio
-// of the differences at d and d / 2 is 4 where truncation dominates) and (2) the runs'
+// exact derivative by (1) its truncation error, O(d^2) ~ 1e-8 here, and (2) the runs'
 // global errors e, which do not cancel between the two runs (other step sequences): at most
-// 2 e / (2 d |p|) in the quotient. The sensitivity itself is integrated with the run's
-// tolerances: its own error is of the order of e / |p| relative to the largest derivative.
-// The tolerance is their sum with a margin of 2, relative to the largest |derivative| of
-// the output over the run; the measured figures are in docs/sensitivities.md.
+// 2 e / (2 d |p|) in the quotient, about rtol / d of the derivative's scale. Halving d (1e-4
+// to 5e-5) moves the quotients by 3e-8 .. 9e-6 of the largest, not by 3/4 of a truncation
+// error: (2) dominates. The sensitivity itself is integrated with the run's tolerances. The
+// tolerance is (1) + (2) with a margin, relative to the largest |derivative| of the output
+// over the run; the measured figures are in docs/sensitivities.md.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -105,7 +105,7 @@ TEST(SensitivitiesElastic, ModalRodMatchesWholeRuns) {
 // eigenvector's sign is the eigensolver's choice, so the modal coordinates of the scenes at
 // p + h and p - h may stand for opposite shapes: dF/dp then compares different equations.
 // Measured: d mid.uy / dE exactly -1 times the whole runs' difference, d mid.uy / d height
-// 370 times it; with the largest entry of each mode made positive both agree to 1e-9.
+// 370 times it; with the largest entry of each mode made positive both agree to 6 digits.
 // Enable when fixed.
 TEST(SensitivitiesElastic, DISABLED_ModalRodSectionMatchesWholeRuns) {
   const json scene = elasticSliderCrank(8, 2, 0.005, 1e-10, 1e-12);
