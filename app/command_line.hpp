@@ -117,6 +117,32 @@ inline double parseNumberOption(const std::string& option, const std::string& te
   return x;
 }
 
+/// What --sensitivity needs (run, modes): the message of a missing value.
+inline constexpr const char* kSensitivityPathNeeded = "a scene path (e.g. --sensitivity bodies[1].mass)";
+
+/// Takes every `--name VALUE` and `--name=VALUE` of the repeatable option `name` out of
+/// `args`, values in the order given (run's and modes' --sensitivity PATH).
+/// @throws UsageError "option <name> needs <what>" for a missing or empty value.
+inline std::vector<std::string> takeRepeatedOption(std::vector<std::string>& args, const std::string& name,
+                                                   const std::string& what) {
+  std::vector<std::string> values, rest;
+  const std::string prefix = name + "=";
+  for (std::size_t k = 0; k < args.size(); ++k) {
+    const std::string& a = args[k];
+    if (a == name) {
+      if (k + 1 >= args.size() || args[k + 1].empty()) throw UsageError("option " + name + " needs " + what);
+      values.push_back(args[++k]);
+    } else if (a.rfind(prefix, 0) == 0) {
+      if (a.size() == prefix.size()) throw UsageError("option " + name + " needs " + what);
+      values.push_back(a.substr(prefix.size()));
+    } else {
+      rest.push_back(a);
+    }
+  }
+  args = rest;
+  return values;
+}
+
 inline double parsePositiveOption(const std::string& option, const std::string& text) {
   const double x = parseNumberOption(option, text);
   if (!(x > 0.0)) throw UsageError("option " + option + " must be > 0, got " + text);

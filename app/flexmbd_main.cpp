@@ -66,6 +66,7 @@ const char* const kUsage =
     "                    [--labels L1,L2] [--title TEXT] [--deg]\n"
     "       flexmbd modes SCENE.json --out DIR [--at T] [--count N] [--steady]\n"
     "                     [--sweep NAME:FROM:TO:N] [--solver auto|dense|sparse]\n"
+    "                     [--sensitivity PATH ...]\n"
     "       flexmbd sid SCENE.json --body NAME --out FILE.SID_FEM\n"
     "       flexmbd view DIR [--out FILE.html] [--columns A,B] [--scene SCENE.json]\n"
     "                    [--max-frames N]\n"
@@ -129,7 +130,9 @@ const char* const kUsage =
     "(see docs/modes.md). --steady: the state is the steady motion at the initial velocities\n"
     "(accelerations zero: a rotor stretched by its centrifugal load), solved by Newton.\n"
     "--solver: dense (Eigen), sparse (Spectra shift-invert) or auto (dense up to 400\n"
-    "independent coordinates).\n"
+    "independent coordinates). --sensitivity PATH (repeatable): the derivatives of the\n"
+    "modes.csv columns with respect to the scene number at PATH (eigenvalue sensitivities,\n"
+    "docs/modes.md), columns d<column>/d<PATH>.\n"
     "\n"
     "sid writes the Standard Input Data (SID, Wallrapp 1994) of the spatial flexible body\n"
     "NAME of SCENE.json to FILE: a reduced body for other multibody codes, or for a\n"
@@ -167,18 +170,10 @@ struct Options {
 
 /// Takes the repeatable --sensitivity PATH (or --sensitivity=PATH) out of `args` into `o`.
 void takeSensitivityOptions(std::vector<std::string>& args, Options& o) {
+  o.sensitivities = cli::takeRepeatedOption(args, "--sensitivity", cli::kSensitivityPathNeeded);
   std::vector<std::string> rest;
-  for (std::size_t k = 0; k < args.size(); ++k) {
-    const std::string& a = args[k];
-    if (a == "--sensitivity") {
-      if (k + 1 >= args.size() || args[k + 1].empty()) {
-        throw UsageError("option --sensitivity needs a scene path (e.g. --sensitivity bodies[1].mass)");
-      }
-      o.sensitivities.push_back(args[++k]);
-    } else if (a.rfind("--sensitivity=", 0) == 0) {
-      if (a.size() == 14) throw UsageError("option --sensitivity needs a scene path (e.g. --sensitivity bodies[1].mass)");
-      o.sensitivities.push_back(a.substr(14));
-    } else if (a == "--no-sensitivity-error-control") {
+  for (const std::string& a : args) {
+    if (a == "--no-sensitivity-error-control") {
       o.sensitivityErrorControl = false;
     } else {
       rest.push_back(a);

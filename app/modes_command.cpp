@@ -22,10 +22,13 @@
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "integrators/linearization.hpp"
+#include "integrators/modal_sensitivity.hpp"
+#include "integrators/sensitivity_run.hpp"
 #include "integrators/simulation.hpp"
 #include "io/json_reader.hpp"
 #include "io/output_lock.hpp"
 #include "io/scene.hpp"
+#include "io/sensitivity_results.hpp"
 #include "io/vtk_writer.hpp"
 
 namespace flexmbd {
@@ -58,6 +61,7 @@ struct ModesCommandOptions {
   bool quiet = false;
   bool steady = false;  ///< --steady: solveSteadyMotion instead of the consistent state
   EigenSolverKind solver = EigenSolverKind::Automatic;  ///< --solver
+  std::vector<std::string> sensitivities;  ///< --sensitivity PATH (repeatable), in order
 };
 
 EigenSolverKind parseSolver(const std::string& text) {
@@ -101,11 +105,13 @@ Sweep parseSweep(const std::string& text) {
   return s;
 }
 
-ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
+ModesCommandOptions parseOptions(std::vector<std::string> args) {
+  std::vector<std::string> sensitivities = cli::takeRepeatedOption(args, "--sensitivity", cli::kSensitivityPathNeeded);
   const cli::SplitArguments split = cli::splitArguments(
       args, cli::withCommon(cli::kCommonValueOptions, {"--at", "--count", "--sweep", "--solver"}),
       cli::withCommon(cli::kCommonFlags, {{"--steady", "--steady"}}), "modes: ");
   ModesCommandOptions o;
+  o.sensitivities = std::move(sensitivities);
   o.quiet = split.flags.count("--quiet") > 0;
   o.steady = split.flags.count("--steady") > 0;
   for (const auto& [name, value] : split.values) {
@@ -131,6 +137,15 @@ ModesCommandOptions parseOptions(const std::vector<std::string>& args) {
   if (o.outDir.empty()) throw cli::UsageError("modes: missing --out DIR (the output directory)");
   if (o.at && o.sweep) throw cli::UsageError("modes: --at and --sweep cannot be combined (a sweep linearises at t_start)");
   if (o.at && o.steady) throw cli::UsageError("modes: --at and --steady cannot be combined (--steady solves for the state)");
+  if (!o.sensitivities.empty() && o.sweep) {
+    throw cli::UsageError("modes: --sensitivity and --sweep cannot be combined (the eigenvalue sensitivities are of "
+                          "one linearisation; run modes --sensitivity at each speed)");
+  }
+  if (!o.sensitivities.empty() && o.at) {
+    throw cli::UsageError("modes: --sensitivity and --at cannot be combined (the state reached by a simulation would "
+                          "be differentiated through two runs' integration errors; the sensitivities are about the "
+                          "consistent state, its equilibrium or --steady)");
+  }
   return o;
 }
 
@@ -181,15 +196,67 @@ std::runtime_error writeFailure(const fs::path& file) {
   return std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
 }
 
-void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes) {
+/// The derivatives of the modes with respect to one parameter (--sensitivity).
+struct ParameterModeDerivatives {
+  std::string path;
+  std::vector<ModeDerivative> modes;
+};
+
+/// The columns of modes.csv after index; each parameter adds d<column>/d<PATH> for them.
+const std::vector<std::string> kModeColumns = {"frequency_hz", "omega_rad_s", "damping_ratio", "real", "imag"};
+
+void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes,
+                   const std::vector<ParameterModeDerivatives>& derivatives) {
   std::ofstream out(file);
-  out << "index,frequency_hz,omega_rad_s,damping_ratio,real,imag\n";
+  out << "index";
+  for (const std::string& c : kModeColumns) out << ',' << c;
+  for (const ParameterModeDerivatives& p : derivatives) {
+    for (const std::string& c : kModeColumns) out << ",d" << c << "/d" << p.path;
+  }
+  out << '\n';
   for (size_t k = 0; k < modes.size(); ++k) {
     const Mode& m = modes[k];
     out << k + 1 << ',' << number(m.frequencyHz) << ',' << number(m.omega) << ',' << number(m.dampingRatio) << ','
-        << number(m.eigenvalue.real()) << ',' << number(m.eigenvalue.imag()) << '\n';
+        << number(m.eigenvalue.real()) << ',' << number(m.eigenvalue.imag());
+    for (const ParameterModeDerivatives& p : derivatives) {
+      const ModeDerivative& d = p.modes[k];
+      out << ',' << number(d.frequencyHz) << ',' << number(d.omega) << ',' << number(d.dampingRatio) << ','
+          << number(d.eigenvalue.real()) << ',' << number(d.eigenvalue.imag());
+    }
+    out << '\n';
   }
   if (!out) throw writeFailure(file);
+}
+
+/// The eigenvalue sensitivities (integrators/modal_sensitivity.hpp) of `modes` with respect
+/// to each parameter: each perturbed scene's reference state found as the base's
+/// (initialReference: its consistent state or equilibrium, or --steady), linearised.
+/// @throws InputError naming the parameter when its perturbed model has no such state.
+std::vector<ParameterModeDerivatives> modeSensitivities(const SensitivityScenes& scenes, bool steady,
+                                                        const LinearizedSystem& lin, const ReducedSystem& red,
+                                                        const std::vector<Mode>& modes) {
+  std::vector<ParameterModeDerivatives> out;
+  for (std::size_t i = 0; i < scenes.parameters.size(); ++i) {
+    const SensitivityParameter& p = scenes.parameters[i];
+    try {
+      const LinearizedSystem plus = linearize(scenes.plus[i]->system, initialReference(*scenes.plus[i], steady));
+      const LinearizedSystem minus = linearize(scenes.minus[i]->system, initialReference(*scenes.minus[i], steady));
+      out.push_back({p.name, modeDerivatives(lin, red, modes, plus, minus, p.step)});
+    } catch (const InputError& e) {
+      throw InputError("sensitivity parameter '" + p.name + "': the model at " + p.name + " = " + fmt(p.value) +
+                       " +- " + fmt(p.step) + " (the steps of the central difference): " + e.what());
+    }
+  }
+  return out;
+}
+
+/// Each parameter's derivatives of the listed frequencies on one line.
+void printDerivatives(const std::vector<ParameterModeDerivatives>& derivatives) {
+  for (const ParameterModeDerivatives& p : derivatives) {
+    std::printf("d frequency_hz / d %s:", cli::oneLine(p.path).c_str());
+    for (size_t k = 0; k < std::min<size_t>(p.modes.size(), 6); ++k) std::printf(" %.6g", p.modes[k].frequencyHz);
+    std::printf("%s\n", p.modes.size() > 6 ? " ..." : "");
+  }
 }
 
 void writeShapesCsv(const fs::path& file, const std::vector<Mode>& modes, const std::vector<std::string>& names) {
@@ -395,11 +462,21 @@ int runModesCommand(const std::vector<std::string>& args) {
   ModesCommandOptions o;
   nlohmann::json base;
   std::optional<Scene> scene;
+  std::optional<SensitivityScenes> sensitivities;  // --sensitivity: the scenes at p +- h
   try {
     o = parseOptions(args);
     const std::string text = readText(o.scenePath);
     scene.emplace(parseSceneText(text, o.scenePath));
     base = nlohmann::json::parse(text);
+    if (!o.sensitivities.empty()) {
+      sensitivities.emplace(buildSensitivityScenes(text, o.scenePath, *scene, o.sensitivities));
+      const DaeSystem dae(scene->system, Formulation::Ggl);
+      for (std::size_t i = 0; i < sensitivities->parameters.size(); ++i) {
+        for (const auto* perturbed : {&sensitivities->plus[i]->system, &sensitivities->minus[i]->system}) {
+          requireSameStructure(dae, DaeSystem(*perturbed, Formulation::Ggl), sensitivities->parameters[i].name);
+        }
+      }
+    }
   } catch (const std::exception& e) {
     cli::printError(e.what());
     return kExitInputError;
@@ -424,10 +501,15 @@ int runModesCommand(const std::vector<std::string>& args) {
     const LinearizedSystem lin = linearize(sys, ref);
     const ReducedSystem red = reduce(lin, basisFor(sys, o.solver));
     ModesOptions mo;
-    mo.count = o.count;
+    // with sensitivities one mode more, so that a repeated eigenvalue at the last is seen
+    mo.count = sensitivities ? o.count + 1 : o.count;
     mo.solver = o.solver;
-    const std::vector<Mode> modes = computeModes(red, mo);
-    writeModesCsv(out / "modes.csv", modes);
+    std::vector<Mode> modes = computeModes(red, mo);
+    std::vector<ParameterModeDerivatives> derivatives;
+    if (sensitivities) derivatives = modeSensitivities(*sensitivities, o.steady, lin, red, modes);
+    if (static_cast<int>(modes.size()) > o.count) modes.resize(static_cast<std::size_t>(o.count));
+    for (ParameterModeDerivatives& d : derivatives) d.modes.resize(modes.size());
+    writeModesCsv(out / "modes.csv", modes, derivatives);
     writeShapesCsv(out / "mode_shapes.csv", modes, lin.velocityNames);
     writeShapeStates(out, *scene, ref, modes);
     writeModesJson(out, o.scenePath, ref.t);
@@ -436,6 +518,7 @@ int runModesCommand(const std::vector<std::string>& args) {
                 o.scenePath.c_str(), ref.t, ref.v.lpNorm<Eigen::Infinity>() == 0.0 ? "at rest" : o.steady ? "steady motion" : "in motion", aMax,
                 sys.numVelocities(), static_cast<int>(red.N.cols()));
     printTable(modes);
+    printDerivatives(derivatives);
     printBeamFrequencies(sys, o.count);
     std::printf("results: %s, %s, %s, %s (flexmbd view %s draws them)\n", (out / "modes.csv").string().c_str(),
                 (out / "mode_shapes.csv").string().c_str(), (out / "mode_states.csv").string().c_str(),

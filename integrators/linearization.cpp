@@ -542,18 +542,46 @@ LinearizedSystem linearize(const System& sys, const ReferenceState& state) {
   return lin;
 }
 
-ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
-  ReducedSystem red;
+namespace {
+
+/// Z with G Z = Y (Y m x k), zero on the rows not in `dep` (the dependent velocities of
+/// coordinate partitioning): the right inverse R of G applied to Y, sparse.
+class PartitionedSolve {
+ public:
+  PartitionedSolve(const MatX& G, const std::vector<int>& dep) : dep_(dep), nv_(static_cast<int>(G.cols())) {
+    MatX Gd(G.rows(), static_cast<Eigen::Index>(dep.size()));
+    for (size_t k = 0; k < dep.size(); ++k) Gd.col(static_cast<Eigen::Index>(k)) = G.col(dep[k]);
+    qr_.compute(Gd);
+  }
+  SpMat operator()(const MatX& Y) const {
+    const MatX Zd = qr_.solve(Y);
+    Triplets t;
+    for (size_t k = 0; k < dep_.size(); ++k) {
+      for (Eigen::Index j = 0; j < Zd.cols(); ++j) {
+        if (Zd(static_cast<Eigen::Index>(k), j) != 0.0) t.emplace_back(dep_[k], j, Zd(static_cast<Eigen::Index>(k), j));
+      }
+    }
+    return fromTriplets(nv_, static_cast<int>(Y.cols()), t);
+  }
+
+ private:
+  std::vector<int> dep_;
+  int nv_;
+  Eigen::ColPivHouseholderQR<MatX> qr_;
+};
+
+/// Mr, Cr, Kr of `lin` in the basis red.N (set, with red.rank): N^T M N, N^T C N, N^T K N
+/// when G is constant along the reference, otherwise with the rates N', N'' of the basis
+/// that follows G (reduce()); `dep` the dependent velocities of coordinate partitioning
+/// (found here if empty and needed).
+void reduceInBasis(const LinearizedSystem& lin, std::vector<int> dep, ReducedSystem& red) {
   const MatX G = lin.G;
-  std::vector<int> dep;
-  red.N = basis == BasisKind::Svd ? svdBasis(G, red.rank) : partitioningBasis(G, lin.velocityKinds, red.rank, dep);
-  if (red.N.cols() == 0) throw ModelError("modes: every velocity is constrained (the model has no degree of freedom)");
   const SpMat Nt = red.N.transpose();
   red.M = Nt * lin.M * red.N;
   if (lin.Gdot.nonZeros() == 0 && lin.Gddot.nonZeros() == 0) {  // G constant along the reference: N constant
     red.C = Nt * lin.C * red.N;
     red.K = Nt * lin.K * red.N;
-    return red;
+    return;
   }
   // G changes along the reference motion: dx = N(t) x with G N = 0 at all times, so
   // N' = -R G' N and N'' = -R (2 G' N' + G'' N), R a right inverse of G (the dependent rows
@@ -568,25 +596,50 @@ ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
     int rank = 0;
     partitioningBasis(G, lin.velocityKinds, rank, dep);
   }
-  MatX Gd(G.rows(), static_cast<Eigen::Index>(dep.size()));
-  for (size_t k = 0; k < dep.size(); ++k) Gd.col(static_cast<Eigen::Index>(k)) = G.col(dep[k]);
-  const Eigen::ColPivHouseholderQR<MatX> GdQr(Gd);
   // Z with G Z = Y (m x nx), zero on the independent rows: sparse, its m dependent rows dense
-  const auto solveG = [&](const MatX& Y) -> SpMat {
-    const MatX Zd = GdQr.solve(Y);
-    Triplets t;
-    for (size_t k = 0; k < dep.size(); ++k) {
-      for (Eigen::Index j = 0; j < Zd.cols(); ++j) {
-        if (Zd(static_cast<Eigen::Index>(k), j) != 0.0) t.emplace_back(dep[k], j, Zd(static_cast<Eigen::Index>(k), j));
-      }
-    }
-    return fromTriplets(static_cast<int>(G.cols()), static_cast<int>(Y.cols()), t);
-  };
+  const PartitionedSolve solveG(G, dep);
   const SpMat& N = red.N;
   const SpMat N1 = -solveG(MatX(lin.Gdot * N));
   const SpMat N2 = -solveG(MatX(2.0 * (lin.Gdot * N1) + lin.Gddot * N));
   red.C = Nt * (2.0 * (lin.M * N1) + lin.C * N);
   red.K = Nt * (lin.M * N2 + lin.C * N1 + lin.K * N);
+}
+
+}  // namespace
+
+ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis) {
+  ReducedSystem red;
+  const MatX G = lin.G;
+  std::vector<int> dep;
+  red.N = basis == BasisKind::Svd ? svdBasis(G, red.rank) : partitioningBasis(G, lin.velocityKinds, red.rank, dep);
+  if (red.N.cols() == 0) throw ModelError("modes: every velocity is constrained (the model has no degree of freedom)");
+  reduceInBasis(lin, std::move(dep), red);
+  return red;
+}
+
+std::vector<int> dependentVelocities(const LinearizedSystem& lin) {
+  int rank = 0;
+  std::vector<int> dep;
+  partitioningBasis(MatX(lin.G), lin.velocityKinds, rank, dep);
+  return dep;
+}
+
+ReducedSystem reduceNear(const LinearizedSystem& lin, const SpMat& near, const std::vector<int>& dependent) {
+  if (near.rows() != lin.M.rows()) {
+    throw InputError("reduceNear: the basis has " + std::to_string(near.rows()) + " rows, the linearisation " +
+                     std::to_string(lin.M.rows()) + " velocities");
+  }
+  ReducedSystem red;
+  red.rank = static_cast<int>(near.rows() - near.cols());
+  // N = N0 - R (G N0): G N = 0 (R the right inverse of G on the dependent columns); smooth
+  // in G, and N0 itself where G N0 = 0
+  if (dependent.empty()) {
+    red.N = near;  // no constraint (or none independent): every velocity is free
+  } else {
+    const PartitionedSolve solveG(MatX(lin.G), dependent);
+    red.N = near - solveG(MatX(lin.G * near));
+  }
+  reduceInBasis(lin, dependent, red);
   return red;
 }
 

@@ -98,6 +98,21 @@ struct ReducedSystem {
 /// @throws ModelError if every velocity is constrained (nothing moves).
 ReducedSystem reduce(const LinearizedSystem& lin, BasisKind basis = BasisKind::Svd);
 
+/// The velocities coordinate partitioning takes as dependent for lin.G (pivoted QR with
+/// elastic columns weighted, as reduce() chooses them), ascending: one per independent
+/// constraint equation.
+std::vector<int> dependentVelocities(const LinearizedSystem& lin);
+
+/// The reduced equations of `lin` in the basis `near` (nv x nx, e.g. reduce()'s N of a
+/// neighbouring linearisation) moved onto the null space of lin.G: N = N0 - R (G N0), R the
+/// right inverse of G on the `dependent` velocities (zero on the others), so that G N = 0;
+/// N = N0 where G N0 = 0 already. N is a smooth function of G: the reduced matrices of
+/// linearisations at p + h and p - h in the bases moved from one N0 differ by O(h), which
+/// is what their central differences need (the eigenvalue sensitivities,
+/// integrators/modal_sensitivity.hpp). @pre N0 spans a complement of the null space's
+/// orthogonal complement (true for a basis of a nearby G's null space).
+ReducedSystem reduceNear(const LinearizedSystem& lin, const SpMat& near, const std::vector<int>& dependent);
+
 /// One eigenvalue s of the first-order form [0 I; -Mr^-1 Kr, -Mr^-1 Cr] and its mode.
 struct Mode {
   std::complex<double> eigenvalue;   ///< s = -zeta omega + i omega sqrt(1 - zeta^2)

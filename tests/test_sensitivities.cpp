@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
+#include "sensitivity_test_support.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/sensitivity_run.hpp"
@@ -27,60 +28,6 @@ using namespace flexmbd;
 using nlohmann::json;
 
 namespace {
-
-/// The rows of a run with sensitivities: results columns, and per row the derivatives
-/// (sensitivityColumns' order: parameter by parameter, every column but t).
-struct SensitivityRun {
-  std::vector<std::string> columns;
-  std::vector<std::vector<double>> rows, derivatives;
-  SimulationSummary summary;
-  int column(const std::string& name) const {
-    for (std::size_t k = 0; k < columns.size(); ++k) {
-      if (columns[k] == name) return static_cast<int>(k);
-    }
-    ADD_FAILURE() << "no column " << name;
-    return 0;
-  }
-  /// d column / d parameter i at row r.
-  double d(std::size_t r, const std::string& name, std::size_t i) const {
-    return derivatives[r][i * (columns.size() - 1) + static_cast<std::size_t>(column(name)) - 1];
-  }
-  double value(std::size_t r, const std::string& name) const { return rows[r][static_cast<std::size_t>(column(name))]; }
-};
-
-SensitivityRun runWithSensitivities(const json& scene, const std::vector<std::string>& paths, bool errorControl = true) {
-  const std::string text = scene.dump();
-  Scene base = parseSceneText(text);
-  base.solver.progress = false;
-  const SensitivityScenes perturbed = buildSensitivityScenes(text, "<scene>", base, paths);
-  SensitivityRun run;
-  run.columns = resultColumns(base);
-  std::vector<double> row, d;
-  run.summary = simulateWithSensitivities(base.system, perturbed.parameters, base.solver, {errorControl},
-                                          [&](const OutputSample& s, const SensitivitySample& sens) {
-                                            resultRow(base, run.columns, s, row);
-                                            sensitivityRow(perturbed, run.columns, sens, d);
-                                            run.rows.push_back(row);
-                                            run.derivatives.push_back(d);
-                                          });
-  return run;
-}
-
-/// The rows of a plain run of the scene with the number at `path` set to `value`.
-std::vector<std::vector<double>> plainRun(json scene, const std::string& path, double value) {
-  setSceneNumber(scene, path, value);
-  Scene s = parseSceneText(scene.dump());
-  s.solver.progress = false;
-  const std::vector<std::string> columns = resultColumns(s);
-  std::vector<std::vector<double>> rows;
-  std::vector<double> row;
-  const SimulationSummary summary = simulate(s.system, s.solver, [&](const OutputSample& o) {
-    resultRow(s, columns, o, row);
-    rows.push_back(row);
-  });
-  EXPECT_TRUE(summary.ok) << summary.message;
-  return rows;
-}
 
 // ----- (a) a linear spring-mass-damper: closed form -----------------------------------
 
@@ -158,24 +105,6 @@ json pendulum() {
   })");
   j["bodies"][0]["position"] = {L * std::sin(th), -L * std::cos(th)};
   return j;
-}
-
-/// Largest |sensitivity - central difference of whole runs| over the rows and the largest
-/// |derivative|, for `column` with respect to `path` (relative step `relStep`).
-std::pair<double, double> againstWholeRuns(const json& scene, const SensitivityRun& run, std::size_t parameter,
-                                           const std::string& path, const std::string& column, double relStep) {
-  const double p = sceneNumber(scene, path), dp = relStep * std::fabs(p);
-  const auto plus = plainRun(scene, path, p + dp), minus = plainRun(scene, path, p - dp);
-  EXPECT_EQ(plus.size(), run.rows.size());
-  EXPECT_EQ(minus.size(), run.rows.size());
-  const auto k = static_cast<std::size_t>(run.column(column));
-  double worst = 0.0, largest = 0.0;
-  for (std::size_t r = 0; r < std::min({plus.size(), minus.size(), run.rows.size()}); ++r) {
-    const double fd = (plus[r][k] - minus[r][k]) / (2.0 * dp);
-    worst = std::max(worst, std::fabs(run.d(r, column, parameter) - fd));
-    largest = std::max(largest, std::fabs(fd));
-  }
-  return {worst, largest};
 }
 
 TEST(Sensitivities, PendulumAngleByLengthMatchesWholeRuns) {
