@@ -41,6 +41,16 @@ std::vector<int> chosenModes(int count, const std::vector<int>& set, const std::
   return keep;
 }
 
+void fixModeSigns(MatX& phi) {
+  constexpr double kTie = 1e-6;  // entries this close to the largest count as tied with it
+  for (Eigen::Index k = 0; k < phi.cols(); ++k) {
+    const double largest = phi.col(k).cwiseAbs().maxCoeff();
+    Eigen::Index i = 0;
+    while (i + 1 < phi.rows() && std::abs(phi(i, k)) < (1.0 - kTie) * largest) ++i;
+    if (phi(i, k) < 0.0) phi.col(k) = -phi.col(k);
+  }
+}
+
 MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, const std::string& owner, VecX* omega,
                  const std::string& what) {
   const int available = static_cast<int>(K.rows());
@@ -57,6 +67,7 @@ MatX normalModes(const MatX& K, const MatX& M, const std::vector<int>& keep, con
     Phi.col(k) = eig.eigenvectors().col(keep[k] - 1);
     if (omega) (*omega)[k] = std::sqrt(std::max(eig.eigenvalues()[keep[k] - 1], 0.0));
   }
+  fixModeSigns(Phi);
   return Phi;
 }
 
@@ -143,6 +154,7 @@ MatX freeFreeModes(const SpMat& K, const SpMat& M, const MatX& rigid, int count,
   phi = llt.matrixU().solve<Eigen::OnTheRight>(phi);
   if (omega != nullptr) omega->resize(count);
   for (int i = 0; i < count && omega != nullptr; ++i) (*omega)[i] = std::sqrt(lambda[6 + i]);
+  fixModeSigns(phi);
   return phi;
 }
 
@@ -197,6 +209,7 @@ MatX clampedModes(const SpMat& K, const SpMat& M, const std::vector<int>& held, 
     for (int i = 0; i < nf; ++i) phi(freeDofs[i], j) = x[i];
     if (omega != nullptr) (*omega)[j] = std::sqrt(1.0 / nu[j]);  // lambda = 1 / nu
   }
+  fixModeSigns(phi);
   return phi;
 }
 

@@ -35,6 +35,12 @@ enum class ModalReduction {
 /// @throws InputError naming `owner`: count < 0, a number < 1, a number chosen twice.
 std::vector<int> chosenModes(int count, const std::vector<int>& set, const std::string& owner);
 
+/// The sign convention of every mode basis the engine computes: each column's largest
+/// entry in magnitude (the first of those within 1e-6 of it) made positive. Eigensolvers
+/// leave the sign open; fixed, a scene read twice, or with a parameter moved a step
+/// (design sensitivities, docs/sensitivities.md), gives modal coordinates of the same shapes.
+void fixModeSigns(MatX& phi);
+
 /// The mass-normalised eigenvectors (columns, phi^T M phi = I) of K phi = omega^2 M phi
 /// numbered `keep` (1-based, ascending frequency); `omega` (if given) receives their
 /// natural frequencies (rad/s). K symmetric, M symmetric positive definite (dense).

@@ -4,6 +4,8 @@
 #include <ctime>
 #include <exception>
 
+#include <Eigen/QR>
+
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/system_evaluation.hpp"
@@ -133,7 +135,59 @@ InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vect
     s.s0.col(static_cast<Eigen::Index>(i)) = (yPlus - yMinus) / (2.0 * pairs[i].step);
     s.sp0.col(static_cast<Eigen::Index>(i)) = (ypPlus - ypMinus) / (2.0 * pairs[i].step);
   }
+  projectOntoConstraints(base, pairs, init, t0, s.s0);
   return s;
+}
+
+namespace {
+
+/// Rows [r0, r0 + nr) and columns [c0, c0 + nc) of a matrix in CSC values on `p`, dense.
+MatX denseBlock(const SparsePattern& p, const std::vector<double>& values, int r0, int nr, int c0, int nc) {
+  MatX B = MatX::Zero(nr, nc);
+  for (int c = 0; c < nc; ++c) {
+    for (int64_t k = p.colStart()[c0 + c]; k < p.colStart()[c0 + c + 1]; ++k) {
+      const auto r = static_cast<int>(p.rowIndex()[k]) - r0;
+      if (r >= 0 && r < nr) B(r, c) = values[static_cast<std::size_t>(k)];
+    }
+  }
+  return B;
+}
+
+}  // namespace
+
+void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
+                            const ConsistentState& init, double t0, MatX& s0) {
+  if (base.formulation() == Formulation::Index1) return;  // no position-level rows
+  const DaeLayout& L = base.layout();
+  if (L.m == 0) return;
+  VecX y, yp;
+  base.packState(init.q, init.v, init.a, init.lambda, y, yp);
+  const SparsePattern& P = base.pattern();
+  std::vector<double> J0(static_cast<std::size_t>(P.nonZeros()), 0.0);
+  JacobianSink sink = JacobianSink::sparse(J0.data(), P);
+  base.jacobian(t0, y.data(), yp.data(), 0.0, sink);  // dF/dy: the constraint rows hold no y'
+  // F_g's rows in q (minimum-norm corrections: complete orthogonal decomposition, so a
+  // released equation's empty row is no obstacle), F_gv's in v
+  const Eigen::CompleteOrthogonalDecomposition<MatX> Gq(denseBlock(P, J0, L.lambda, L.m, L.q, L.nq));
+  const bool ggl = L.mu >= 0;
+  const Eigen::CompleteOrthogonalDecomposition<MatX> Gv(ggl ? denseBlock(P, J0, L.mu, L.m, L.v, L.nv) : MatX());
+  VecX Fplus(L.size), Fminus(L.size), r(L.size);
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    auto col = s0.col(static_cast<Eigen::Index>(i));
+    // dF/dp at the base state: the constraint rows of F_y s + F_p, which must vanish
+    pairs[i].plus->residual(t0, y.data(), yp.data(), Fplus.data());
+    pairs[i].minus->residual(t0, y.data(), yp.data(), Fminus.data());
+    const auto residualOfRows = [&](int row0) {
+      r.setZero();
+      for (int c = 0; c < L.size; ++c) {
+        for (int64_t k = P.colStart()[c]; k < P.colStart()[c + 1]; ++k) r[P.rowIndex()[k]] += J0[static_cast<std::size_t>(k)] * col[c];
+      }
+      return VecX(r.segment(row0, L.m) + (Fplus - Fminus).segment(row0, L.m) / (2.0 * pairs[i].step));
+    };
+    // G s_q + g_p = 0 (positions), then d/dp (G v + g_t) = 0 (velocities) with the new s_q
+    col.segment(L.q, L.nq) -= Gq.solve(residualOfRows(L.lambda));
+    if (ggl) col.segment(L.v, L.nv) -= Gv.solve(residualOfRows(L.mu));
+  }
 }
 
 // ----- the run ----------------------------------------------------------------------

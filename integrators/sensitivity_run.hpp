@@ -110,6 +110,15 @@ struct InitialSensitivities {
 InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
                                           const ConsistentState& init, double t0);
 
+/// The differences' s0 satisfies the differentiated constraints only to the consistent
+/// initialisation's Newton tolerance divided by 2h (~5e-11 of the position scale), more
+/// than the sensitivities' absolute tolerances at tight rtol: the first step's corrector
+/// would move s_q by that much at any step size and the error test fail down to h ~ 1e-15.
+/// This makes the minimum-norm corrections of s_q and then s_v (GGL) that zero the
+/// constraint rows of F_y s + F_p at t0 (index 3: s_q only; index 1: nothing).
+void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
+                            const ConsistentState& init, double t0, MatX& s0);
+
 /// Refuses a parameter whose perturbed system changes the structure of the DAE: another
 /// number of coordinates, velocities or constraint equations, or another Jacobian pattern.
 /// @throws InputError naming the parameter and what changed.
