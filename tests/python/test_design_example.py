@@ -43,7 +43,8 @@ FEASIBLE = 1e-4
 ACTIVE = 1e-2
 
 
-def _check(opt, grid, bound, height_step, width_of_best):
+def _check(problem, opt, grid, height_step, width_of_best):
+    bound = problem.bound
     # the optimum meets the bound, and sits on it
     assert opt["peak"] <= bound * (1 + FEASIBLE)
     assert opt["peak"] >= bound * (1 - ACTIVE)
@@ -51,7 +52,7 @@ def _check(opt, grid, bound, height_step, width_of_best):
     # no more than one height step above the optimum at the same width: its mass within
     # rho L w dh of the optimum's (w the grid point's width)
     assert grid["mass"] is not None
-    mass_step = design.rod_mass({"bodies": [None, opt["scene_rod"]]}, width_of_best, height_step)
+    mass_step = problem.mass(width_of_best, height_step)
     assert opt["mass"] <= grid["mass"] * (1 + FEASIBLE)
     assert grid["mass"] - opt["mass"] <= mass_step * (1 + FEASIBLE)
     # fewer engine runs than the grid
@@ -66,11 +67,10 @@ def test_height_alone_against_a_grid_of_heights(tmp_path):
     width = design.WIDTH_BOUNDS[0]
     problem = design.RodDesign(width=width)
     opt = design.optimise(problem)
-    opt["scene_rod"] = problem.scene["bodies"][1]
     heights = design.linear_grid(design.HEIGHT_BOUNDS, 17)
     grid = _grid(problem, [width], heights, tmp_path)
     assert grid["failed"] == 0
-    _check(opt, grid, problem.bound, heights[1] - heights[0], width)
+    _check(problem, opt, grid, heights[1] - heights[0], width)
     assert opt["width"] == width
 
 
@@ -78,12 +78,11 @@ def test_height_alone_against_a_grid_of_heights(tmp_path):
 def test_width_and_height_against_a_grid_study(tmp_path):
     problem = design.RodDesign()
     opt = design.optimise(problem)
-    opt["scene_rod"] = problem.scene["bodies"][1]
     widths = design.linear_grid(design.WIDTH_BOUNDS, 3)
     heights = design.linear_grid(design.HEIGHT_BOUNDS, 17)
     grid = _grid(problem, widths, heights, tmp_path)
     assert grid["failed"] == 0
-    _check(opt, grid, problem.bound, heights[1] - heights[0], grid["width"])
+    _check(problem, opt, grid, heights[1] - heights[0], grid["width"])
     # the width goes to its lower bound (the deflection hardly depends on it; the mass
     # grows with it), within SLSQP's step tolerance
     assert opt["width"] == pytest.approx(design.WIDTH_BOUNDS[0], rel=1e-6)
