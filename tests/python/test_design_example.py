@@ -77,7 +77,7 @@ def test_height_alone_against_a_grid_of_heights(tmp_path):
     assert opt["width"] == width
 
 
-@pytest.mark.skipif(not SLOW, reason="slow (about 3 minutes): CTest python_design_slow, FLEXMBD_SLOW_TESTS=1")
+@pytest.mark.skipif(not SLOW, reason="slow (about 2-4 minutes): CTest python_design_slow, FLEXMBD_SLOW_TESTS=1")
 def test_width_and_height_against_a_grid_study(tmp_path):
     problem = design.RodDesign()
     opt = design.optimise(problem)
