@@ -4,7 +4,7 @@
 set -eu
 PACKAGES="build-essential cmake libeigen3-dev libsundials-dev libsuitesparse-dev \
 libgtest-dev libbenchmark-dev nlohmann-json3-dev python3-matplotlib libsiconos-numerics-dev \
-libhdf5-dev libspectra-dev python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed python3-pandas python3-h5py \
+libhdf5-dev libspectra-dev python3-dev pybind11-dev python3-numpy python3-pytest python3-distributed python3-pandas python3-h5py python3-scipy \
 python3-venv python3-pip calculix-ccx chromium doxygen"
 missing=""
 for p in $PACKAGES; do
