@@ -27,7 +27,11 @@ import numpy as np
 from . import InputError, parse_json, read_scene_file, scene_from_dict
 
 FIXED_COLUMNS = ["point", "status", "message", "t_reached", "wall_seconds"]
-STUDY_KEYS = {"name", "scene", "overrides", "axes", "combine", "samples", "outputs", "plot"}
+STUDY_KEYS = {"name", "scene", "overrides", "axes", "combine", "samples", "outputs", "plot", "sensitivities",
+              "sensitivity_error_control"}
+# the outputs that have a derivative: a value of one row of a results column (the summary's
+# keys and user functions have none)
+DIFFERENTIABLE_OUTPUTS = ("max_abs", "max", "min", "final")
 AXIS_KEYS = {"name", "key", "values", "range", "count", "spacing"}
 OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions"}
 PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
@@ -131,7 +135,17 @@ class Study:
         self.points = self._make_points(spec, where)
         self.outputs = spec.get("outputs", {"summary": ["steps", "cpu_seconds"]})
         _check_outputs(self.outputs, where + ": outputs")
-        self.output_names = output_names(self.outputs)
+        self.sensitivities = spec.get("sensitivities", [])
+        if (not isinstance(self.sensitivities, list) or
+                not all(isinstance(p, str) and p for p in self.sensitivities)):
+            _fail(where, f'key "sensitivities" must be a list of scene paths (strings), got {_shown(self.sensitivities)}')
+        if len(set(self.sensitivities)) != len(self.sensitivities):
+            _fail(where, 'key "sensitivities": a scene path is given twice')
+        self.sensitivity_error_control = spec.get("sensitivity_error_control", True)
+        if not isinstance(self.sensitivity_error_control, bool):
+            _fail(where, f'key "sensitivity_error_control" must be true or false, got '
+                         f'{_shown(self.sensitivity_error_control)}')
+        self.output_names = output_names(self.outputs) + gradient_names(self.outputs, self.sensitivities)
         self.plot = spec.get("plot")
         if self.plot is not None:
             self._check_plot(where + ": plot")
@@ -302,6 +316,41 @@ def output_names(outputs):
     return names
 
 
+def gradient_names(outputs, paths):
+    """The study.csv columns of the outputs' derivatives: d<NAME>/d<PATH> for every output
+    of a differentiable kind (max_abs, max, min, final, at; in output_names' order) and
+    every scene path of "sensitivities", in its order."""
+    names = [f"{kind}({c})" for kind in DIFFERENTIABLE_OUTPUTS for c in outputs.get(kind, [])]
+    names += [a.get("name", f"{a['column']}@{a['t']}") for a in outputs.get("at", [])]
+    return [f"d{n}/d{p}" for n in names for p in paths]
+
+
+def collect_gradients(results, outputs, paths):
+    """The values named by gradient_names(outputs, paths) from a run with sensitivities:
+    each output's derivative at the row it was taken from (the first row of the largest
+    value; max_abs times the sign of its value), an "at" output's interpolated as the
+    output is; NaN where a run ended before a requested time."""
+    t = results.t if len(results) else np.array([])
+    mask = t >= outputs.get("after", -math.inf) if len(t) else np.array([], dtype=bool)
+    values = []
+    pick = {"max_abs": lambda x: int(np.argmax(np.abs(x))), "max": lambda x: int(np.argmax(x)),
+            "min": lambda x: int(np.argmin(x)), "final": lambda x: len(x) - 1}
+    for kind in DIFFERENTIABLE_OUTPUTS:
+        for c in outputs.get(kind, []):
+            x = results[c][mask] if len(t) else np.array([])
+            if not len(x):
+                values += [math.nan] * len(paths)
+                continue
+            k = pick[kind](x)
+            sign = float(np.sign(x[k])) if kind == "max_abs" else 1.0
+            values += [sign * float(results.derivative(c, p)[mask][k]) for p in paths]
+    for a in outputs.get("at", []):
+        inside = len(t) and t[0] <= a["t"] <= t[-1]
+        values += [float(np.interp(a["t"], t, results.derivative(a["column"], p))) if inside else math.nan
+                   for p in paths]
+    return values
+
+
 def collect(results, outputs):
     """The values named by output_names(outputs) from a run's Results (NaN where a run
     ended before a requested time)."""
@@ -328,13 +377,20 @@ def collect(results, outputs):
     return values
 
 
-def run_point(index, scene, overrides, outputs, names):
-    """One point (a Dask task): a small record, whatever happens in the run."""
+def run_point(index, scene, overrides, outputs, names, sensitivities=(), sensitivity_error_control=True):
+    """One point (a Dask task): a small record, whatever happens in the run. With
+    ``sensitivities`` (scene paths) the run integrates the derivatives too and the record
+    holds the outputs' gradients after the outputs (gradient_names)."""
     start = time.perf_counter()
     record = {"point": index, "status": "ok", "message": "", "t_reached": math.nan}
     results = None
     try:
-        results = scene_from_dict(scene, overrides, source=f"point {index}").run(raise_on_failure=False)
+        point = scene_from_dict(scene, overrides, source=f"point {index}")
+        if sensitivities:
+            results = point.run(raise_on_failure=False, sensitivities=list(sensitivities),
+                                sensitivity_error_control=sensitivity_error_control)
+        else:
+            results = point.run(raise_on_failure=False)
         record["status"] = "ok" if results.ok else "failed"
         record["message"] = "" if results.ok else results.message
         tr = results.summary.get("t_reached")
@@ -349,6 +405,8 @@ def run_point(index, scene, overrides, outputs, names):
     if results is not None and record["status"] == "ok":
         try:
             values = collect(results, outputs)
+            if sensitivities:
+                values += collect_gradients(results, outputs, sensitivities)
         except Exception as e:  # noqa: BLE001
             record["status"] = "error"
             record["message"] = f"outputs: {type(e).__name__}: {e}"
@@ -444,7 +502,8 @@ def run_study(study, out_dir, scheduler=None, workers=None, progress=True):
             input_errors.append(record["message"])
         prog.update(record["status"])
 
-    args = lambda i: (i, study.scene, study.overrides_of(study.points[i]), study.outputs, study.output_names)  # noqa: E731
+    args = lambda i: (i, study.scene, study.overrides_of(study.points[i]), study.outputs, study.output_names,  # noqa: E731
+                      study.sensitivities, study.sensitivity_error_control)
     try:
         if workers == 0 and scheduler is None:
             for i in todo:

@@ -212,3 +212,63 @@ def test_damaged_study_files_are_input_errors_on_one_short_line(tmp_path, capsys
     err = capsys.readouterr().err
     assert words in err
     assert err.count("\n") == 1 and len(err) < 400 and "Traceback" not in err
+
+
+def test_study_gradients_equal_the_runs_and_the_closed_form(tmp_path):
+    # The rigid slider crank (l1 = 1) over two rod lengths l2, with sensitivities to l2 (the
+    # rod's end O3 on the rod) and the slider's mass. final(slider.x) by l2 is the closed
+    # form l2 / sqrt(l2^2 - sin^2 theta) at t_end (the engine's error ~1e-8 at rtol 1e-8:
+    # 1e-6); every gradient column equals the same point's Scene.run with sensitivities, at
+    # the row the output was taken from (the same engine path: 1e-15).
+    import numpy as np
+
+    import flexmbd
+
+    rod, mass = "joints[2].points[0][0]", "bodies[2].mass"
+    spec = {
+        "scene": os.path.join(SOURCE, "examples", "slider_crank_rigid.json"),
+        "overrides": {"solver": {"t_end": 2.0}},
+        "axes": [{"name": "l2", "key": rod, "values": [2.0, 2.5]}],
+        "outputs": {"final": ["slider.x"], "max_abs": ["motor.effort"], "summary": ["steps"],
+                    "at": [{"column": "slider.x", "t": 1.0, "name": "x_at_1"}]},
+        "sensitivities": [rod, mass],
+    }
+    path = tmp_path / "study.json"
+    path.write_text(json.dumps(spec))
+    study = st.load_study(str(path))
+    assert study.output_names[-6:] == [f"dmax_abs(motor.effort)/d{rod}", f"dmax_abs(motor.effort)/d{mass}",
+                                       f"dfinal(slider.x)/d{rod}", f"dfinal(slider.x)/d{mass}",
+                                       f"dx_at_1/d{rod}", f"dx_at_1/d{mass}"]
+    ran, failed = st.run_study(study, str(tmp_path / "out"), workers=0, progress=False)
+    assert (ran, failed) == (2, 0)
+    header, rows = table(str(tmp_path / "out"))
+    col = {name: header.index(name) - (header.index(name) > header.index("wall_seconds")) for name in header}
+    for row in rows:
+        l2 = float(row[col["l2"]])
+        res = flexmbd.load_scene(spec["scene"], {"solver": {"t_end": 2.0}, rod: l2}).run(sensitivities=[rod, mass])
+        theta = res["crank.theta"][-1]
+        closed = l2 / np.sqrt(l2 ** 2 - np.sin(theta) ** 2)
+        assert float(row[col[f"dfinal(slider.x)/d{rod}"]]) == pytest.approx(closed, abs=1e-6)
+        effort = res["motor.effort"]
+        k = int(np.argmax(np.abs(effort)))
+        for p in (rod, mass):
+            expected = np.sign(effort[k]) * res.derivative("motor.effort", p)[k]
+            assert float(row[col[f"dmax_abs(motor.effort)/d{p}"]]) == pytest.approx(expected, rel=1e-15)
+            at = np.interp(1.0, res.t, res.derivative("slider.x", p))
+            assert float(row[col[f"dx_at_1/d{p}"]]) == pytest.approx(at, rel=1e-15)
+        # the slider's mass moves no position of a driven mechanism: its derivative is zero
+        assert float(row[col[f"dfinal(slider.x)/d{mass}"]]) == pytest.approx(0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("value,words", [
+    ("bodies[1].mass", 'key "sensitivities" must be a list'),
+    ([1], 'key "sensitivities" must be a list'),
+    (["bodies[1].mass", "bodies[1].mass"], "given twice"),
+])
+def test_study_sensitivities_are_checked_before_the_study_runs(tmp_path, value, words):
+    spec = {"scene": os.path.join(SOURCE, "examples", "slider_crank_rigid.json"),
+            "axes": [{"name": "m", "key": "bodies[2].mass", "values": [1.0]}], "sensitivities": value}
+    path = tmp_path / "study.json"
+    path.write_text(json.dumps(spec))
+    with pytest.raises(InputError, match=words):
+        st.load_study(str(path))
