@@ -133,7 +133,15 @@ class RodDesign:
         return value, gradient
 
 
-def optimise(design, start=START, tolerance=1e-6, max_iterations=30, constraint="linear"):
+# SLSQP's ftol on the mass in grams: the peak deflection of a run at the scene's rtol 1e-6
+# is known to about 1e-6 of itself, which moves the height on the bound by about 1/4 of
+# that (D falls roughly as h^-4) and the mass by ~2e-5 g; a ftol below it has the line
+# search chase the integration's noise (measured: 1e-6 g took 18 runs of the one-variable
+# problem where 1e-4 g takes 8, to the same height within 1e-9 m).
+FTOL_GRAMS = 1e-4
+
+
+def optimise(design, start=START, tolerance=FTOL_GRAMS, max_iterations=30, constraint="linear"):
     """SLSQP on the section in millimetres: the mass (grams) with its analytic gradient,
     the constraint 1 - D / bound >= 0 with the engine's gradient, or with
     ``constraint="log"`` log(bound / D) >= 0 (D falls roughly as a power of h, so its
