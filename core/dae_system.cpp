@@ -446,12 +446,6 @@ void DaeSystem::residualOfParts(double t, const double* y, const double* yp, dou
   }
 }
 
-ResidualParts ResidualParts::all(const System& sys) {
-  return {std::vector<char>(static_cast<size_t>(sys.numBodies()), 1),
-          std::vector<char>(static_cast<size_t>(sys.numForces()), 1),
-          std::vector<char>(static_cast<size_t>(sys.numConstraints()), 1)};
-}
-
 ResidualParts ResidualParts::none(const System& sys) {
   return {std::vector<char>(static_cast<size_t>(sys.numBodies()), 0),
           std::vector<char>(static_cast<size_t>(sys.numForces()), 0),

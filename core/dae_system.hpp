@@ -53,7 +53,6 @@ VecX defaultStabilisationMetric(const System& sys);
 /// flag per body, force and constraint of the system.
 struct ResidualParts {
   std::vector<char> bodies, forces, constraints;
-  static ResidualParts all(const System& sys);
   static ResidualParts none(const System& sys);
 };
 

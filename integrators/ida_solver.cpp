@@ -148,14 +148,7 @@ struct IdaSolver::Impl {
 
   /// r += A x for A in CSC values on the DAE's pattern.
   void addProduct(const std::vector<double>& A, const double* x, double* r) const {
-    const SparsePattern& p = dae->pattern();
-    const auto& cs = p.colStart();
-    const auto& ri = p.rowIndex();
-    for (int c = 0; c < p.size(); ++c) {
-      const double xc = x[c];
-      if (xc == 0.0) continue;
-      for (int64_t k = cs[c]; k < cs[c + 1]; ++k) r[ri[k]] += A[k] * xc;
-    }
+    addPatternProduct(dae->pattern(), A.data(), x, r);
   }
 
   /// The sensitivity residuals F_y s_i + F_y' s_i' + F_p_i: the forward sensitivity system

@@ -4,9 +4,22 @@
 /// sensitivities and how the sensitivities enter the error test.
 #pragma once
 
+#include "core/sparse_pattern.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
+
+/// r += A x for A in CSC values on `pattern` (the sensitivity residual's F_y s, the
+/// projection of the initial sensitivities). Allocates nothing.
+inline void addPatternProduct(const SparsePattern& pattern, const double* values, const double* x, double* r) {
+  const auto& cs = pattern.colStart();
+  const auto& ri = pattern.rowIndex();
+  for (int c = 0; c < pattern.size(); ++c) {
+    const double xc = x[c];
+    if (xc == 0.0) continue;
+    for (int64_t k = cs[c]; k < cs[c + 1]; ++k) r[ri[k]] += values[k] * xc;
+  }
+}
 
 /// dF/dp_i (t, y, y') of a DAE F(t, y, y', p) = 0 for each parameter p_i.
 class ParameterDerivatives {

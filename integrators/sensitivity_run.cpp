@@ -179,9 +179,7 @@ void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDif
     pairs[i].minus->residual(t0, y.data(), yp.data(), Fminus.data());
     const auto residualOfRows = [&](int row0) {
       r.setZero();
-      for (int c = 0; c < L.size; ++c) {
-        for (int64_t k = P.colStart()[c]; k < P.colStart()[c + 1]; ++k) r[P.rowIndex()[k]] += J0[static_cast<std::size_t>(k)] * col[c];
-      }
+      addPatternProduct(P, J0.data(), col.data(), r.data());
       return VecX(r.segment(row0, L.m) + (Fplus - Fminus).segment(row0, L.m) / (2.0 * pairs[i].step));
     };
     // G s_q + g_p = 0 (positions), then d/dp (G v + g_t) = 0 (velocities) with the new s_q
