@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "integrators/adjoint_problem.hpp"
 #include "integrators/dae_integrator.hpp"
 #include "integrators/sensitivity_problem.hpp"
 
@@ -24,11 +25,21 @@ class IdaSolver final : public DaeIntegrator {
   /// @throws InputError if the sizes do not match, SolverError if IDAS cannot be set up.
   IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, const IntegratorOptions& options,
             const SensitivityProblem& sensitivity);
+  /// With the integrals of `outputs` as forward quadratures (outside the error test: they
+  /// follow the state's steps) and, if `stepsPerCheckpoint` > 0, recording for adjoint
+  /// sensitivities (IDAS: one checkpoint every `stepsPerCheckpoint` steps, the BDF's own
+  /// interpolating polynomials between the steps; see checkpoints()). `outputs` and `dae`
+  /// must outlive the solver; a recording DAE must provide its rate Jacobian product
+  /// (DaeProblem::providesRateJacobianProduct).
+  /// @throws InputError if it does not, SolverError if IDAS cannot be set up.
+  IdaSolver(const DaeProblem& dae, double t0, const VecX& y0, const VecX& yp0, const IntegratorOptions& options,
+            IntegralOutputs& outputs, long stepsPerCheckpoint);
   ~IdaSolver();
   IdaSolver(const IdaSolver&) = delete;
   IdaSolver& operator=(const IdaSolver&) = delete;
 
-  /// Integrates to tout (never past tStop), returns the time reached (= tout).
+  /// Integrates to tout (never past tStop, but with adjoint recording: see advance's
+  /// comment), returns the time reached (= tout).
   /// @throws SolverError with IDA's reason, the time and the last step size; an exception
   /// of the model's residual or Jacobian as it was thrown (DaeIntegrator::advance).
   double advance(double tout, double tStop) override;
@@ -42,6 +53,23 @@ class IdaSolver final : public DaeIntegrator {
   const MatX& sensitivityRate() const { return sp_; }
   /// Sensitivity residual evaluations (calls of the sensitivity residual function).
   long sensitivityResidualEvals() const;
+  /// The integrals of the outputs from t0 to the time returned by advance() (empty without).
+  VecX integrals() const;
+  /// Checkpoints IDAS has stored (recording): 1 while the run has taken fewer steps than
+  /// stepsPerCheckpoint. IDAS 6.4 recomputes each interval between checkpoints in the
+  /// backward integration and overruns its step store when the recomputation takes more
+  /// steps than the first pass did (SUNDIALS issue 49; measured here from the second
+  /// checkpoint on: a restored checkpoint takes a fresh Jacobian, the first pass an older
+  /// one). The recomputation from the first checkpoint repeats the first pass exactly, so
+  /// a recording is safe with one checkpoint (simulateWithAdjoint records in segments).
+  int checkpoints() const { return checkpoints_; }
+  /// After the recording reached T: integrates the adjoints of `problem` (one backward
+  /// problem per output, terminal values at T) back to t0, with the quadratures of the
+  /// gradients (docs/sensitivities.md, "Adjoint sensitivities"). Each backward problem's
+  /// Newton matrix is -J(-cj_B)^T (the term of dE/dt left out).
+  /// @throws SolverError with IDAS's reason and the time; an exception of a callback as
+  /// it was thrown; std::logic_error without recording.
+  AdjointSolution integrateAdjoint(const AdjointProblem& problem, double t0);
   bool usesKlu() const override { return usesKlu_; }
   bool solutionAtFailure(VecX& y) const override {
     if (failureState_.size() == 0) return false;
@@ -53,7 +81,10 @@ class IdaSolver final : public DaeIntegrator {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   void startSensitivities(const SensitivityProblem& sensitivity);
+  void startQuadratures(IntegralOutputs& outputs, long stepsPerCheckpoint);
   VecX y_, yp_, failureState_;
+  double t_ = 0.0;  ///< the time returned by the last advance()
+  int checkpoints_ = 0;
   MatX s_, sp_;
   bool usesKlu_ = false;
 };

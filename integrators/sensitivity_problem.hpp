@@ -21,6 +21,17 @@ inline void addPatternProduct(const SparsePattern& pattern, const double* values
   }
 }
 
+/// r += A^T x for A in CSC values on `pattern` (the adjoint's F_y^T lambda). Allocates nothing.
+inline void addPatternTransposeProduct(const SparsePattern& pattern, const double* values, const double* x, double* r) {
+  const auto& cs = pattern.colStart();
+  const auto& ri = pattern.rowIndex();
+  for (int c = 0; c < pattern.size(); ++c) {
+    double sum = 0.0;
+    for (int64_t k = cs[c]; k < cs[c + 1]; ++k) sum += values[k] * x[ri[k]];
+    r[c] += sum;
+  }
+}
+
 /// dF/dp_i (t, y, y') of a DAE F(t, y, y', p) = 0 for each parameter p_i.
 class ParameterDerivatives {
  public:

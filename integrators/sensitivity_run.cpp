@@ -227,24 +227,46 @@ SensitivitySample sensitivitySample(const DaeLayout& L, const MatX& S, const std
 
 }  // namespace
 
-SimulationSummary simulateWithSensitivities(const System& sys, const std::vector<SensitivityParameter>& params,
-                                            const SolverSettings& given, const SensitivitySettings& sensitivity,
-                                            const SensitivityCallback& onOutput) {
+SolverSettings sensitivityRunSettings(const SolverSettings& given, const std::string& what) {
   given.validate();
-  if (params.empty()) throw InputError("sensitivities: no parameter given");
   if (given.integrator != IntegratorKind::Automatic && given.integrator != IntegratorKind::Ida) {
-    throw InputError("solver.integrator: sensitivities are computed by IDAS only: expected \"ida\" or \"auto\", got \"" +
+    throw InputError("solver.integrator: " + what + " are computed by IDAS only: expected \"ida\" or \"auto\", got \"" +
                      toString(given.integrator) + "\"");
   }
   if (given.elasticStart != ElasticStart::Given) {
-    throw InputError("solver.elastic_start: sensitivities need the elastic start \"given\", got \"" +
+    throw InputError("solver.elastic_start: " + what + " need the elastic start \"given\", got \"" +
                      toString(given.elasticStart) + "\"");
   }
   if (given.finiteDifferenceJacobian) {
-    throw InputError("solver.fd_jacobian: sensitivities use the analytic Jacobian: expected false");
+    throw InputError("solver.fd_jacobian: " + what + " use the analytic Jacobian: expected false");
   }
   SolverSettings settings = given;
   settings.integrator = IntegratorKind::Ida;
+  return settings;
+}
+
+PerturbedDaes perturbedDaes(const DaeSystem& base, const std::vector<SensitivityParameter>& params) {
+  PerturbedDaes out;
+  out.scales = VecX(static_cast<Eigen::Index>(params.size()));
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const SensitivityParameter& p = params[i];
+    for (const System* s : {p.plus, p.minus}) {
+      if (!s || !s->isFinalized()) throw InputError("sensitivity parameter '" + p.name + "': no finalized system");
+      out.daes.push_back(std::make_unique<DaeSystem>(*s, base.formulation(), defaultStabilisationMetric(*s),
+                                                     base.releasedEquations()));
+      requireSameStructure(base, *out.daes.back(), p.name);
+    }
+    out.pairs.push_back({out.daes[out.daes.size() - 2].get(), out.daes.back().get(), p.step});
+    out.scales[static_cast<Eigen::Index>(i)] = std::max(std::fabs(p.value), kParameterTypicalMagnitude);
+  }
+  return out;
+}
+
+SimulationSummary simulateWithSensitivities(const System& sys, const std::vector<SensitivityParameter>& params,
+                                            const SolverSettings& given, const SensitivitySettings& sensitivity,
+                                            const SensitivityCallback& onOutput) {
+  if (params.empty()) throw InputError("sensitivities: no parameter given");
+  const SolverSettings settings = sensitivityRunSettings(given, "forward sensitivities");
   const std::clock_t cpuStart = std::clock();
   const double t0 = settings.tStart, tEnd = settings.tEnd;
 
@@ -254,20 +276,9 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
   const ConsistentState init =
       computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
   const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
-  std::vector<std::unique_ptr<DaeSystem>> perturbed;
-  std::vector<ResidualDifferences::Pair> pairs;
-  VecX scales(static_cast<Eigen::Index>(params.size()));
-  for (std::size_t i = 0; i < params.size(); ++i) {
-    const SensitivityParameter& p = params[i];
-    for (const System* s : {p.plus, p.minus}) {
-      if (!s || !s->isFinalized()) throw InputError("sensitivity parameter '" + p.name + "': no finalized system");
-      perturbed.push_back(std::make_unique<DaeSystem>(*s, settings.formulation, defaultStabilisationMetric(*s),
-                                                      init.released));
-      requireSameStructure(dae, *perturbed.back(), p.name);
-    }
-    pairs.push_back({perturbed[perturbed.size() - 2].get(), perturbed.back().get(), p.step});
-    scales[static_cast<Eigen::Index>(i)] = std::max(std::fabs(p.value), kParameterTypicalMagnitude);
-  }
+  const PerturbedDaes perturbed = perturbedDaes(dae, params);
+  const std::vector<ResidualDifferences::Pair>& pairs = perturbed.pairs;
+  const VecX& scales = perturbed.scales;
   const InitialSensitivities s0 = initialSensitivities(dae, pairs, init, t0);
   const RunStart start = startRun(dae, init, t0);
 

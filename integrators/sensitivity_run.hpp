@@ -124,6 +124,22 @@ void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDif
 /// @throws InputError naming the parameter and what changed.
 void requireSameStructure(const DaeSystem& base, const DaeSystem& perturbed, const std::string& parameter);
 
+/// The settings of a run with sensitivities (forward or adjoint): `given` with the
+/// integrator IDA. @throws InputError naming the key: an integrator other than ida or
+/// auto, an elastic start other than "given", fd_jacobian (`what`: "forward sensitivities").
+SolverSettings sensitivityRunSettings(const SolverSettings& given, const std::string& what);
+
+/// The DAEs of the perturbed systems of every parameter (same formulation and released
+/// equations as `base`), checked for the base's structure, their pairs and the
+/// parameters' scales max(|p|, kParameterTypicalMagnitude).
+struct PerturbedDaes {
+  std::vector<std::unique_ptr<DaeSystem>> daes;
+  std::vector<ResidualDifferences::Pair> pairs;
+  VecX scales;
+};
+/// @throws InputError naming a parameter without a finalized system or one that changes the structure.
+PerturbedDaes perturbedDaes(const DaeSystem& base, const std::vector<SensitivityParameter>& parameters);
+
 /// simulateKeepingFailures with forward sensitivities, on IDA(S) only (no hand-over to
 /// Radau IIA, no singular crossing: a run that fails stops there, rows kept). `onOutput`
 /// gets every output with its sensitivities.

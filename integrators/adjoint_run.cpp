@@ -1,0 +1,432 @@
+#include "integrators/adjoint_run.hpp"
+
+#include <cmath>
+#include <ctime>
+#include <exception>
+
+#include <Eigen/QR>
+
+#include "core/errors.hpp"
+#include "core/system_evaluation.hpp"
+#include "integrators/ida_solver.hpp"
+#include "integrators/output_recorder.hpp"
+#include "integrators/run_stages.hpp"
+#include "integrators/run_state.hpp"
+
+namespace flexmbd {
+
+namespace {
+
+/// The integral outputs of a run on its systems: g_k on the base system, its gradient in
+/// (q, v) by central differences over the entries it depends on, g_p on each parameter's
+/// perturbed systems, dF/dp from ResidualDifferences (shared by the outputs at a state).
+class SystemIntegrals final : public IntegralOutputs {
+ public:
+  SystemIntegrals(const DaeSystem& dae, const std::vector<SensitivityParameter>& params,
+                  const std::vector<IntegralOutput>& outputs, ResidualDifferences& derivatives, double t0,
+                  const VecX& y0, const VecX& yp0)
+      : dae_(dae), params_(params), outputs_(outputs), derivatives_(derivatives) {
+    const DaeLayout& L = dae.layout();
+    q_ = y0.segment(L.q, L.nq);
+    v_ = y0.segment(L.v, L.nv);
+    const auto n = static_cast<Eigen::Index>(y0.size());
+    dFdp_ = MatX::Zero(n, static_cast<Eigen::Index>(params.size()));
+    cacheY_ = VecX::Zero(n);
+    cacheYp_ = VecX::Zero(n);
+    gyCache_.assign(outputs.size(), VecX::Zero(n));
+    gyTime_.assign(outputs.size(), std::nan(""));
+    gyY_.assign(outputs.size(), VecX::Zero(n));
+    findDependencies(t0, y0, yp0);
+  }
+  int count() const override { return static_cast<int>(outputs_.size()); }
+  int parameterCount() const override { return static_cast<int>(params_.size()); }
+
+  void integrands(double t, const double* y, double* g) override {
+    unpack(y);
+    for (std::size_t k = 0; k < outputs_.size(); ++k) g[k] = outputs_[k].integrand(dae_.system(), t, q_, v_);
+  }
+
+  void integrandGradient(int k, double t, const double* y, double* gy) override {
+    const auto K = static_cast<std::size_t>(k);
+    const auto n = static_cast<Eigen::Index>(cacheY_.size());
+    const Eigen::Map<const VecX> Y(y, n);
+    if (!(t == gyTime_[K] && Y == gyY_[K])) {
+      unpack(y);
+      VecX& out = gyCache_[K];
+      out.setZero();
+      for (const int j : dependencies_[K]) out[j] = difference(k, t, j);
+      gyTime_[K] = t;
+      gyY_[K] = Y;
+    }
+    Eigen::Map<VecX>(gy, n) = gyCache_[K];
+  }
+
+  void gradientIntegrand(int k, double t, const double* y, const double* yp, const double* lambda,
+                         double* out) override {
+    const auto n = static_cast<Eigen::Index>(cacheY_.size());
+    const Eigen::Map<const VecX> Y(y, n), Yp(yp, n), Lambda(lambda, n);
+    if (!(cacheValid_ && t == cacheT_ && Y == cacheY_ && Yp == cacheYp_)) {
+      for (int i = 0; i < parameterCount(); ++i) derivatives_.residualDerivative(i, t, y, yp, dFdp_.col(i).data());
+      cacheT_ = t;
+      cacheY_ = Y;
+      cacheYp_ = Yp;
+      cacheValid_ = true;
+    }
+    unpack(y);
+    const auto K = static_cast<std::size_t>(k);
+    for (int i = 0; i < parameterCount(); ++i) {
+      const auto I = static_cast<std::size_t>(i);
+      // g_p - lambda^T F_p (IDAS guide, "Adjoint sensitivity analysis")
+      out[i] = -Lambda.dot(dFdp_.col(i));
+      if (explicitParameters_[K][I]) {
+        const double plus = outputs_[K].integrand(*params_[I].plus, t, q_, v_);
+        const double minus = outputs_[K].integrand(*params_[I].minus, t, q_, v_);
+        out[i] += (plus - minus) / (2.0 * params_[I].step);  // central difference, Nocedal & Wright 2006, sec. 8.1
+      }
+    }
+  }
+
+  /// The entries of y output k depends on (for the tests and the docs).
+  const std::vector<int>& dependencies(int k) const { return dependencies_[static_cast<std::size_t>(k)]; }
+
+ private:
+  void unpack(const double* y) {
+    const DaeLayout& L = dae_.layout();
+    q_ = Eigen::Map<const VecX>(y + L.q, L.nq);
+    v_ = Eigen::Map<const VecX>(y + L.v, L.nv);
+  }
+  /// The step of entry j of y: eps^(1/3) max(|y_j|, 1) (as parameterStep).
+  static double stepOf(double value) { return parameterStep(value); }
+  /// dg_k/dy_j by a central difference at the unpacked state (restored after).
+  double difference(int k, double t, int j) {
+    const DaeLayout& L = dae_.layout();
+    const bool isQ = j < L.q + L.nq;
+    double& entry = isQ ? q_[j - L.q] : v_[j - L.v];
+    const double saved = entry, h = stepOf(saved);
+    const System& sys = dae_.system();
+    const auto& g = outputs_[static_cast<std::size_t>(k)].integrand;
+    entry = saved + h;
+    const double plus = g(sys, t, q_, v_);
+    entry = saved - h;
+    const double minus = g(sys, t, q_, v_);
+    entry = saved;
+    return (plus - minus) / (2.0 * h);
+  }
+  /// Which entries of (q, v) each integrand depends on and which parameters it holds
+  /// explicitly: those that change it, bit for bit, at the initial state or at a generic
+  /// state near it (as ResidualDifferences finds the bodies of a parameter).
+  void findDependencies(double t0, const VecX& y0, const VecX& yp0) {
+    (void)yp0;
+    const DaeLayout& L = dae_.layout();
+    std::vector<VecX> states{y0, y0};
+    for (Eigen::Index k = 0; k < y0.size(); ++k) {
+      states[1][k] += 1e-2 * std::sin(1.0 + 0.7548776662 * static_cast<double>(k)) * (1.0 + std::fabs(y0[k]));
+    }
+    dependencies_.assign(outputs_.size(), {});
+    explicitParameters_.assign(outputs_.size(), std::vector<char>(params_.size(), 0));
+    const System& sys = dae_.system();
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      const auto& g = outputs_[k].integrand;
+      for (int j = 0; j < L.nq + L.nv; ++j) {
+        const int entry = j < L.nq ? L.q + j : L.v + (j - L.nq);
+        bool depends = false;
+        for (const VecX& y : states) {
+          unpack(y.data());
+          const double base = g(sys, t0, q_, v_);
+          double& e = j < L.nq ? q_[j] : v_[j - L.nq];
+          e += stepOf(e);
+          depends = depends || !(g(sys, t0, q_, v_) == base);
+        }
+        if (depends) dependencies_[k].push_back(entry);
+      }
+      for (std::size_t i = 0; i < params_.size(); ++i) {
+        for (const VecX& y : states) {
+          unpack(y.data());
+          if (!(g(*params_[i].plus, t0, q_, v_) == g(*params_[i].minus, t0, q_, v_))) explicitParameters_[k][i] = 1;
+        }
+      }
+    }
+  }
+
+  const DaeSystem& dae_;
+  const std::vector<SensitivityParameter>& params_;
+  const std::vector<IntegralOutput>& outputs_;
+  ResidualDifferences& derivatives_;
+  VecX q_, v_;
+  std::vector<std::vector<int>> dependencies_;
+  std::vector<std::vector<char>> explicitParameters_;
+  // dF/dp at (cacheT_, cacheY_, cacheYp_), shared by the outputs
+  MatX dFdp_;
+  VecX cacheY_, cacheYp_;
+  double cacheT_ = 0.0;
+  bool cacheValid_ = false;
+  // g_y per output at (gyTime_, gyY_): the backward corrector evaluates it several times at one state
+  std::vector<VecX> gyCache_, gyY_;
+  std::vector<double> gyTime_;
+};
+
+/// Dense F_y = J(0) and E = J(1) - J(0) of the DAE at a state.
+void denseJacobians(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, MatX& Fy, MatX& E) {
+  const int n = dae.size();
+  Fy = MatX::Zero(n, n);
+  E = MatX::Zero(n, n);
+  JacobianSink s0 = JacobianSink::dense(Fy.data(), n);
+  dae.jacobian(t, y.data(), yp.data(), 0.0, s0);
+  JacobianSink s1 = JacobianSink::dense(E.data(), n);
+  dae.jacobian(t, y.data(), yp.data(), 1.0, s1);
+  E -= Fy;
+}
+
+}  // namespace
+
+MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy) {
+  const DaeLayout& L = dae.layout();
+  if (L.mu < 0 || L.q != 0 || L.v != L.nq || L.lambda != L.nq + L.nv) {
+    throw std::logic_error("adjointTerminalValues: the GGL layout [q, v, lambda, mu] expected");
+  }
+  MatX Fy, E;
+  denseJacobians(dae, t, y, yp, Fy, E);
+  const int nd = L.nq + L.nv, na = L.size - nd;
+  // unknowns x = [lambda_D' (nd); lambda_A (na)], lambda_D(T) = 0
+  MatX A = MatX::Zero(L.size, L.size);
+  VecX b = VecX::Zero(L.size);
+  // differential rows of E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y = 0 at lambda_D = 0
+  A.topLeftCorner(nd, nd) = E.topLeftCorner(nd, nd).transpose();
+  A.topRightCorner(nd, na) = -Fy.bottomLeftCorner(na, nd).transpose();
+  b.head(nd) = -gy.head(nd);
+  // algebraic rows: -F_Da^T lambda_D - F_Aa^T lambda_A + g_a = 0 (g holds no multiplier); where
+  // F_Aa's column is empty (a constraint not released) its derivative at lambda_D = 0:
+  // F_Da^T lambda_D' = 0 (the hidden constraint); where not (a released equation's row
+  // lambda_k = 0): F_Aa^T lambda_A = 0
+  for (int j = 0; j < na; ++j) {
+    const auto column = Fy.col(nd + j);
+    if (column.tail(na).cwiseAbs().maxCoeff() > 0.0) {
+      A.row(nd + j).tail(na) = column.tail(na).transpose();
+    } else {
+      A.row(nd + j).head(nd) = column.head(nd).transpose();
+    }
+  }
+  const VecX x = Eigen::CompleteOrthogonalDecomposition<MatX>(A).solve(b);
+  MatX out = MatX::Zero(L.size, 2);
+  out.col(0).tail(na) = x.tail(na);
+  out.col(1).head(nd) = x.head(nd);
+  return out;
+}
+
+namespace {
+
+/// The tolerances of the adjoint of an output of value G (docs/sensitivities.md): M lambda_v
+/// = dG/dv(t) and lambda_q = dG/dq(t) (the output's derivative with respect to the state at
+/// t) are held to rtol |G| over the state's scale, y_scale = atol_j rtol-free scale of the
+/// run's own tolerances (atol_j / rtol); the adjoint multipliers like lambda_q.
+VecX adjointTolerances(const DaeLayout& L, const VecX& atol, double rtol, const MatX& E, double value) {
+  const double g = std::max(std::fabs(value), std::numeric_limits<double>::min() / rtol);
+  VecX out(atol.size());
+  for (Eigen::Index j = 0; j < atol.size(); ++j) {
+    const double scale = atol[j] / rtol;  // the state's scale of entry j
+    const bool velocity = j >= L.v && j < L.v + L.nv;
+    const double mass = velocity && E(j, j) > 0.0 ? E(j, j) : 1.0;
+    out[j] = rtol * g / (scale * mass);
+  }
+  return out;
+}
+
+}  // namespace
+
+namespace {
+
+/// The forward run's state at an output: where a segment of the backward pass restarts it.
+struct ForwardPoint {
+  double t = 0.0;
+  VecX y, yp;
+  long steps = 0;  ///< the run's steps up to t
+};
+
+/// Memory of one segment's recording: IDAS keeps one vector of the DAE's size per step.
+constexpr double kRecordingBytes = 256.0 * 1024 * 1024;
+/// A segment's recording restarts from an output (order 1, a small first step) and may
+/// take more steps than the run did there: its store holds this many times the run's
+/// steps, plus kRecordingExtraSteps.
+constexpr long kRecordingStepFactor = 2;
+constexpr long kRecordingExtraSteps = 500;
+
+/// A model without a degree of freedom (G v = -g_t fixes every velocity: a kinematically
+/// driven mechanism) has lambda_q = lambda_v = 0: its adjoint is all algebraic, IDAS's error
+/// estimates vanish and its backward steps stay at order 1, so the gradients carry errors
+/// of about sqrt(rtol) (measured on the driven rigid slider crank: 6e-3, 6e-4, 6e-5 at rtol
+/// 1e-7, 1e-9, 1e-11). The warning for such a model ("" for others).
+std::string algebraicAdjointWarning(const System& sys, const DaeSystem& dae, const ConsistentState& init, double t0) {
+  if (dae.layout().m == 0) return "";
+  MatX G;
+  evaluateConstraints(sys, init.q, t0, nullptr, &G);
+  const Eigen::Index freedom = G.cols() - Eigen::CompleteOrthogonalDecomposition<MatX>(G).rank();
+  if (freedom > 0) return "";
+  return "adjoint: the model has no degree of freedom (its constraints and drivers fix every velocity): its adjoint "
+         "is algebraic and IDAS integrates it back at order 1, so the gradients carry errors of about sqrt(rtol) "
+         "(docs/sensitivities.md); the forward sensitivities (--sensitivity without --adjoint) are exact there";
+}
+
+/// Consecutive outputs [first, last] of at most `maxSteps` steps of the run (at least one
+/// output interval each), from the start.
+std::vector<std::pair<std::size_t, std::size_t>> segmentsOf(const std::vector<ForwardPoint>& points, long maxSteps) {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
+  std::size_t first = 0;
+  while (first + 1 < points.size()) {
+    std::size_t last = first + 1;
+    while (last + 1 < points.size() && points[last + 1].steps - points[first].steps <= maxSteps) ++last;
+    out.emplace_back(first, last);
+    first = last;
+  }
+  return out;
+}
+
+/// Stage "backward": the adjoints of every output from T back to t0, segment by segment
+/// from the last: each segment's forward run recorded again from its first output with
+/// one IDAS checkpoint (IdaSolver::checkpoints), then integrated back with the adjoint's
+/// values at its end (the terminal values at T, the previous segment's lambda(t_a) after).
+/// @returns lambda(t0) and the quadratures summed over the segments.
+AdjointSolution integrateBackward(const DaeSystem& dae, const IntegratorOptions& options, SystemIntegrals& integrals,
+                                  const std::vector<ForwardPoint>& points, AdjointProblem problem) {
+  const long maxSteps =
+      std::max(1L, static_cast<long>(kRecordingBytes / (8.0 * dae.size())) / kRecordingStepFactor);
+  const auto segments = segmentsOf(points, maxSteps);
+  AdjointSolution total{MatX(), MatX(), MatX::Zero(problem.atolQ.rows(), problem.atolQ.cols()), 0};
+  for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
+    const ForwardPoint& a = points[it->first];
+    const ForwardPoint& b = points[it->second];
+    long store = kRecordingStepFactor * (b.steps - a.steps) + kRecordingExtraSteps;
+    std::unique_ptr<IdaSolver> recording;
+    for (int attempt = 0; attempt < 3; ++attempt, store *= 4) {
+      recording = std::make_unique<IdaSolver>(dae, a.t, a.y, a.yp, options, integrals, store);
+      recording->advance(b.t, b.t);
+      if (recording->checkpoints() <= 1) break;
+    }
+    if (recording->checkpoints() > 1) {
+      throw SolverError("adjoint: the recording of [" + std::to_string(a.t) + ", " + std::to_string(b.t) +
+                            "] took more than " + std::to_string(store / 4) + " steps (the run took " +
+                            std::to_string(b.steps - a.steps) + ")",
+                        a.t, 0.0);
+    }
+    const AdjointSolution part = recording->integrateAdjoint(problem, a.t);
+    total.integral += part.integral;
+    total.steps += part.steps;
+    total.lambda0 = part.lambda0;
+    total.lambdaRate0 = part.lambdaRate0;
+    problem.lambdaT = part.lambda0;  // the next segment ends where this one starts
+    problem.lambdaTp = part.lambdaRate0;
+  }
+  return total;
+}
+
+}  // namespace
+
+AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<SensitivityParameter>& params,
+                                   const std::vector<IntegralOutput>& outputs, const SolverSettings& given,
+                                   const OutputCallback& onOutput) {
+  if (params.empty()) throw InputError("adjoint sensitivities: no parameter given");
+  if (outputs.empty()) throw InputError("adjoint sensitivities: no integral output given");
+  const SolverSettings settings = sensitivityRunSettings(given, "adjoint sensitivities");
+  if (settings.formulation != Formulation::Ggl) {
+    throw InputError("solver.formulation: adjoint sensitivities are derived for the GGL form: expected \"ggl\", got \"" +
+                     toString(settings.formulation) + "\"");
+  }
+  const std::clock_t cpuStart = std::clock();
+  const double t0 = settings.tStart, tEnd = settings.tEnd;
+
+  // start: the consistent state, the perturbed DAEs, the initial sensitivities (the
+  // gradient's term lambda(t0)^T E s(t0))
+  ReleasedEquations released;
+  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
+  const ConsistentState init =
+      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
+  const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
+  const PerturbedDaes perturbed = perturbedDaes(dae, params);
+  const InitialSensitivities s0 = initialSensitivities(dae, perturbed.pairs, init, t0);
+  const RunStart start = startRun(dae, init, t0);
+
+  AdjointSummary out;
+  OutputRecorder recorder(sys, start.modelSize, onOutput, dae.releasedEquations());
+  if (const std::optional<RunFailure> stop = recordInitialOutput(recorder, dae.layout(), start, t0)) {
+    out.run = summaryAtStart(start, recorder.recorded(), *stop);
+    return out;
+  }
+  const ModelScales modelScale = modelScales(sys, init.v, t0, tEnd);
+  ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings, &modelScale);
+  choice.reason = "adjoint sensitivities are computed by IDAS";
+
+  // forward: the run as a plain one, with the outputs' integrals, its state kept at every output
+  ResidualDifferences derivatives(perturbed.pairs, t0, start.y0, start.yp0);
+  SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0, start.yp0);
+  RunState state;
+  state.kind = IntegratorKind::Ida;
+  auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, integrals, 0);
+  IdaSolver& solver = *ida;
+  state.usedKlu = solver.usesKlu();
+  state.integrator = std::move(ida);
+  const OutputSchedule schedule(t0, tEnd, settings.outputStep);
+  ProgressReporter progress(settings.progress, t0, tEnd, "ida+adjoint");
+  const DaeLayout& L = dae.layout();
+  const RunContext ctx{sys, dae, settings, choice.options, schedule, start.modelSize, start.startRatio, false};
+  std::vector<ForwardPoint> points{{t0, start.y0, start.yp0, 0}};
+  std::optional<RunFailure> failure;
+  try {
+    for (long k = 1; k <= schedule.count; ++k) {
+      const double t = solver.advance(schedule.time(k), tEnd);
+      requireStepBudget(ctx, state, t);
+      recorder.record(t, solver.y().segment(L.q, L.nq), solver.y().segment(L.v, L.nv));
+      points.push_back({t, solver.y(), solver.yp(), solver.stats().steps});
+      progress.update(t, solver.stats().steps);
+    }
+  } catch (...) {
+    const FailureContext failed{sys, recorder.recorded(), start.modelSize, start.startRatio,
+                                solver.stats().currentTime, &dae.releasedEquations()};
+    failure = diagnoseFailure(std::current_exception(), failed);
+  }
+  out.run = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
+  for (const int r : dae.releasedEquations()) out.run.redundantConstraints.push_back(sys.describeEquation(r));
+  out.run.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
+  if (!out.run.ok) return out;
+
+  // backward: one adjoint per output from its terminal values at T
+  const std::clock_t backwardStart = std::clock();
+  if (const std::string w = algebraicAdjointWarning(sys, dae, init, t0); !w.empty()) out.run.warnings.push_back(w);
+  const VecX G = solver.integrals();
+  const int n = dae.size(), count = static_cast<int>(outputs.size());
+  const auto np = static_cast<Eigen::Index>(params.size());
+  AdjointProblem problem{&integrals, MatX(n, count), MatX(n, count), MatX(n, count), MatX(np, count), L.nq};
+  MatX FyT, ET;
+  const ForwardPoint& end = points.back();
+  denseJacobians(dae, end.t, end.y, end.yp, FyT, ET);
+  VecX gy(n);
+  for (int k = 0; k < count; ++k) {
+    integrals.integrandGradient(k, end.t, end.y.data(), gy.data());
+    const MatX terminal = adjointTerminalValues(dae, end.t, end.y, end.yp, gy);
+    problem.lambdaT.col(k) = terminal.col(0);
+    problem.lambdaTp.col(k) = terminal.col(1);
+    problem.atolB.col(k) = adjointTolerances(L, choice.options.atol, choice.options.rtol, ET, G[k]);
+    const double g = std::max(std::fabs(G[k]), std::numeric_limits<double>::min() / choice.options.rtol);
+    // each gradient to rtol |G| / |p_i| (the change of G over a relative change of p_i of 1)
+    for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
+  }
+  try {
+    const AdjointSolution backward = integrateBackward(dae, choice.options, integrals, points, problem);
+    // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
+    MatX Fy0, E0;
+    denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);
+    for (int k = 0; k < count; ++k) {
+      IntegralGradient r{outputs[static_cast<std::size_t>(k)].name, G[k], backward.integral.col(k)};
+      r.gradient += (backward.lambda0.col(k).transpose() * E0 * s0.s0).transpose();
+      out.outputs.push_back(std::move(r));
+    }
+    out.backwardOk = true;
+    out.backwardSteps = backward.steps;
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    out.backwardMessage = e.what();
+  }
+  out.backwardCpuSeconds = static_cast<double>(std::clock() - backwardStart) / CLOCKS_PER_SEC;
+  return out;
+}
+
+}  // namespace flexmbd
