@@ -1,6 +1,7 @@
 // flexmbd: the command line.
 //   flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A] [--format csv|hdf5] [--quiet]
 //                                    [--sensitivity PATH ...] [--no-sensitivity-error-control]
+//                                    [--adjoint KIND:COLUMN ...]
 //     (scenes with "model": "tensegrity": app/tensegrity_command.cpp)
 //   flexmbd kinematics SCENE.json --out DIR [...]   (app/kinematics_command.cpp)
 //   flexmbd summary DIR                              (app/summary_command.cpp)
@@ -39,6 +40,7 @@
 #include "io/json_reader.hpp"
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
+#include "io/adjoint_results.hpp"
 #include "io/sensitivity_results.hpp"
 #include "io/vtk_writer.hpp"
 
@@ -59,6 +61,7 @@ const char* const kUsage =
     "usage: flexmbd run SCENE.json --out DIR [--t-end T] [--rtol R] [--atol A]\n"
     "                   [--format csv|hdf5] [--vtk] [--quiet]\n"
     "                   [--sensitivity PATH ...] [--no-sensitivity-error-control]\n"
+    "                   [--adjoint KIND:COLUMN ...]\n"
     "       flexmbd kinematics SCENE.json --out DIR [--steps N] [--tolerance T]\n"
     "                          [--corrector newton|modified_newton] [--quiet]\n"
     "       flexmbd summary DIR\n"
@@ -102,6 +105,12 @@ const char* const kUsage =
     "               column, summary.json \"sensitivities\" the gradients of the final and\n"
     "               largest values (IDAS; docs/sensitivities.md)\n"
     "  --no-sensitivity-error-control  the sensitivities out of the local error test\n"
+    "  --adjoint KIND:COLUMN  (repeatable) instead of the derivative columns: the gradient\n"
+    "               of the integral output KIND:COLUMN with respect to every --sensitivity\n"
+    "               parameter by the adjoint method (one backward run per output, whatever\n"
+    "               the number of parameters); KIND integral (int c dt) or integral_square\n"
+    "               (int c^2 dt) of a coordinate, velocity or scene output column;\n"
+    "               summary.json \"sensitivities\" gets the values and gradients\n"
     "  --help, -h   this text\n"
     "\n"
     "kinematics analyses the linkage of SCENE.json (see docs/kinematics.md) step by step in\n"
@@ -166,11 +175,14 @@ struct Options {
   ResultsFormat format = ResultsFormat::Csv;  ///< --format
   std::vector<std::string> sensitivities;  ///< --sensitivity PATH (repeatable), in order
   bool sensitivityErrorControl = true;     ///< off with --no-sensitivity-error-control
+  std::vector<std::string> adjoint;        ///< --adjoint KIND:COLUMN (repeatable), in order
 };
 
 /// Takes the repeatable --sensitivity PATH (or --sensitivity=PATH) out of `args` into `o`.
 void takeSensitivityOptions(std::vector<std::string>& args, Options& o) {
   o.sensitivities = cli::takeRepeatedOption(args, "--sensitivity", cli::kSensitivityPathNeeded);
+  o.adjoint = cli::takeRepeatedOption(args, "--adjoint",
+                                      "an integral output KIND:COLUMN (e.g. --adjoint integral_square:slider.x)");
   std::vector<std::string> rest;
   for (const std::string& a : args) {
     if (a == "--no-sensitivity-error-control") {
@@ -273,8 +285,8 @@ SimulationSummary runWithSensitivities(const Scene& scene, const SensitivityScen
 
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
-    if (!o.sensitivities.empty()) {
-      printError("--sensitivity is not available for tensegrity scenes (forward sensitivities run on the DAE "
+    if (!o.sensitivities.empty() || !o.adjoint.empty()) {
+      printError("--sensitivity and --adjoint are not available for tensegrity scenes (forward sensitivities run on the DAE "
                  "integrator IDAS: multibody scenes only)");
       return kExitInputError;
     }
@@ -311,9 +323,16 @@ int runCommand(const Options& o) {
     overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (integrators/tolerances.hpp)
     s.progress = !o.quiet;
     checkSolverSettings(s);
+    if (!o.adjoint.empty() && o.sensitivities.empty()) {
+      throw InputError("option --adjoint needs the parameters of its gradients: one --sensitivity PATH or more");
+    }
+    if (!o.adjoint.empty() && !o.sensitivityErrorControl) {
+      throw InputError("option --no-sensitivity-error-control is for the forward sensitivities, not with --adjoint");
+    }
     if (!o.sensitivities.empty()) {  // the scene read again with each parameter a step up and down
       sensitivities.emplace(
           buildSensitivityScenes(jsonread::readSceneFile(o.scenePath), o.scenePath, *scene, o.sensitivities));
+      for (const std::string& spec : o.adjoint) integralOutput(spec, *scene, *sensitivities);  // refused before the run
     }
   } catch (const std::exception& e) {
     return reportInputError(outDir, e.what());
@@ -325,7 +344,9 @@ int runCommand(const Options& o) {
   try {
     writer.emplace(outDir, *scene, o.format);
     sceneColumns = writer->columns();
-    if (sensitivities) writer->addColumns(sensitivityColumns(sceneColumns, sensitivities->parameters));
+    if (sensitivities && o.adjoint.empty()) {
+      writer->addColumns(sensitivityColumns(sceneColumns, sensitivities->parameters));
+    }
     if (o.vtk) {
       vtk.emplace(std::filesystem::path(outDir) / "vtk", scene->system, "bodies", 4, scene->geometry, scene->feBodies);
       for (const std::string& b : vtk->bodiesNotDrawn()) {
@@ -345,9 +366,22 @@ int runCommand(const Options& o) {
   // ----- the run -----
   SimulationSummary summary;
   std::optional<SensitivitySummary> gradients;
+  std::optional<nlohmann::json> adjointSummary;
   try {
     const StopOnSignals stop;  // a signal stops the run within its step
-    if (sensitivities) {
+    if (!o.adjoint.empty()) {
+      const AdjointSummary adjoint = runAdjointScene(*scene, *sensitivities, o.adjoint, [&](const OutputSample& sample) {
+        writer->write(sample);
+        if (vtk) vtk->write(sample);
+        if (sample.t < scene->solver.tEnd) stopIfSignalled(sample.t);
+      });
+      summary = adjoint.run;
+      adjointSummary = adjointJson(adjoint, *sensitivities);
+      if (summary.ok && !adjoint.backwardOk) {  // the run's rows are kept; the gradients are not there
+        summary.ok = false;
+        summary.message = "the adjoint (backward) integration failed: " + adjoint.backwardMessage;
+      }
+    } else if (sensitivities) {
       gradients.emplace(sceneColumns, sensitivities->parameters);
       summary = runWithSensitivities(*scene, *sensitivities, o.sensitivityErrorControl, *writer, vtk, *gradients);
     } else {
@@ -376,8 +410,8 @@ int runCommand(const Options& o) {
                                                                                : "solver failure: " + summary.message;
   try {
     const nlohmann::json sensitivitySummary =
-        gradients ? gradients->toJson(o.sensitivityErrorControl) : nlohmann::json();
-    writeSummary(outDir, summary, *scene, o.scenePath, gradients ? &sensitivitySummary : nullptr);
+        adjointSummary ? *adjointSummary : gradients ? gradients->toJson(o.sensitivityErrorControl) : nlohmann::json();
+    writeSummary(outDir, summary, *scene, o.scenePath, adjointSummary || gradients ? &sensitivitySummary : nullptr);
   } catch (const std::exception& e) {
     printError((summary.ok ? std::string() : what + " (" + kept + "); ") + "cannot write the summary: " + e.what());
     return summary.ok ? kExitSolverFailure : failureStatus;

@@ -150,6 +150,7 @@ void SensitivitySummary::add(const std::vector<double>& row, const std::vector<d
 
 json SensitivitySummary::toJson(bool errorControl) const {
   json out;
+  out["method"] = "forward";
   out["parameters"] = json::array();
   for (std::size_t i = 0; i < names_.size(); ++i) {
     out["parameters"].push_back({{"path", names_[i]}, {"value", values_[i]}, {"step", steps_[i]}});

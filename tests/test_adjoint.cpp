@@ -18,6 +18,7 @@
 #include "core/errors.hpp"
 #include "integrators/adjoint_run.hpp"
 #include "io/adjoint_results.hpp"
+#include "io/results_table.hpp"
 #include "io/scene_path.hpp"
 #include "io/sensitivity_results.hpp"
 
@@ -238,4 +239,73 @@ TEST(Adjoint, ElasticSliderCrankIntegralEqualsForwardGradient) {
   const double kSliderTolerance = 5e-5;
   expectAdjointEqualsForward("elastic crank", j, {"bodies[2].mass"}, "integral_square", "mid.uy", 5e-6,
                              kSliderTolerance);
+}
+
+// ----- the command line ------------------------------------------------------------------
+
+TEST_F(Cli, AdjointGradientsInTheSummary) {
+  // the free slider crank (FreeSliderCrankIntegralEqualsForwardGradient) over 1 s: two
+  // outputs, two parameters; the gradients equal those of the library call to round-off
+  json j = exampleScene("slider_crank_rigid.json");
+  j.erase("drivers");
+  j["bodies"][0]["angular_velocity"] = 1.0;
+  j["solver"]["t_end"] = 1.0;
+  const fs::path scene = writeScene("crank.json", j);
+  const CliResult r = run("run " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / "out").string()) +
+                          " --quiet --sensitivity 'bodies[2].mass' --sensitivity 'joints[2].points[0][0]'"
+                          " --adjoint integral_square:slider.x --adjoint=integral:crank.theta_dot");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string csv = readFile(dir_ / "out" / "results.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')).find("/d"), std::string::npos);  // no derivative columns
+  const json s = json::parse(readFile(dir_ / "out" / "summary.json")).at("sensitivities");
+  EXPECT_EQ(s.at("method"), "adjoint");
+  EXPECT_TRUE(s.at("backward_ok").get<bool>());
+  const AdjointSummary direct = adjointRun(j, {"bodies[2].mass", "joints[2].points[0][0]"},
+                                           {"integral_square:slider.x", "integral:crank.theta_dot"});
+  ASSERT_EQ(direct.outputs.size(), 2u);
+  for (const IntegralGradient& g : direct.outputs) {
+    const json& out = s.at("integrals").at(g.name);
+    EXPECT_DOUBLE_EQ(out.at("value").get<double>(), g.value) << g.name;
+    EXPECT_DOUBLE_EQ(out.at("gradient").at("bodies[2].mass").get<double>(), g.gradient[0]) << g.name;
+    EXPECT_DOUBLE_EQ(out.at("gradient").at("joints[2].points[0][0]").get<double>(), g.gradient[1]) << g.name;
+  }
+  // int theta_dot dt = theta(1) - theta(0): the forward quadrature follows the state's steps
+  // (rtol 1e-8 of the example): 1e-6 rad holds it
+  const ResultsTable table = readResults(dir_ / "out");
+  const int theta = table.column("crank.theta");
+  ASSERT_GE(theta, 0);
+  EXPECT_NEAR(s.at("integrals").at("integral:crank.theta_dot").at("value").get<double>(),
+              table.rows.back()[static_cast<std::size_t>(theta)] - table.rows.front()[static_cast<std::size_t>(theta)],
+              1e-6);
+}
+
+TEST_F(Cli, AdjointBadInputExitsTwoNamingTheOutput) {
+  const fs::path scene = writeScene("crank.json", exampleScene("slider_crank_rigid.json"));
+  const auto runWith = [&](const std::string& options) {
+    return run("run " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / "out").string()) + " --quiet " +
+               options);
+  };
+  struct Case {
+    std::string options, expected;
+  };
+  for (const Case& c : {Case{"--adjoint integral:slider.x", "needs the parameters"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint maximum:slider.x", "expected KIND:COLUMN"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.z", "no results column \"slider.z\""},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint integral:motor.effort", "multipliers"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.x_ddot", "accelerations"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint", "needs an integral output"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.x --no-sensitivity-error-control",
+                             "not with --adjoint"}}) {
+    const CliResult r = runWith(c.options);
+    EXPECT_EQ(r.status, 2) << c.options << ": " << r.err;
+    EXPECT_TRUE(IsOneErrorLine(r.err)) << c.options;
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.options << ": " << r.err;
+  }
+  json index3 = exampleScene("slider_crank_rigid.json");
+  index3["solver"]["formulation"] = "index3";
+  const CliResult r = run("run " + shellQuote(writeScene("index3.json", index3).string()) + " --out " +
+                          shellQuote((dir_ / "out").string()) +
+                          " --quiet --sensitivity 'bodies[2].mass' --adjoint integral:slider.x");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("GGL"), std::string::npos) << r.err;
 }
