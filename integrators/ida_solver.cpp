@@ -294,6 +294,13 @@ struct IdaSolver::Impl {
         std::memcpy(SUNSparseMatrix_IndexValues(JB), tp.rowIndex().data(), tp.rowIndex().size() * sizeof(sunindextype));
         double* values = SUNSparseMatrix_Data(JB);
         for (std::size_t k = 0; k < self->jB.size(); ++k) values[self->toTransposed[k]] = -self->jB[k];
+        // a fresh factorisation (pivots chosen anew) at every new matrix: KLU's refactorisation
+        // keeps the pivots of the first one, taken at T, and SUNDIALS does not factor afresh
+        // when it fails; near a start at rest (velocities zero) a pivot vanished and every
+        // retry failed (a chain of links: IDA_CONV_FAIL at t = 2e-3)
+        if (SUNLinSol_KLUReInit(b->LS, JB, static_cast<sunindextype>(self->jB.size()), SUNKLU_REINIT_PARTIAL) != 0) {
+          return -1;
+        }
       } else {
         self->jDenseB.setZero();
         JacobianSink sink = JacobianSink::dense(self->jDenseB.data(), p.size());

@@ -34,9 +34,10 @@ inline constexpr double kSensitivityNoiseFloor = 1e-10;
 /// (the class tolerances are atol times the class's scale over L, so the factor holds each
 /// class at kSensitivityNoiseFloor of its scale).
 MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize, const VecX& scales);
-/// The step h = eps^(1/3) max(|p|, 1) of a parameter of value p, rounded so that p + h
-/// and p - h are exact in floating point.
-double parameterStep(double p);
+/// The step h = eps^(1/3) max(|p|, typical) of a parameter of value p, rounded so that
+/// p + h and p - h are exact in floating point. The scenes take typical = 1 (SI units),
+/// and |p| for a small non-zero p whose step would cross zero (buildSensitivityScenes).
+double parameterStep(double p, double typical = kParameterTypicalMagnitude);
 
 /// One parameter of a sensitivity run: its name (the scene path), value and step, and the
 /// system built from the scene with p + h and with p - h (finalized, outliving the run).

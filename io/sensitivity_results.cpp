@@ -48,7 +48,13 @@ SensitivityScenes buildSensitivityScenes(const std::string& sceneText, const std
     } catch (const InputError& e) {
       throw InputError("sensitivity parameter: " + std::string(e.what()));
     }
-    const double h = parameterStep(p);
+    double h = parameterStep(p);
+    if (std::fabs(p) < kParameterTypicalMagnitude && p != 0.0 && h >= std::fabs(p)) {
+      // a small non-zero value (an inertia of 1e-6 kg m^2): the step of the typical magnitude
+      // would cross zero, where the scene may not be valid (a mass, an inertia); the relative
+      // step keeps the sign (its truncation error is relative to p as well)
+      h = parameterStep(p, std::fabs(p));
+    }
     out.plus.push_back(sceneAt(j, source, path, p + h));
     out.minus.push_back(sceneAt(j, source, path, p - h));
     for (const Scene* s : {out.plus.back().get(), out.minus.back().get()}) {
