@@ -266,6 +266,33 @@ std::string algebraicAdjointWarning(const System& sys, const DaeSystem& dae, con
          "(docs/sensitivities.md); the forward sensitivities (--sensitivity without --adjoint) are exact there";
 }
 
+/// The steps one recording may store within kRecordingBytes.
+long recordingSteps(const DaeSystem& dae) {
+  return std::max(1L, static_cast<long>(kRecordingBytes / (8.0 * dae.size())) / kRecordingStepFactor);
+}
+/// The fraction of the run a pilot integrates to estimate its steps (recordingStore).
+constexpr double kPilotFraction = 0.05;
+
+/// The store of the run's own recording: IDAS allocates it whole at the start (a vector
+/// per step, about 2 us each: 0.2 s for 1e5 steps), and a run that outgrows it is recorded
+/// again (integrateBackward). A plain pilot over the first kPilotFraction of the run counts
+/// its steps; the store holds twice their extrapolation (a start takes the smallest steps,
+/// so this errs high), within the memory of one recording.
+long recordingStore(const DaeSystem& dae, const IntegratorOptions& options, const RunStart& start, double t0,
+                    double tEnd) {
+  IdaSolver pilot(dae, t0, start.y0, start.yp0, options);
+  const double tPilot = t0 + kPilotFraction * (tEnd - t0);
+  long steps = 0;
+  try {
+    pilot.advance(tPilot, tPilot);
+    steps = pilot.stats().steps;
+  } catch (const SolverError&) {  // the run itself will say why
+    steps = pilot.stats().steps;
+  }
+  const double estimate = 2.0 * static_cast<double>(steps) / kPilotFraction + kRecordingExtraSteps;
+  return std::min(recordingSteps(dae), static_cast<long>(estimate));
+}
+
 /// Consecutive outputs [first, last] of at most `maxSteps` steps of the run (at least one
 /// output interval each), from the start.
 std::vector<std::pair<std::size_t, std::size_t>> segmentsOf(const std::vector<ForwardPoint>& points, long maxSteps) {
@@ -287,9 +314,7 @@ std::vector<std::pair<std::size_t, std::size_t>> segmentsOf(const std::vector<Fo
 /// @returns lambda(t0) and the quadratures summed over the segments.
 AdjointSolution integrateBackward(const DaeSystem& dae, const IntegratorOptions& options, SystemIntegrals& integrals,
                                   const std::vector<ForwardPoint>& points, AdjointProblem problem) {
-  const long maxSteps =
-      std::max(1L, static_cast<long>(kRecordingBytes / (8.0 * dae.size())) / kRecordingStepFactor);
-  const auto segments = segmentsOf(points, maxSteps);
+  const auto segments = segmentsOf(points, recordingSteps(dae));
   AdjointSolution total{MatX(), MatX(), MatX::Zero(problem.atolQ.rows(), problem.atolQ.cols()), 0};
   for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
     const ForwardPoint& a = points[it->first];
@@ -359,7 +384,11 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0, start.yp0);
   RunState state;
   state.kind = IntegratorKind::Ida;
-  auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, integrals, 0);
+  // recorded for the backward pass on the way: with one checkpoint (a store of
+  // recordingStore steps) IDAS's recomputation repeats this pass exactly; a longer run is
+  // recorded again in segments (integrateBackward)
+  const long store = recordingStore(dae, choice.options, start, t0, tEnd);
+  auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, integrals, store);
   IdaSolver& solver = *ida;
   state.usedKlu = solver.usesKlu();
   state.integrator = std::move(ida);
@@ -409,7 +438,9 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
   }
   try {
-    const AdjointSolution backward = integrateBackward(dae, choice.options, integrals, points, problem);
+    const AdjointSolution backward = solver.checkpoints() <= 1
+                                         ? solver.integrateAdjoint(problem, t0)
+                                         : integrateBackward(dae, choice.options, integrals, points, problem);
     // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);

@@ -607,11 +607,7 @@ IdaSolver::~IdaSolver() = default;
 
 double IdaSolver::advance(double tout, double tStop) {
   Impl& d = *impl_;
-  // A recording runs without a stop time: IDAS 6.4's recomputation of the last checkpoint
-  // interval in IDASolveB overran its step store (measured: an invalid write past the
-  // Nd + 1 data points) when IDASolveF had clipped its last step at the stop time. It steps
-  // past tStop and interpolates there, as it does at every output.
-  if (!d.recording) d.check(IDASetStopTime(d.mem, tStop), "IDASetStopTime");
+  d.check(IDASetStopTime(d.mem, tStop), "IDASetStopTime");
   realtype tret = 0.0;
   d.pending = nullptr;
   int checkpoints = 0;

@@ -38,8 +38,7 @@ class IdaSolver final : public DaeIntegrator {
   IdaSolver(const IdaSolver&) = delete;
   IdaSolver& operator=(const IdaSolver&) = delete;
 
-  /// Integrates to tout (never past tStop, but with adjoint recording: see advance's
-  /// comment), returns the time reached (= tout).
+  /// Integrates to tout (never past tStop), returns the time reached (= tout).
   /// @throws SolverError with IDA's reason, the time and the last step size; an exception
   /// of the model's residual or Jacobian as it was thrown (DaeIntegrator::advance).
   double advance(double tout, double tStop) override;
