@@ -235,20 +235,33 @@ VecX adjointTolerances(const DaeLayout& L, const VecX& atol, double rtol, const 
 
 namespace {
 
-/// The forward run's state at an output: where a segment of the backward pass restarts it.
-struct ForwardPoint {
-  double t = 0.0;
-  VecX y, yp;
-  long steps = 0;  ///< the run's steps up to t
-};
-
-/// Memory of one segment's recording: IDAS keeps one vector of the DAE's size per step.
-constexpr double kRecordingBytes = 256.0 * 1024 * 1024;
-/// A segment's recording restarts from an output (order 1, a small first step) and may
-/// take more steps than the run did there: its store holds this many times the run's
-/// steps, plus kRecordingExtraSteps.
-constexpr long kRecordingStepFactor = 2;
+/// Memory of one recording: IDAS keeps one vector of the DAE's size per step.
+constexpr double kRecordingBytes = 512.0 * 1024 * 1024;
+/// The steps one recording may store within kRecordingBytes.
+long recordingSteps(const DaeSystem& dae) {
+  return std::max(1L, static_cast<long>(kRecordingBytes / (8.0 * dae.size())));
+}
+/// The fraction of the run a pilot integrates to estimate its steps (recordingStore).
+constexpr double kPilotFraction = 0.05;
+/// Steps added to every estimate of a store.
 constexpr long kRecordingExtraSteps = 500;
+
+/// The store of the run's own recording: IDAS allocates it whole at the start (a vector
+/// per step, about 2 us each: 0.2 s for 1e5 steps), and a run that outgrows it is recorded
+/// again (recordAgain). A plain pilot over the first kPilotFraction of the run counts its
+/// steps; the store holds twice their extrapolation (a start takes the smallest steps, so
+/// this errs high), within the memory of one recording.
+long recordingStore(const DaeSystem& dae, const IntegratorOptions& options, const RunStart& start, double t0,
+                    double tEnd) {
+  IdaSolver pilot(dae, t0, start.y0, start.yp0, options);
+  const double tPilot = t0 + kPilotFraction * (tEnd - t0);
+  try {
+    pilot.advance(tPilot, tPilot);
+  } catch (const SolverError&) {  // the run itself will say why
+  }
+  const double estimate = 2.0 * static_cast<double>(pilot.stats().steps) / kPilotFraction + kRecordingExtraSteps;
+  return std::min(recordingSteps(dae), static_cast<long>(estimate));
+}
 
 /// A model without a degree of freedom (G v = -g_t fixes every velocity: a kinematically
 /// driven mechanism) has lambda_q = lambda_v = 0: its adjoint is all algebraic, IDAS's error
@@ -266,88 +279,35 @@ std::string algebraicAdjointWarning(const System& sys, const DaeSystem& dae, con
          "(docs/sensitivities.md); the forward sensitivities (--sensitivity without --adjoint) are exact there";
 }
 
-/// The steps one recording may store within kRecordingBytes.
-long recordingSteps(const DaeSystem& dae) {
-  return std::max(1L, static_cast<long>(kRecordingBytes / (8.0 * dae.size())) / kRecordingStepFactor);
-}
-/// The fraction of the run a pilot integrates to estimate its steps (recordingStore).
-constexpr double kPilotFraction = 0.05;
-
-/// The store of the run's own recording: IDAS allocates it whole at the start (a vector
-/// per step, about 2 us each: 0.2 s for 1e5 steps), and a run that outgrows it is recorded
-/// again (integrateBackward). A plain pilot over the first kPilotFraction of the run counts
-/// its steps; the store holds twice their extrapolation (a start takes the smallest steps,
-/// so this errs high), within the memory of one recording.
-long recordingStore(const DaeSystem& dae, const IntegratorOptions& options, const RunStart& start, double t0,
-                    double tEnd) {
-  IdaSolver pilot(dae, t0, start.y0, start.yp0, options);
-  const double tPilot = t0 + kPilotFraction * (tEnd - t0);
-  long steps = 0;
-  try {
-    pilot.advance(tPilot, tPilot);
-    steps = pilot.stats().steps;
-  } catch (const SolverError&) {  // the run itself will say why
-    steps = pilot.stats().steps;
-  }
-  const double estimate = 2.0 * static_cast<double>(steps) / kPilotFraction + kRecordingExtraSteps;
-  return std::min(recordingSteps(dae), static_cast<long>(estimate));
-}
-
-/// Consecutive outputs [first, last] of at most `maxSteps` steps of the run (at least one
-/// output interval each), from the start.
-std::vector<std::pair<std::size_t, std::size_t>> segmentsOf(const std::vector<ForwardPoint>& points, long maxSteps) {
-  std::vector<std::pair<std::size_t, std::size_t>> out;
-  std::size_t first = 0;
-  while (first + 1 < points.size()) {
-    std::size_t last = first + 1;
-    while (last + 1 < points.size() && points[last + 1].steps - points[first].steps <= maxSteps) ++last;
-    out.emplace_back(first, last);
-    first = last;
-  }
-  return out;
-}
-
-/// Stage "backward": the adjoints of every output from T back to t0, segment by segment
-/// from the last: each segment's forward run recorded again from its first output with
-/// one IDAS checkpoint (IdaSolver::checkpoints), then integrated back with the adjoint's
-/// values at its end (the terminal values at T, the previous segment's lambda(t_a) after).
-/// @returns lambda(t0) and the quadratures summed over the segments.
-AdjointSolution integrateBackward(const DaeSystem& dae, const IntegratorOptions& options, SystemIntegrals& integrals,
-                                  const std::vector<ForwardPoint>& points, AdjointProblem problem) {
-  const auto segments = segmentsOf(points, recordingSteps(dae));
-  AdjointSolution total{MatX(), MatX(), MatX::Zero(problem.atolQ.rows(), problem.atolQ.cols()), 0};
-  for (auto it = segments.rbegin(); it != segments.rend(); ++it) {
-    const ForwardPoint& a = points[it->first];
-    const ForwardPoint& b = points[it->second];
-    long store = kRecordingStepFactor * (b.steps - a.steps) + kRecordingExtraSteps;
-    std::unique_ptr<IdaSolver> recording;
-    for (int attempt = 0; attempt < 3; ++attempt, store *= 4) {
-      recording = std::make_unique<IdaSolver>(dae, a.t, a.y, a.yp, options, integrals, store);
-      recording->advance(b.t, b.t);
-      if (recording->checkpoints() <= 1) break;
+/// Stage "record again": the run from t0 once more, as one recording whose store holds
+/// twice the steps the run took (up to kRecordingBytes; four times more if it took more
+/// still). Only the first checkpoint's interval is recomputed exactly by IDAS (a restored
+/// later checkpoint takes a fresh Jacobian where the first pass had an older one, and IDAS
+/// 6.4 overran its step store when that took more steps: SUNDIALS issue 49). Recording the
+/// backward pass in segments from the run's outputs was tried: a recording restarted mid-run
+/// made the adjoint's corrector fail in its first steps.
+/// @throws SolverError if the run needs more memory than one recording may take.
+std::unique_ptr<IdaSolver> recordAgain(const DaeSystem& dae, const IntegratorOptions& options, SystemIntegrals& integrals,
+                                       const RunStart& start, double t0, double tEnd, long runSteps) {
+  const long limit = recordingSteps(dae);
+  for (long store = 2 * runSteps + kRecordingExtraSteps;; store *= 4) {
+    if (store > limit) {
+      throw SolverError("adjoint: the run's " + std::to_string(runSteps) + " steps of " + std::to_string(dae.size()) +
+                            " unknowns need more than the " + std::to_string(static_cast<long>(kRecordingBytes / 1048576)) +
+                            " MiB one recording may take: shorten the run (t_end) or loosen rtol",
+                        t0, 0.0);
     }
-    if (recording->checkpoints() > 1) {
-      throw SolverError("adjoint: the recording of [" + std::to_string(a.t) + ", " + std::to_string(b.t) +
-                            "] took more than " + std::to_string(store / 4) + " steps (the run took " +
-                            std::to_string(b.steps - a.steps) + ")",
-                        a.t, 0.0);
-    }
-    const AdjointSolution part = recording->integrateAdjoint(problem, a.t);
-    total.integral += part.integral;
-    total.steps += part.steps;
-    total.lambda0 = part.lambda0;
-    total.lambdaRate0 = part.lambdaRate0;
-    problem.lambdaT = part.lambda0;  // the next segment ends where this one starts
-    problem.lambdaTp = part.lambdaRate0;
+    auto recording = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, options, integrals, std::min(store, limit));
+    recording->advance(tEnd, tEnd);
+    if (recording->checkpoints() <= 1) return recording;
   }
-  return total;
 }
 
 }  // namespace
 
 AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<SensitivityParameter>& params,
                                    const std::vector<IntegralOutput>& outputs, const SolverSettings& given,
-                                   const OutputCallback& onOutput) {
+                                   const OutputCallback& onOutput, long recordingStoreSteps) {
   if (params.empty()) throw InputError("adjoint sensitivities: no parameter given");
   if (outputs.empty()) throw InputError("adjoint sensitivities: no integral output given");
   const SolverSettings settings = sensitivityRunSettings(given, "adjoint sensitivities");
@@ -379,15 +339,14 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   ChosenIntegrator choice = chooseIntegratorOptions(sys, dae, settings, &modelScale);
   choice.reason = "adjoint sensitivities are computed by IDAS";
 
-  // forward: the run as a plain one, with the outputs' integrals, its state kept at every output
+  // forward: the run, with the outputs' integrals, recorded for the backward pass on the
+  // way (one checkpoint: IDAS's recomputation repeats this pass exactly)
   ResidualDifferences derivatives(perturbed.pairs, t0, start.y0, start.yp0);
   SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0, start.yp0);
   RunState state;
   state.kind = IntegratorKind::Ida;
-  // recorded for the backward pass on the way: with one checkpoint (a store of
-  // recordingStore steps) IDAS's recomputation repeats this pass exactly; a longer run is
-  // recorded again in segments (integrateBackward)
-  const long store = recordingStore(dae, choice.options, start, t0, tEnd);
+  const long store =
+      recordingStoreSteps > 0 ? recordingStoreSteps : recordingStore(dae, choice.options, start, t0, tEnd);
   auto ida = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, choice.options, integrals, store);
   IdaSolver& solver = *ida;
   state.usedKlu = solver.usesKlu();
@@ -396,14 +355,12 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   ProgressReporter progress(settings.progress, t0, tEnd, "ida+adjoint");
   const DaeLayout& L = dae.layout();
   const RunContext ctx{sys, dae, settings, choice.options, schedule, start.modelSize, start.startRatio, false};
-  std::vector<ForwardPoint> points{{t0, start.y0, start.yp0, 0}};
   std::optional<RunFailure> failure;
   try {
     for (long k = 1; k <= schedule.count; ++k) {
       const double t = solver.advance(schedule.time(k), tEnd);
       requireStepBudget(ctx, state, t);
       recorder.record(t, solver.y().segment(L.q, L.nq), solver.y().segment(L.v, L.nv));
-      points.push_back({t, solver.y(), solver.yp(), solver.stats().steps});
       progress.update(t, solver.stats().steps);
     }
   } catch (...) {
@@ -420,27 +377,30 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   const std::clock_t backwardStart = std::clock();
   if (const std::string w = algebraicAdjointWarning(sys, dae, init, t0); !w.empty()) out.run.warnings.push_back(w);
   const VecX G = solver.integrals();
-  const int n = dae.size(), count = static_cast<int>(outputs.size());
-  const auto np = static_cast<Eigen::Index>(params.size());
-  AdjointProblem problem{&integrals, MatX(n, count), MatX(n, count), MatX(n, count), MatX(np, count), L.nq};
-  MatX FyT, ET;
-  const ForwardPoint& end = points.back();
-  denseJacobians(dae, end.t, end.y, end.yp, FyT, ET);
-  VecX gy(n);
-  for (int k = 0; k < count; ++k) {
-    integrals.integrandGradient(k, end.t, end.y.data(), gy.data());
-    const MatX terminal = adjointTerminalValues(dae, end.t, end.y, end.yp, gy);
-    problem.lambdaT.col(k) = terminal.col(0);
-    problem.lambdaTp.col(k) = terminal.col(1);
-    problem.atolB.col(k) = adjointTolerances(L, choice.options.atol, choice.options.rtol, ET, G[k]);
-    const double g = std::max(std::fabs(G[k]), std::numeric_limits<double>::min() / choice.options.rtol);
-    // each gradient to rtol |G| / |p_i| (the change of G over a relative change of p_i of 1)
-    for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
-  }
   try {
-    const AdjointSolution backward = solver.checkpoints() <= 1
-                                         ? solver.integrateAdjoint(problem, t0)
-                                         : integrateBackward(dae, choice.options, integrals, points, problem);
+    std::unique_ptr<IdaSolver> again;
+    IdaSolver& recording =
+        solver.checkpoints() <= 1
+            ? solver
+            : *(again = recordAgain(dae, choice.options, integrals, start, t0, tEnd, solver.stats().steps));
+    out.recordedAgain = again != nullptr;
+    const int n = dae.size(), count = static_cast<int>(outputs.size());
+    const auto np = static_cast<Eigen::Index>(params.size());
+    AdjointProblem problem{&integrals, MatX(n, count), MatX(n, count), MatX(n, count), MatX(np, count), L.nq};
+    MatX FyT, ET;
+    denseJacobians(dae, tEnd, recording.y(), recording.yp(), FyT, ET);
+    VecX gy(n);
+    for (int k = 0; k < count; ++k) {
+      integrals.integrandGradient(k, tEnd, recording.y().data(), gy.data());
+      const MatX terminal = adjointTerminalValues(dae, tEnd, recording.y(), recording.yp(), gy);
+      problem.lambdaT.col(k) = terminal.col(0);
+      problem.lambdaTp.col(k) = terminal.col(1);
+      problem.atolB.col(k) = adjointTolerances(L, choice.options.atol, choice.options.rtol, ET, G[k]);
+      const double g = std::max(std::fabs(G[k]), std::numeric_limits<double>::min() / choice.options.rtol);
+      // each gradient to rtol |G| / |p_i| (the change of G over a relative change of p_i of 1)
+      for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
+    }
+    const AdjointSolution backward = recording.integrateAdjoint(problem, t0);
     // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);

@@ -36,6 +36,7 @@ struct AdjointSummary {
   bool backwardOk = false;
   std::string backwardMessage;  ///< why the backward integration failed ("" if it did not)
   long backwardSteps = 0;       ///< backward steps, summed over the outputs
+  bool recordedAgain = false;   ///< the run outgrew its recording and was recorded once more
   double backwardCpuSeconds = 0.0;
 };
 
@@ -53,13 +54,15 @@ MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const 
 inline constexpr long kStepsPerCheckpoint = 200;
 
 /// The run of `sys` (IDA, GGL form) with the gradients of `outputs` with respect to
-/// `parameters` by the adjoint method. `onOutput` gets every output as in a plain run. A
-/// failure of the forward run or of the backward integration is reported in the summary
-/// (rows kept), not thrown.
+/// `parameters` by the adjoint method. `onOutput` gets every output as in a plain run. The
+/// run records itself for the backward pass in a store of `recordingStoreSteps` steps (0:
+/// sized by a pilot over the first 5 % of the run); a run that outgrows it is recorded once
+/// more from t0. A failure of the forward run or of the backward integration is reported
+/// in the summary (rows kept), not thrown.
 /// @throws InputError: no parameter or output, a formulation other than GGL, settings
 /// sensitivityRunSettings refuses, a parameter that changes the structure.
 AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<SensitivityParameter>& parameters,
                                    const std::vector<IntegralOutput>& outputs, const SolverSettings& settings,
-                                   const OutputCallback& onOutput);
+                                   const OutputCallback& onOutput, long recordingStoreSteps = 0);
 
 }  // namespace flexmbd

@@ -106,6 +106,7 @@ nlohmann::json adjointJson(const AdjointSummary& summary, const SensitivityScene
   out["backward_ok"] = summary.backwardOk;
   out["backward_message"] = summary.backwardMessage;
   out["backward_steps"] = summary.backwardSteps;
+  out["recorded_again"] = summary.recordedAgain;
   out["backward_cpu_seconds"] = summary.backwardCpuSeconds;
   return out;
 }

@@ -33,7 +33,8 @@ AdjointSummary runAdjointScene(const Scene& scene, const SensitivityScenes& scen
 
 /// summary.json's "sensitivities" of an adjoint run: {"method": "adjoint", "parameters":
 /// [{"path", "value", "step"}], "integrals": {SPEC: {"value", "gradient": {PATH: dG/dp}}},
-/// "backward_ok", "backward_message", "backward_steps", "backward_cpu_seconds"}.
+/// "backward_ok", "backward_message", "backward_steps", "recorded_again" (the run outgrew
+/// its recording and was integrated once more), "backward_cpu_seconds"}.
 nlohmann::json adjointJson(const AdjointSummary& summary, const SensitivityScenes& scenes);
 
 }  // namespace flexmbd
