@@ -27,6 +27,7 @@
 #include "io/results_writer.hpp"
 #include "io/scene.hpp"
 #include "io/scene_path.hpp"
+#include "io/adjoint_results.hpp"
 #include "io/sensitivity_results.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
@@ -101,6 +102,37 @@ RunOutput runSceneWithSensitivities(const std::string& text, const std::string& 
   nlohmann::json json = nlohmann::json::parse(summaryJson(summary, scene));
   json["sensitivities"] = gradients.toJson(errorControl);
   out.columns.insert(out.columns.end(), added.begin(), added.end());
+  out.ok = summary.ok;
+  out.summary = json.dump();
+  return out;
+}
+
+/// The run of the scene `text` with the gradients of the integral outputs `specs`
+/// ("KIND:COLUMN") with respect to `paths` by the adjoint method (io/adjoint_results.hpp):
+/// the table of a plain run; the summary's "sensitivities" has the values and gradients, as
+/// `flexmbd run --adjoint`. A failed backward integration fails the run (rows kept).
+RunOutput runSceneWithAdjoint(const std::string& text, const std::string& source, const std::vector<std::string>& paths,
+                              const std::vector<std::string>& specs, bool progress) {
+  Scene scene = parseSceneText(text, source);
+  scene.solver.progress = progress;
+  checkSolverSettings(scene.solver);
+  const SensitivityScenes sensitivities = buildSensitivityScenes(text, source, scene, paths);
+  RunOutput out;
+  out.columns = resultColumns(scene);
+  SpatialJointOutputs joints(scene.system);
+  std::vector<double> row;
+  const AdjointSummary adjoint = runAdjointScene(scene, sensitivities, specs, [&](const OutputSample& s) {
+    resultRow(scene, out.columns, s, row, joints);
+    out.data.insert(out.data.end(), row.begin(), row.end());
+    ++out.rows;
+  });
+  SimulationSummary summary = adjoint.run;
+  if (summary.ok && !adjoint.backwardOk) {
+    summary.ok = false;
+    summary.message = "the adjoint (backward) integration failed: " + adjoint.backwardMessage;
+  }
+  nlohmann::json json = nlohmann::json::parse(summaryJson(summary, scene));
+  json["sensitivities"] = adjointJson(adjoint, sensitivities);
   out.ok = summary.ok;
   out.summary = json.dump();
   return out;
@@ -761,6 +793,22 @@ PYBIND11_MODULE(_flexmbd, m) {
       "Runs the scene text with forward sensitivities with respect to the dotted scene paths "
       "(docs/sensitivities.md): (columns, table, summary JSON, ok), the table's columns those of a plain run "
       "then d<column>/d<path>");
+  m.def(
+      "_run_scene_text_with_adjoint",
+      [](const std::string& text, const std::string& source, const std::vector<std::string>& paths,
+         const std::vector<std::string>& specs, bool progress) {
+        RunOutput r;
+        {
+          py::gil_scoped_release release;
+          const PythonSignalCheck ctrlC;
+          r = runSceneWithAdjoint(text, source, paths, specs, progress);
+        }
+        PythonSignalCheck::raiseIfInterrupted();
+        return py::make_tuple(r.columns, table(r), r.summary, r.ok);
+      },
+      py::arg("text"), py::arg("source"), py::arg("paths"), py::arg("outputs"), py::arg("progress") = false,
+      "Runs the scene text with the gradients of the integral outputs (KIND:COLUMN) with respect to the dotted "
+      "scene paths by the adjoint method (docs/sensitivities.md): (columns, table, summary JSON, ok)");
   m.def(
       "parse_scene_path",
       [](const std::string& path) {

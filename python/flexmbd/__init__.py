@@ -143,6 +143,14 @@ class Results:
         "d<column>/d<parameter>" of a run with ``sensitivities`` (KeyError without it)."""
         return self[f"d{column}/d{parameter}"]
 
+    def gradient(self, output):
+        """{parameter: dG/dp} of the integral output ``output`` ("KIND:COLUMN") of a run
+        with ``adjoint`` (KeyError without it)."""
+        integrals = self.summary.get("sensitivities", {}).get("integrals", {})
+        if output not in integrals:
+            raise KeyError(f"no adjoint output {output!r} (outputs: {', '.join(integrals)})")
+        return dict(integrals[output]["gradient"])
+
     def __len__(self):
         return self.data.shape[0]
 
@@ -215,7 +223,8 @@ class Scene:
         mode shape's entries; finalizes the system."""
         return self._native.velocity_names
 
-    def run(self, progress=False, raise_on_failure=True, sensitivities=None, sensitivity_error_control=True):
+    def run(self, progress=False, raise_on_failure=True, sensitivities=None, sensitivity_error_control=True,
+            adjoint=None):
         """Runs the model (the GIL is released: runs in threads go on in parallel).
 
         Returns Results. A solver failure raises SolverFailure (its ``results`` hold the
@@ -227,15 +236,33 @@ class Scene:
         table then also has a column "d<column>/d<path>" per column and parameter
         (``Results.derivative``) and the summary the gradients of the final and largest
         values (``summary["sensitivities"]``). Needs a scene read from a file or a dict
-        (load_scene, scene_from_dict): each parameter's scene is read again a step away."""
+        (load_scene, scene_from_dict): each parameter's scene is read again a step away.
+
+        ``adjoint``: integral outputs "KIND:COLUMN" (KIND "integral" or "integral_square" of
+        a coordinate, velocity or scene output column) whose gradients with respect to the
+        ``sensitivities`` parameters the adjoint method gives instead of the derivative
+        columns: one backward integration per output, whatever the number of parameters
+        (``summary["sensitivities"]["integrals"][OUTPUT]`` holds "value" and "gradient";
+        ``Results.gradient(OUTPUT)`` as a dict)."""
+        if adjoint:
+            if not sensitivities:
+                raise InputError("adjoint outputs need the parameters of their gradients: sensitivities=[PATH, ...]")
+            if not sensitivity_error_control:
+                raise InputError("sensitivity_error_control is for the forward sensitivities, not with adjoint")
+            if isinstance(adjoint, str):
+                adjoint = [adjoint]
         if sensitivities:
             if self._text is None:
                 raise InputError("sensitivities need a scene read from a file or a dict (load_scene, "
                                  "scene_from_dict): each parameter's scene is read again a step away")
             if isinstance(sensitivities, str):
                 sensitivities = [sensitivities]
-            columns, data, summary_text, ok = _flexmbd._run_scene_text_with_sensitivities(
-                self._text, self._source, list(sensitivities), bool(sensitivity_error_control), progress)
+            if adjoint:
+                columns, data, summary_text, ok = _flexmbd._run_scene_text_with_adjoint(
+                    self._text, self._source, list(sensitivities), list(adjoint), progress)
+            else:
+                columns, data, summary_text, ok = _flexmbd._run_scene_text_with_sensitivities(
+                    self._text, self._source, list(sensitivities), bool(sensitivity_error_control), progress)
         else:
             columns, data, summary_text, ok = self._native._run(progress)
         results = Results(columns, data, json.loads(summary_text))

@@ -63,3 +63,56 @@ def test_sensitivity_errors_name_the_parameter():
     plain = flexmbd.load_scene(CRANK).run()
     with pytest.raises(KeyError, match="no column"):
         plain.derivative("slider.x", SLIDER_MASS)
+
+
+def free_crank():
+    """The slider crank without its driver, the crank started at 1 rad/s, over 1 s (one
+    degree of freedom: the adjoint's test model, tests/test_adjoint.cpp)."""
+    with open(CRANK) as f:
+        scene = json.load(f)
+    del scene["drivers"]
+    scene["bodies"][0]["angular_velocity"] = 1.0
+    scene["solver"]["t_end"] = 1.0
+    scene["solver"]["rtol"] = 1e-10
+    scene["solver"]["atol"] = 1e-12
+    return scene
+
+
+def test_adjoint_gradients_equal_the_forward_ones_and_the_command_lines(tmp_path):
+    # int slider.x dt by the adjoint, against the forward sensitivities of slider.x at
+    # outputs 1e-3 s apart integrated by Simpson's rule (error ~h^4: 1e-12) and against the
+    # command line (one engine path, io/adjoint_results.hpp: the same numbers)
+    scene = free_crank()
+    res = flexmbd.scene_from_dict(scene).run(sensitivities=[SLIDER_MASS, ROD_LENGTH], adjoint="integral:slider.x")
+    assert res.ok
+    assert not any(c.startswith("d") and "/d" in c for c in res.columns)  # no derivative columns
+    gradient = res.gradient("integral:slider.x")
+    fine = dict(scene, solver=dict(scene["solver"], output_step=1e-3))
+    forward = flexmbd.scene_from_dict(fine).run(sensitivities=[SLIDER_MASS, ROD_LENGTH])
+    weights = np.ones(len(forward))
+    weights[1:-1:2], weights[2:-1:2] = 4.0, 2.0
+    for path in (SLIDER_MASS, ROD_LENGTH):
+        simpson = np.sum(weights * forward.derivative("slider.x", path)) * 1e-3 / 3.0
+        # both at rtol 1e-10 over a second: 1e-6 of the gradient (the slider's mass moves
+        # its position little, so the state's errors weigh more in that derivative:
+        # measured 1.4e-5 of it at rtol 1e-8)
+        assert gradient[path] == pytest.approx(simpson, rel=1e-6)
+    path = tmp_path / "crank.json"
+    path.write_text(json.dumps(scene))
+    out = tmp_path / "out"
+    subprocess.run([CLI, "run", str(path), "--out", str(out), "-q", "--sensitivity", SLIDER_MASS,
+                    "--sensitivity", ROD_LENGTH, "--adjoint", "integral:slider.x"], check=True)
+    with open(out / "summary.json") as f:
+        summary = json.load(f)
+    integrals = summary["sensitivities"]["integrals"]
+    assert integrals == res.summary["sensitivities"]["integrals"]
+
+
+def test_adjoint_errors():
+    with pytest.raises(flexmbd.InputError, match="need the parameters"):
+        flexmbd.load_scene(CRANK).run(adjoint="integral:slider.x")
+    with pytest.raises(flexmbd.InputError, match="no results column"):
+        flexmbd.load_scene(CRANK).run(sensitivities=[SLIDER_MASS], adjoint="integral:slider.w")
+    plain = flexmbd.load_scene(CRANK).run()
+    with pytest.raises(KeyError, match="no adjoint output"):
+        plain.gradient("integral:slider.x")
