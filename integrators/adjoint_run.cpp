@@ -1,8 +1,10 @@
 #include "integrators/adjoint_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <exception>
+#include <limits>
 
 #include <Eigen/QR>
 
@@ -24,7 +26,7 @@ class SystemIntegrals final : public IntegralOutputs {
  public:
   SystemIntegrals(const DaeSystem& dae, const std::vector<SensitivityParameter>& params,
                   const std::vector<IntegralOutput>& outputs, ResidualDifferences& derivatives, double t0,
-                  const VecX& y0, const VecX& yp0)
+                  const VecX& y0)
       : dae_(dae), params_(params), outputs_(outputs), derivatives_(derivatives) {
     const DaeLayout& L = dae.layout();
     q_ = y0.segment(L.q, L.nq);
@@ -36,7 +38,7 @@ class SystemIntegrals final : public IntegralOutputs {
     gyCache_.assign(outputs.size(), VecX::Zero(n));
     gyTime_.assign(outputs.size(), std::nan(""));
     gyY_.assign(outputs.size(), VecX::Zero(n));
-    findDependencies(t0, y0, yp0);
+    findDependencies(t0, y0);
   }
   int count() const override { return static_cast<int>(outputs_.size()); }
   int parameterCount() const override { return static_cast<int>(params_.size()); }
@@ -86,9 +88,6 @@ class SystemIntegrals final : public IntegralOutputs {
     }
   }
 
-  /// The entries of y output k depends on (for the tests and the docs).
-  const std::vector<int>& dependencies(int k) const { return dependencies_[static_cast<std::size_t>(k)]; }
-
  private:
   void unpack(const double* y) {
     const DaeLayout& L = dae_.layout();
@@ -115,8 +114,7 @@ class SystemIntegrals final : public IntegralOutputs {
   /// Which entries of (q, v) each integrand depends on and which parameters it holds
   /// explicitly: those that change it, bit for bit, at the initial state or at a generic
   /// state near it (as ResidualDifferences finds the bodies of a parameter).
-  void findDependencies(double t0, const VecX& y0, const VecX& yp0) {
-    (void)yp0;
+  void findDependencies(double t0, const VecX& y0) {
     const DaeLayout& L = dae_.layout();
     std::vector<VecX> states{y0, y0};
     for (Eigen::Index k = 0; k < y0.size(); ++k) {
@@ -342,7 +340,7 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   // forward: the run, with the outputs' integrals, recorded for the backward pass on the
   // way (one checkpoint: IDAS's recomputation repeats this pass exactly)
   ResidualDifferences derivatives(perturbed.pairs, t0, start.y0, start.yp0);
-  SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0, start.yp0);
+  SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0);
   RunState state;
   state.kind = IntegratorKind::Ida;
   const long store =

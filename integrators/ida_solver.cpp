@@ -233,7 +233,7 @@ struct IdaSolver::Impl {
     // E depends on the positions, the first `positions` entries of y (AdjointProblem::positions)
     const double speed = Yp.head(positions).cwiseAbs().maxCoeff();
     if (!(speed > 0.0)) return;
-    const double e = kRateDerivativeStep * std::max(1.0, Y.head(positions).cwiseAbs().maxCoeff()) / speed;
+    const double e = kCentralDifferenceFraction * std::max(1.0, Y.head(positions).cwiseAbs().maxCoeff()) / speed;
     for (const double sign : {1.0, -1.0}) {
       shiftedY = Y;
       shiftedY.head(positions) += sign * e * Yp.head(positions);
@@ -244,8 +244,6 @@ struct IdaSolver::Impl {
   }
   long maxSteps = 500;  ///< IntegratorOptions::maxSteps (the backward problems' too)
   int positions = 0;  ///< number of positions (the first entries of y)
-  /// Relative step of the difference along the motion: eps^(1/3) (Nocedal & Wright 2006, sec. 8.1).
-  static constexpr double kRateDerivativeStep = 6.0554544523933395e-06;
 
   /// The adjoint residual E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y^T (IDAS
   /// guide, "Adjoint sensitivity analysis"; E = dF/dy' symmetric for GGL: diag(I, M, 0, 0)).

@@ -4,10 +4,16 @@
 /// sensitivities and how the sensitivities enter the error test.
 #pragma once
 
+#include <cmath>
+
 #include "core/sparse_pattern.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
+
+/// Relative step of the engine's central differences: eps^(1/3) balances their truncation
+/// error h^2 |f^(3)| / 6 against the round-off eps |f| / h (Nocedal & Wright 2006, sec. 8.1).
+inline const double kCentralDifferenceFraction = std::cbrt(2.220446049250313e-16);
 
 /// r += A x for A in CSC values on `pattern` (the sensitivity residual's F_y s, the
 /// projection of the initial sensitivities). Allocates nothing.

@@ -17,7 +17,7 @@
 namespace flexmbd {
 
 double parameterStep(double p, double typical) {
-  const double h = kParameterStepFraction * std::max(std::fabs(p), typical);
+  const double h = kCentralDifferenceFraction * std::max(std::fabs(p), typical);
   // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, sec. 5.7)
   const volatile double shifted = p + h;
   return shifted - p;

@@ -17,9 +17,6 @@
 
 namespace flexmbd {
 
-/// Relative step of the central differences in p: eps^(1/3) balances their truncation
-/// error h^2 |F'''| / 6 against the round-off eps |F| / h (Nocedal & Wright 2006, sec. 8.1).
-inline const double kParameterStepFraction = std::cbrt(2.220446049250313e-16);
 /// Magnitude below which a parameter's step is taken from 1 (SI units of the key): a
 /// parameter at 0 (an offset, an initial velocity) still gets a step of 6e-6.
 inline constexpr double kParameterTypicalMagnitude = 1.0;

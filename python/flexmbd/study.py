@@ -33,7 +33,9 @@ STUDY_KEYS = {"name", "scene", "overrides", "axes", "combine", "samples", "outpu
 # keys and user functions have none)
 DIFFERENTIABLE_OUTPUTS = ("max_abs", "max", "min", "final")
 AXIS_KEYS = {"name", "key", "values", "range", "count", "spacing"}
-OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions"}
+OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions", "integrals"}
+# the kinds of an adjoint integral output "KIND:COLUMN" (docs/sensitivities.md)
+INTEGRAL_KINDS = ("integral", "integral_square")
 PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
 PLOT_FILE_TYPES = (".png", ".svg", ".pdf")
 MAX_TITLE_LENGTH = 300  # a title is one line over the figure; matplotlib fails on 100 kB ("raster overflow")
@@ -81,6 +83,12 @@ def _check_outputs(outputs, where):
     for c in outputs.get("functions", []):
         if ":" not in c:
             _fail(where, f'key "functions": {_shown(c)} is not "module:function"')
+    integrals = outputs.get("integrals", [])
+    if not isinstance(integrals, list) or not all(isinstance(c, str) for c in integrals):
+        _fail(where, f'key "integrals" must be a list of "KIND:COLUMN", got {_shown(integrals)}')
+    for c in integrals:
+        if c.partition(":")[0] not in INTEGRAL_KINDS or not c.partition(":")[2]:
+            _fail(where, f'key "integrals": {_shown(c)} is not "KIND:COLUMN" with KIND one of {", ".join(INTEGRAL_KINDS)}')
     after = outputs.get("after", 0.0)
     if not isinstance(after, (int, float)) or isinstance(after, bool):
         _fail(where, f'key "after" must be a number (a time), got {_shown(after)}')
@@ -145,6 +153,9 @@ class Study:
         if not isinstance(self.sensitivity_error_control, bool):
             _fail(where, f'key "sensitivity_error_control" must be true or false, got '
                          f'{_shown(self.sensitivity_error_control)}')
+        if self.outputs.get("integrals") and not self.sensitivities:
+            _fail(where, 'outputs "integrals" need the parameters of their gradients: key "sensitivities" (the '
+                         'adjoint run that gives them)')
         self.output_names = output_names(self.outputs) + gradient_names(self.outputs, self.sensitivities)
         self.plot = spec.get("plot")
         if self.plot is not None:
@@ -313,6 +324,7 @@ def output_names(outputs):
         names.append(a.get("name", f"{a['column']}@{a['t']}"))
     for f in outputs.get("functions", []):
         names.append(f)
+    names += list(outputs.get("integrals", []))
     return names
 
 
@@ -322,6 +334,7 @@ def gradient_names(outputs, paths):
     every scene path of "sensitivities", in its order."""
     names = [f"{kind}({c})" for kind in DIFFERENTIABLE_OUTPUTS for c in outputs.get(kind, [])]
     names += [a.get("name", f"{a['column']}@{a['t']}") for a in outputs.get("at", [])]
+    names += list(outputs.get("integrals", []))
     return [f"d{n}/d{p}" for n in names for p in paths]
 
 
@@ -377,20 +390,34 @@ def collect(results, outputs):
     return values
 
 
+def _needs_forward(outputs):
+    """Whether a study's outputs have gradients only forward sensitivities give."""
+    return any(outputs.get(kind) for kind in DIFFERENTIABLE_OUTPUTS + ("at",))
+
+
 def run_point(index, scene, overrides, outputs, names, sensitivities=(), sensitivity_error_control=True):
     """One point (a Dask task): a small record, whatever happens in the run. With
     ``sensitivities`` (scene paths) the run integrates the derivatives too and the record
-    holds the outputs' gradients after the outputs (gradient_names)."""
+    holds the outputs' gradients after the outputs (gradient_names); the "integrals"
+    outputs and their gradients come from a run with the adjoint (the only run of the
+    point when no other output has a gradient)."""
     start = time.perf_counter()
     record = {"point": index, "status": "ok", "message": "", "t_reached": math.nan}
-    results = None
+    results = adjoint = None
+    integrals = list(outputs.get("integrals", []))
     try:
         point = scene_from_dict(scene, overrides, source=f"point {index}")
-        if sensitivities:
+        if integrals:
+            adjoint = point.run(raise_on_failure=False, sensitivities=list(sensitivities), adjoint=integrals)
+        if sensitivities and (_needs_forward(outputs) or not integrals):
             results = point.run(raise_on_failure=False, sensitivities=list(sensitivities),
                                 sensitivity_error_control=sensitivity_error_control)
+        elif adjoint is not None:
+            results = adjoint  # the table of a plain run, and the integrals
         else:
             results = point.run(raise_on_failure=False)
+        if adjoint is not None and not adjoint.ok:
+            results = adjoint
         record["status"] = "ok" if results.ok else "failed"
         record["message"] = "" if results.ok else results.message
         tr = results.summary.get("t_reached")
@@ -405,8 +432,10 @@ def run_point(index, scene, overrides, outputs, names, sensitivities=(), sensiti
     if results is not None and record["status"] == "ok":
         try:
             values = collect(results, outputs)
+            values += [adjoint.summary["sensitivities"]["integrals"][c]["value"] for c in integrals]
             if sensitivities:
                 values += collect_gradients(results, outputs, sensitivities)
+                values += [adjoint.gradient(c)[p] for c in integrals for p in sensitivities]
         except Exception as e:  # noqa: BLE001
             record["status"] = "error"
             record["message"] = f"outputs: {type(e).__name__}: {e}"

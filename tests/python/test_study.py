@@ -272,3 +272,57 @@ def test_study_sensitivities_are_checked_before_the_study_runs(tmp_path, value, 
     path.write_text(json.dumps(spec))
     with pytest.raises(InputError, match=words):
         st.load_study(str(path))
+
+
+def test_study_integrals_and_their_adjoint_gradients(tmp_path):
+    # The slider crank without its driver (the crank started at 1 rad/s: one degree of
+    # freedom) over two rod lengths, with the integral int slider.x^2 dt and its adjoint
+    # gradient by the rod length and the slider's mass, next to a forward gradient
+    # (final(slider.x)): each point's columns equal its own Scene.run(adjoint=...) and
+    # Scene.run(sensitivities=...) (the same engine paths: 1e-15).
+    import flexmbd
+
+    rod, mass, out = "joints[2].points[0][0]", "bodies[2].mass", "integral_square:slider.x"
+    with open(os.path.join(SOURCE, "examples", "slider_crank_rigid.json")) as f:
+        scene = json.load(f)
+    del scene["drivers"]
+    scene["bodies"][0]["angular_velocity"] = 1.0
+    scene["solver"]["t_end"] = 1.0
+    (tmp_path / "crank.json").write_text(json.dumps(scene))
+    spec = {"scene": "crank.json", "axes": [{"name": "l2", "key": rod, "values": [2.0, 2.5]}],
+            "outputs": {"integrals": [out], "final": ["slider.x"]}, "sensitivities": [rod, mass]}
+    path = tmp_path / "study.json"
+    path.write_text(json.dumps(spec))
+    study = st.load_study(str(path))
+    assert study.output_names == ["final(slider.x)", out, f"dfinal(slider.x)/d{rod}", f"dfinal(slider.x)/d{mass}",
+                                  f"d{out}/d{rod}", f"d{out}/d{mass}"]
+    assert st.run_study(study, str(tmp_path / "out"), workers=0, progress=False) == (2, 0)
+    header, rows = table(str(tmp_path / "out"))
+    col = {name: header.index(name) - (header.index(name) > header.index("wall_seconds")) for name in header}
+    for row in rows:
+        point = dict(scene)
+        point["joints"] = json.loads(json.dumps(scene["joints"]))
+        point["joints"][2]["points"][0][0] = float(row[col["l2"]])
+        adjoint = flexmbd.scene_from_dict(point).run(sensitivities=[rod, mass], adjoint=out)
+        forward = flexmbd.scene_from_dict(point).run(sensitivities=[rod, mass])
+        integral = adjoint.summary["sensitivities"]["integrals"][out]
+        assert float(row[col[out]]) == pytest.approx(integral["value"], rel=1e-15)
+        for p in (rod, mass):
+            assert float(row[col[f"d{out}/d{p}"]]) == pytest.approx(integral["gradient"][p], rel=1e-15)
+            assert float(row[col[f"dfinal(slider.x)/d{p}"]]) == pytest.approx(
+                forward.derivative("slider.x", p)[-1], rel=1e-15)
+
+
+def test_study_integrals_need_sensitivities(tmp_path):
+    spec = {"scene": os.path.join(SOURCE, "examples", "slider_crank_rigid.json"),
+            "axes": [{"name": "m", "key": "bodies[2].mass", "values": [1.0]}],
+            "outputs": {"integrals": ["integral_square:slider.x"]}}
+    path = tmp_path / "study.json"
+    path.write_text(json.dumps(spec))
+    with pytest.raises(InputError, match="need the parameters of their gradients"):
+        st.load_study(str(path))
+    spec["outputs"] = {"integrals": ["maximum:slider.x"]}
+    spec["sensitivities"] = ["bodies[2].mass"]
+    path.write_text(json.dumps(spec))
+    with pytest.raises(InputError, match="is not \"KIND:COLUMN\""):
+        st.load_study(str(path))
