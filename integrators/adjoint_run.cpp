@@ -405,6 +405,7 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     for (int k = 0; k < count; ++k) {
       IntegralGradient r{outputs[static_cast<std::size_t>(k)].name, G[k], backward.integral.col(k)};
       r.gradient += (backward.lambda0.col(k).transpose() * E0 * s0.s0).transpose();
+      if (const auto& report = outputs[static_cast<std::size_t>(k)].report) report(tEnd - t0, r.value, r.gradient);
       out.outputs.push_back(std::move(r));
     }
     out.backwardOk = true;
@@ -415,6 +416,7 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     out.backwardMessage = e.what();
   }
   out.backwardCpuSeconds = static_cast<double>(std::clock() - backwardStart) / CLOCKS_PER_SEC;
+  out.run.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;  // the whole: forward and backward
   return out;
 }
 

@@ -19,6 +19,9 @@ namespace flexmbd {
 struct IntegralOutput {
   std::string name;
   std::function<double(const System& sys, double t, const VecX& q, const VecX& v)> integrand;
+  /// A function of the integral reported instead of it (empty: G itself): from G, dG/dp and
+  /// the run's span T - t0, the value and its gradient (a KS aggregate: ln(G / T) / rho).
+  std::function<void(double span, double& value, VecX& gradient)> report;
 };
 
 /// The value and gradient of one integral output.
@@ -31,7 +34,7 @@ struct IntegralGradient {
 /// A run with adjoint sensitivities: the forward run's summary and, when it reached t_end,
 /// the gradients.
 struct AdjointSummary {
-  SimulationSummary run;
+  SimulationSummary run;  ///< its cpuSeconds: the whole, the backward integration included
   std::vector<IntegralGradient> outputs;  ///< empty if the run or the backward integration failed
   bool backwardOk = false;
   std::string backwardMessage;  ///< why the backward integration failed ("" if it did not)
@@ -45,6 +48,9 @@ struct AdjointSummary {
 /// lambda_gv with lambda_q', lambda_v' from the adjoint's differential rows and the
 /// derivatives of its algebraic rows (the hidden constraints G D T^T lambda_q' = 0,
 /// G lambda_v' = 0; a released equation's rows: its adjoint multiplier 0).
+/// @param dae the run's DAE (GGL layout)
+/// @param t the time T
+/// @param y, yp the forward solution at T
 /// @param gy the integrand's gradient at (T, y) (size n)
 /// @returns lambda(T) and lambda'(T) as the columns of an n x 2 matrix
 MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy);

@@ -165,6 +165,43 @@ TEST(Adjoint, SpringMassDamperIntegralMatchesClosedForm) {
 
 
 
+TEST(Adjoint, KsAggregateMatchesClosedForm) {
+  // The spring-mass-damper's KS aggregate of x over 3 s, ln(int exp(rho x) dt / T) / rho with
+  // rho = 20 / m (a smooth maximum: within ln(T ...) / rho of max x = 1.1 m), and its
+  // gradient: the complex-step derivative of the same function of the Gauss-Legendre
+  // integral. Its error: that of int exp(rho x) dt, relative (as SpringMassDamper...).
+  const std::vector<std::string> paths = {"forces[0].stiffness", "forces[0].damping", "bodies[0].position[0]"};
+  const AdjointSummary s = adjointRun(springMassDamper(), paths, {"ks:mass.x:20"});
+  ASSERT_TRUE(s.backwardOk) << s.backwardMessage;
+  const double rho = 20.0, T = 3.0, e = 1e-30;
+  const std::complex<double> I(0.0, 1.0);
+  const auto ks = [&](std::complex<double> k, std::complex<double> c, std::complex<double> x0) {
+    const double nodes[5] = {0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640, 0.9061798459386640};
+    const double weights[5] = {0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891,
+                               0.2369268850561891};
+    const int panels = 600;
+    const double h = T / panels;
+    std::complex<double> sum = 0.0;
+    for (int p = 0; p < panels; ++p) {
+      for (int i = 0; i < 5; ++i) sum += 0.5 * h * weights[i] * std::exp(rho * position(h * (p + 0.5 + 0.5 * nodes[i]), k, c, 2.0, x0));
+    }
+    return std::log(sum / T) / rho;
+  };
+  const double k = 50.0, c = 0.8, x0 = 1.1;
+  EXPECT_NEAR(s.outputs[0].value, std::real(ks(k, c, x0)), 1e-9);
+  EXPECT_GT(s.outputs[0].value, 1.0);  // near the largest x, 1.1
+  EXPECT_LT(s.outputs[0].value, 1.1);
+  const double exact[3] = {std::imag(ks(k + I * e, c, x0)) / e, std::imag(ks(k, c + I * e, x0)) / e,
+                           std::imag(ks(k, c, x0 + I * e)) / e};
+  const double kRelativeTolerance = 1e-6;  // as SpringMassDamperIntegralMatchesClosedForm
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const double got = s.outputs[0].gradient[static_cast<Eigen::Index>(i)];
+    std::printf("spring-mass-damper dKS/d%s: adjoint %.12g, closed form %.12g (relative %.2g)\n", paths[i].c_str(), got,
+                exact[i], std::fabs(got - exact[i]) / std::fabs(exact[i]));
+    EXPECT_NEAR(got, exact[i], kRelativeTolerance * std::fabs(exact[i])) << paths[i];
+  }
+}
+
 TEST(Adjoint, PendulumIntegralEqualsForwardGradient) {
   // A bob on a massless length L = 0.8 m released at 0.3 rad (tests/test_sensitivities.cpp):
   // one constraint pair, so the adjoint multipliers and their terminal values take part.
@@ -326,6 +363,8 @@ TEST_F(Cli, AdjointBadInputExitsTwoNamingTheOutput) {
   };
   for (const Case& c : {Case{"--adjoint integral:slider.x", "needs the parameters"},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint maximum:slider.x", "expected KIND:COLUMN"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint ks:slider.x", "RHO a positive number"},
+                        Case{"--sensitivity 'bodies[2].mass' --adjoint ks:slider.x:-1", "RHO a positive number"},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.z", "no results column \"slider.z\""},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint integral:motor.effort", "multipliers"},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.x_ddot", "accelerations"},
