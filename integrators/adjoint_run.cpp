@@ -351,21 +351,8 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   state.integrator = std::move(ida);
   const OutputSchedule schedule(t0, tEnd, settings.outputStep);
   ProgressReporter progress(settings.progress, t0, tEnd, "ida+adjoint");
-  const DaeLayout& L = dae.layout();
   const RunContext ctx{sys, dae, settings, choice.options, schedule, start.modelSize, start.startRatio, false};
-  std::optional<RunFailure> failure;
-  try {
-    for (long k = 1; k <= schedule.count; ++k) {
-      const double t = solver.advance(schedule.time(k), tEnd);
-      requireStepBudget(ctx, state, t);
-      recorder.record(t, solver.y().segment(L.q, L.nq), solver.y().segment(L.v, L.nv));
-      progress.update(t, solver.stats().steps);
-    }
-  } catch (...) {
-    const FailureContext failed{sys, recorder.recorded(), start.modelSize, start.startRatio,
-                                solver.stats().currentTime, &dae.releasedEquations()};
-    failure = diagnoseFailure(std::current_exception(), failed);
-  }
+  const std::optional<RunFailure> failure = integrateOnOneIntegrator(ctx, state, recorder, progress);
   out.run = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
   for (const int r : dae.releasedEquations()) out.run.redundantConstraints.push_back(sys.describeEquation(r));
   out.run.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
@@ -382,7 +369,8 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
             ? solver
             : *(again = recordAgain(dae, choice.options, integrals, start, t0, tEnd, solver.stats().steps));
     out.recordedAgain = again != nullptr;
-    const int n = dae.size(), count = static_cast<int>(outputs.size());
+    const DaeLayout& L = dae.layout();
+  const int n = dae.size(), count = static_cast<int>(outputs.size());
     const auto np = static_cast<Eigen::Index>(params.size());
     AdjointProblem problem{&integrals, MatX(n, count), MatX(n, count), MatX(n, count), MatX(np, count), L.nq};
     MatX FyT, ET;

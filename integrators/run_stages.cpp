@@ -325,6 +325,24 @@ void integrateOutputs(const RunContext& ctx, RunState& state, OutputRecorder& re
   }
 }
 
+std::optional<RunFailure> integrateOnOneIntegrator(const RunContext& ctx, RunState& state, OutputRecorder& recorder,
+                                                   ProgressReporter& progress) {
+  const DaeLayout& L = ctx.dae.layout();
+  try {
+    for (; state.nextOutput <= ctx.outputs.count; ++state.nextOutput) {
+      const double t = state.integrator->advance(ctx.outputs.time(state.nextOutput), ctx.outputs.tEnd);
+      requireStepBudget(ctx, state, t);
+      recorder.record(t, state.integrator->y().segment(L.q, L.nq), state.integrator->y().segment(L.v, L.nv));
+      progress.update(t, state.totalSteps());
+    }
+    return std::nullopt;
+  } catch (...) {
+    const FailureContext failed{ctx.sys, recorder.recorded(), ctx.modelSize, ctx.startRatio,
+                                state.integrator->stats().currentTime, &ctx.dae.releasedEquations()};
+    return diagnoseFailure(std::current_exception(), failed);
+  }
+}
+
 // --- diagnose ----------------------------------------------------------------------
 
 std::string divergenceReport(double largest, double modelSize, double t) {

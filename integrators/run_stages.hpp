@@ -142,6 +142,12 @@ void integrateToNextOutput(const RunContext& ctx, RunState& state, OutputRecorde
 /// CrossingFailure, the output's exceptions.
 void integrateOutputs(const RunContext& ctx, RunState& state, OutputRecorder& recorder, ProgressReporter& progress);
 
+/// The loop of a run that stays on its integrator (the sensitivity runs on IDAS: no
+/// hand-over to Radau IIA, no crossing): every output left, each recorded; what ends the run
+/// early, diagnosed (diagnoseFailure). @return nullopt if t_end was reached.
+std::optional<RunFailure> integrateOnOneIntegrator(const RunContext& ctx, RunState& state, OutputRecorder& recorder,
+                                                   ProgressReporter& progress);
+
 // --- diagnose ----------------------------------------------------------------------
 
 /// What the diagnosis of a failure looks at.

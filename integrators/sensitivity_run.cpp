@@ -312,21 +312,8 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
   currentS = &solver.sensitivity();
   const OutputSchedule outputs(t0, tEnd, settings.outputStep);
   ProgressReporter progress(settings.progress, t0, tEnd, "ida+sensitivities");
-  const DaeLayout& L = dae.layout();
   const RunContext ctx{sys, dae, settings, choice.options, outputs, start.modelSize, start.startRatio, false};
-  std::optional<RunFailure> failure;
-  try {
-    for (long k = 1; k <= outputs.count; ++k) {
-      const double t = solver.advance(outputs.time(k), tEnd);
-      requireStepBudget(ctx, state, t);
-      recorder.record(t, solver.y().segment(L.q, L.nq), solver.y().segment(L.v, L.nv));
-      progress.update(t, solver.stats().steps);
-    }
-  } catch (...) {
-    const FailureContext failed{sys, recorder.recorded(), start.modelSize, start.startRatio,
-                             solver.stats().currentTime, &dae.releasedEquations()};
-    failure = diagnoseFailure(std::current_exception(), failed);
-  }
+  const std::optional<RunFailure> failure = integrateOnOneIntegrator(ctx, state, recorder, progress);
   SimulationSummary summary = finishSummary(start, recorder.recorded(), choice, state, failure, tEnd - t0);
   for (const int r : dae.releasedEquations()) summary.redundantConstraints.push_back(sys.describeEquation(r));
   summary.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
