@@ -23,6 +23,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "integrators/adjoint_run.hpp"
 #include "io/adjoint_results.hpp"
 #include "io/results_writer.hpp"
@@ -33,14 +34,10 @@ using nlohmann::json;
 
 namespace {
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using bench::bestOf;
+using bench::readText;
 
-double cpuSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
+double cpuSince(double start) { return bench::cpuSeconds() - start; }
 
 struct Figures {
   double seconds = 0.0;
@@ -54,7 +51,7 @@ Figures plainRun(const std::string& text) {
   s.solver.integrator = IntegratorKind::Ida;
   const std::vector<std::string> columns = resultColumns(s);
   std::vector<double> row;
-  const std::clock_t start = std::clock();
+  const double start = bench::cpuSeconds();
   const SimulationSummary summary =
       simulate(s.system, s.solver, [&](const OutputSample& o) { resultRow(s, columns, o, row); });
   return {cpuSince(start), summary.stats.steps, 0, summary.ok};
@@ -66,7 +63,7 @@ Figures adjointRun(const std::string& text, const std::vector<std::string>& path
   const SensitivityScenes perturbed = buildSensitivityScenes(text, "<scene>", s, paths);
   const std::vector<std::string> columns = resultColumns(s);
   std::vector<double> row;
-  const std::clock_t start = std::clock();
+  const double start = bench::cpuSeconds();
   const AdjointSummary summary =
       runAdjointScene(s, perturbed, {output}, [&](const OutputSample& o) { resultRow(s, columns, o, row); });
   if (!summary.run.ok || !summary.backwardOk) {
@@ -81,7 +78,7 @@ Figures forwardRun(const std::string& text, const std::vector<std::string>& path
   const SensitivityScenes perturbed = buildSensitivityScenes(text, "<scene>", s, paths);
   const std::vector<std::string> columns = resultColumns(s);
   std::vector<double> row, d;
-  const std::clock_t start = std::clock();
+  const double start = bench::cpuSeconds();
   const SimulationSummary summary = simulateWithSensitivities(
       s.system, perturbed.parameters, s.solver, {true}, [&](const OutputSample& o, const SensitivitySample& sens) {
         resultRow(s, columns, o, row);
@@ -90,28 +87,18 @@ Figures forwardRun(const std::string& text, const std::vector<std::string>& path
   return {cpuSince(start), summary.stats.steps, 0, summary.ok};
 }
 
-template <class Run>
-Figures best(int repeat, Run run) {
-  Figures b;
-  for (int k = 0; k < repeat; ++k) {
-    const Figures f = run();
-    if (k == 0 || f.seconds < b.seconds) b = f;
-  }
-  return b;
-}
-
 void benchmark(const char* name, const std::string& text, const std::vector<std::string>& parameters,
                const std::string& output, int repeat) {
-  const Figures plain = best(repeat, [&] { return plainRun(text); });
+  const Figures plain = bestOf(repeat, [&] { return plainRun(text); });
   std::printf("%-22s plain IDA run: %8.4f s CPU, %6ld steps\n", name, plain.seconds, plain.steps);
   for (const std::size_t p : {std::size_t{1}, std::size_t{10}, parameters.size()}) {
     const std::vector<std::string> paths(parameters.begin(), parameters.begin() + static_cast<long>(p));
-    const Figures f = best(repeat, [&] { return adjointRun(text, paths, output); });
+    const Figures f = bestOf(repeat, [&] { return adjointRun(text, paths, output); });
     std::printf("%-22s adjoint p = %2zu: %8.4f s CPU, %6ld + %6ld backward steps, %5.2f plain runs%s\n", name, p,
                 f.seconds, f.steps, f.backwardSteps, f.seconds / plain.seconds, f.ok ? "" : " (FAILED)");
   }
   const std::vector<std::string> four(parameters.begin(), parameters.begin() + 4);
-  const Figures f = best(repeat, [&] { return forwardRun(text, four); });
+  const Figures f = bestOf(repeat, [&] { return forwardRun(text, four); });
   std::printf("%-22s forward p =  4: %8.4f s CPU, %6ld steps, %5.2f plain runs (for comparison)%s\n", name, f.seconds,
               f.steps, f.seconds / plain.seconds, f.ok ? "" : " (FAILED)");
 }

@@ -32,6 +32,26 @@ inline double secondsSince(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
+/// The whole text of a file ("" if it cannot be read: the scene reader then says so).
+inline std::string readText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+/// The figures of the run with the smallest `seconds` of `repeat` calls of run() (the
+/// machine is shared: the minimum is the least disturbed).
+template <class Run>
+auto bestOf(int repeat, Run run) {
+  auto best = run();
+  for (int k = 1; k < repeat; ++k) {
+    const auto f = run();
+    if (f.seconds < best.seconds) best = f;
+  }
+  return best;
+}
+
 /// Median (mean of the two middle values for an even count); NaN for an empty sample.
 inline double median(std::vector<double> v) {
   if (v.empty()) return NAN;

@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_common.hpp"
 #include "integrators/sensitivity_run.hpp"
 #include "io/results_writer.hpp"
 #include "io/sensitivity_results.hpp"
@@ -27,14 +28,10 @@ using namespace flexmbd;
 
 namespace {
 
-std::string readText(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream os;
-  os << in.rdbuf();
-  return os.str();
-}
+using bench::bestOf;
+using bench::readText;
 
-double cpuSince(std::clock_t start) { return static_cast<double>(std::clock() - start) / CLOCKS_PER_SEC; }
+double cpuSince(double start) { return bench::cpuSeconds() - start; }
 
 struct Figures {
   double seconds = 0.0;
@@ -47,7 +44,7 @@ Figures plainRun(const std::string& text) {
   s.solver.integrator = IntegratorKind::Ida;
   const std::vector<std::string> columns = resultColumns(s);
   std::vector<double> row;
-  const std::clock_t start = std::clock();
+  const double start = bench::cpuSeconds();
   const SimulationSummary summary =
       simulate(s.system, s.solver, [&](const OutputSample& o) { resultRow(s, columns, o, row); });
   return {cpuSince(start), summary.stats.steps};
@@ -59,7 +56,7 @@ Figures sensitivityRun(const std::string& text, const std::vector<std::string>& 
   const SensitivityScenes perturbed = buildSensitivityScenes(text, "<scene>", s, paths);
   const std::vector<std::string> columns = resultColumns(s);
   std::vector<double> row, d;
-  const std::clock_t start = std::clock();
+  const double start = bench::cpuSeconds();
   const SimulationSummary summary = simulateWithSensitivities(
       s.system, perturbed.parameters, s.solver, {errorControl}, [&](const OutputSample& o, const SensitivitySample& sens) {
         resultRow(s, columns, o, row);
@@ -68,27 +65,17 @@ Figures sensitivityRun(const std::string& text, const std::vector<std::string>& 
   return {cpuSince(start), summary.stats.steps};
 }
 
-template <class Run>
-Figures best(int repeat, Run run) {
-  Figures b;
-  for (int k = 0; k < repeat; ++k) {
-    const Figures f = run();
-    if (k == 0 || f.seconds < b.seconds) b = f;
-  }
-  return b;
-}
-
 void benchmark(const char* name, const std::string& text, const std::vector<std::string>& parameters, int repeat) {
-  const Figures plain = best(repeat, [&] { return plainRun(text); });
+  const Figures plain = bestOf(repeat, [&] { return plainRun(text); });
   std::printf("%-22s p = 0: %8.4f s CPU, %6ld steps (plain IDA run)\n", name, plain.seconds, plain.steps);
   for (const std::size_t p : {1u, 2u, 4u}) {
     const std::vector<std::string> paths(parameters.begin(), parameters.begin() + static_cast<long>(p));
-    const Figures f = best(repeat, [&] { return sensitivityRun(text, paths); });
+    const Figures f = bestOf(repeat, [&] { return sensitivityRun(text, paths); });
     std::printf("%-22s p = %zu: %8.4f s CPU, %6ld steps, %5.2f plain runs (target 1 + 0.5 p = %.1f)\n", name, p,
                 f.seconds, f.steps, f.seconds / plain.seconds, 1.0 + 0.5 * static_cast<double>(p));
   }
   // the same with the sensitivities out of the error test: the plain run's steps
-  const Figures off = best(repeat, [&] { return sensitivityRun(text, parameters, false); });
+  const Figures off = bestOf(repeat, [&] { return sensitivityRun(text, parameters, false); });
   std::printf("%-22s p = %zu: %8.4f s CPU, %6ld steps, %5.2f plain runs (sensitivities out of the error test)\n", name,
               parameters.size(), off.seconds, off.steps, off.seconds / plain.seconds);
 }
