@@ -83,24 +83,24 @@ json exampleScene(const std::string& name) {
   return json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/" + name));
 }
 
+/// examples/slider_crank_rigid.json without its driver, the crank started at 1 rad/s (one
+/// degree of freedom, four constraint pairs), over `tEnd` at tolerances rtol, rtol / 100.
+json freeCrank(double tEnd, double rtol) {
+  json j = exampleScene("slider_crank_rigid.json");
+  j.erase("drivers");
+  j["bodies"][0]["angular_velocity"] = 1.0;
+  j["solver"]["rtol"] = rtol;
+  j["solver"]["atol"] = rtol / 100;
+  j["solver"]["t_end"] = tEnd;
+  return j;
+}
+
 }  // namespace
 
 namespace {
 
 // ----- a spring-mass-damper: closed form ------------------------------------------------
 
-/// A mass m on a spring k (free length 1 m) and damper c along x, released at rest at
-/// x0 = 1.1 m: m u'' + c u' + k u = 0, u = x - 1 (tests/test_sensitivities.cpp).
-json springMassDamper() {
-  return json::parse(R"({
-    "name": "spring-mass-damper", "gravity": [0.0, 0.0],
-    "bodies": [{"name": "mass", "type": "rigid", "mass": 2.0, "inertia": 0.1, "com": [0.0, 0.0],
-                "position": [1.1, 0.0], "angle": 0.0}],
-    "forces": [{"name": "spring", "type": "spring_damper", "bodies": ["ground", "mass"],
-                "points": [[0.0, 0.0], [0.0, 0.0]], "stiffness": 50.0, "damping": 0.8, "free_length": 1.0}],
-    "solver": {"rtol": 1e-10, "atol": 1e-12, "t_end": 3.0, "output_step": 0.05}
-  })");
-}
 
 /// x(t) = 1 + u0 e^{-zeta wn t} (cos wd t + zeta wn / wd sin wd t) (Meirovitch, Elements of
 /// Vibration Analysis, eq. 2.27), complex for the complex-step derivative.
@@ -227,12 +227,7 @@ TEST(Adjoint, ARunThatOutgrowsItsRecordingIsRecordedAgain) {
   // more from t0 in one store. The same gradients as with a store that holds the run: the
   // second recording takes its own steps, so the two differ at the state's error (rtol
   // 1e-10): 1e-7 of each gradient.
-  json j = exampleScene("slider_crank_rigid.json");
-  j.erase("drivers");
-  j["bodies"][0]["angular_velocity"] = 1.0;
-  j["solver"]["rtol"] = 1e-10;
-  j["solver"]["atol"] = 1e-12;
-  j["solver"]["t_end"] = 3.0;
+  const json j = freeCrank(3.0, 1e-10);
   const std::vector<std::string> paths = {"joints[2].points[0][0]", "bodies[2].mass", "bodies[0].angular_velocity"};
   const std::string text = j.dump();
   Scene base = parseSceneText(text);
@@ -262,12 +257,7 @@ TEST(Adjoint, FreeSliderCrankIntegralEqualsForwardGradient) {
   // degree of freedom, four constraint pairs. int slider.x^2 dt over 3 s with respect to the
   // crank and rod lengths (joint points: in the constraints), the slider's mass (in the
   // dynamics) and the crank's initial speed (an initial condition: through s(t0)).
-  json j = exampleScene("slider_crank_rigid.json");
-  j.erase("drivers");
-  j["bodies"][0]["angular_velocity"] = 1.0;
-  j["solver"]["rtol"] = 1e-11;
-  j["solver"]["atol"] = 1e-13;
-  j["solver"]["t_end"] = 3.0;
+  const json j = freeCrank(3.0, 1e-11);
   const double kTolerance = 1e-7;  // as the pendulum's (the crank turns at about 1 rad/s)
   expectAdjointEqualsForward("free crank", j,
                              {"joints[1].points[0][0]", "joints[2].points[0][0]", "bodies[2].mass",
@@ -319,10 +309,7 @@ TEST(Adjoint, ElasticSliderCrankIntegralEqualsForwardGradient) {
 TEST_F(Cli, AdjointGradientsInTheSummary) {
   // the free slider crank (FreeSliderCrankIntegralEqualsForwardGradient) over 1 s: two
   // outputs, two parameters; the gradients equal those of the library call to round-off
-  json j = exampleScene("slider_crank_rigid.json");
-  j.erase("drivers");
-  j["bodies"][0]["angular_velocity"] = 1.0;
-  j["solver"]["t_end"] = 1.0;
+  const json j = freeCrank(1.0, 1e-8);  // the example's tolerances
   const fs::path scene = writeScene("crank.json", j);
   const CliResult r = run("run " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / "out").string()) +
                           " --quiet --sensitivity 'bodies[2].mass' --sensitivity 'joints[2].points[0][0]'"

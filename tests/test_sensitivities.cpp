@@ -31,18 +31,6 @@ namespace {
 
 // ----- (a) a linear spring-mass-damper: closed form -----------------------------------
 
-/// A rigid body of mass m on a spring k (free length 1 m) and damper c to the ground along
-/// x, released at rest 0.1 m from equilibrium: m u'' + c u' + k u = 0, u = x - 1.
-json springMassDamper() {
-  return json::parse(R"({
-    "name": "spring-mass-damper", "gravity": [0.0, 0.0],
-    "bodies": [{"name": "mass", "type": "rigid", "mass": 2.0, "inertia": 0.1, "com": [0.0, 0.0],
-                "position": [1.1, 0.0], "angle": 0.0}],
-    "forces": [{"name": "spring", "type": "spring_damper", "bodies": ["ground", "mass"],
-                "points": [[0.0, 0.0], [0.0, 0.0]], "stiffness": 50.0, "damping": 0.8, "free_length": 1.0}],
-    "solver": {"rtol": 1e-10, "atol": 1e-12, "t_end": 3.0, "output_step": 0.05}
-  })");
-}
 
 /// u(t) of the underdamped oscillator from u0 at rest: u0 e^{-zeta wn t} (cos wd t +
 /// zeta wn / wd sin wd t) (e.g. Meirovitch, Elements of Vibration Analysis, eq. 2.27),
