@@ -45,10 +45,37 @@ class SystemIntegrals final : public IntegralOutputs {
 
   void integrands(double t, const double* y, double* g) override {
     unpack(y);
-    for (std::size_t k = 0; k < outputs_.size(); ++k) g[k] = outputs_[k].integrand(dae_.system(), t, q_, v_);
+    for (std::size_t k = 0; k < outputs_.size(); ++k) {
+      g[k] = outputs_[k].terminal ? 0.0 : outputs_[k].integrand(dae_.system(), t, q_, v_);
+    }
   }
 
   void integrandGradient(int k, double t, const double* y, double* gy) override {
+    if (outputs_[static_cast<std::size_t>(k)].terminal) {  // its adjoint is homogeneous
+      Eigen::Map<VecX>(gy, cacheY_.size()).setZero();
+      return;
+    }
+    valueGradient(k, t, y, gy);
+  }
+
+  /// The output's value c(t, y) on the run's system.
+  double value(int k, double t, const double* y) {
+    unpack(y);
+    return outputs_[static_cast<std::size_t>(k)].integrand(dae_.system(), t, q_, v_);
+  }
+
+  /// dc/dp_i at (t, y): the output's own dependence on parameter i (0 where it has none).
+  double explicitDerivative(int k, int i, double t, const double* y) {
+    const auto K = static_cast<std::size_t>(k), I = static_cast<std::size_t>(i);
+    if (!explicitParameters_[K][I]) return 0.0;
+    unpack(y);
+    const double plus = outputs_[K].integrand(*params_[I].plus, t, q_, v_);
+    const double minus = outputs_[K].integrand(*params_[I].minus, t, q_, v_);
+    return (plus - minus) / (2.0 * params_[I].step);  // central difference, Nocedal & Wright 2006, sec. 8.1
+  }
+
+  /// dc/dy of output k's integrand (its value for a terminal output) at (t, y) into gy.
+  void valueGradient(int k, double t, const double* y, double* gy) {
     const auto K = static_cast<std::size_t>(k);
     const auto n = static_cast<Eigen::Index>(cacheY_.size());
     const Eigen::Map<const VecX> Y(y, n);
@@ -74,17 +101,10 @@ class SystemIntegrals final : public IntegralOutputs {
       cacheYp_ = Yp;
       cacheValid_ = true;
     }
-    unpack(y);
-    const auto K = static_cast<std::size_t>(k);
+    const bool terminal = outputs_[static_cast<std::size_t>(k)].terminal;
     for (int i = 0; i < parameterCount(); ++i) {
-      const auto I = static_cast<std::size_t>(i);
-      // g_p - lambda^T F_p (IDAS guide, "Adjoint sensitivity analysis")
-      out[i] = -Lambda.dot(dFdp_.col(i));
-      if (explicitParameters_[K][I]) {
-        const double plus = outputs_[K].integrand(*params_[I].plus, t, q_, v_);
-        const double minus = outputs_[K].integrand(*params_[I].minus, t, q_, v_);
-        out[i] += (plus - minus) / (2.0 * params_[I].step);  // central difference, Nocedal & Wright 2006, sec. 8.1
-      }
+      // g_p - lambda^T F_p (IDAS guide, "Adjoint sensitivity analysis"); g = 0 for a terminal output
+      out[i] = -Lambda.dot(dFdp_.col(i)) + (terminal ? 0.0 : explicitDerivative(k, i, t, y));
     }
   }
 
@@ -177,37 +197,102 @@ void denseJacobians(const DaeSystem& dae, double t, const VecX& y, const VecX& y
 
 }  // namespace
 
-MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy) {
-  const DaeLayout& L = dae.layout();
+namespace {
+
+/// The GGL layout [q, v, lambda, mu] the adjoint's terminal values are derived for.
+void requireGglLayout(const DaeLayout& L) {
   if (L.mu < 0 || L.q != 0 || L.v != L.nq || L.lambda != L.nq + L.nv) {
-    throw std::logic_error("adjointTerminalValues: the GGL layout [q, v, lambda, mu] expected");
+    throw std::logic_error("adjoint terminal values: the GGL layout [q, v, lambda, mu] expected");
   }
+}
+
+/// Whether the multiplier column nd + j of F_y has entries in the constraint rows (the
+/// row lambda_k = 0 or mu_k = 0 of a released equation).
+bool releasedColumn(const MatX& Fy, int nd, int j) {
+  const int na = static_cast<int>(Fy.rows()) - nd;
+  return Fy.col(nd + j).tail(na).cwiseAbs().maxCoeff() > 0.0;
+}
+
+}  // namespace
+
+MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy,
+                           const VecX& lambdaD) {
+  const DaeLayout& L = dae.layout();
+  requireGglLayout(L);
   MatX Fy, E;
   denseJacobians(dae, t, y, yp, Fy, E);
   const int nd = L.nq + L.nv, na = L.size - nd;
-  // unknowns x = [lambda_D' (nd); lambda_A (na)], lambda_D(T) = 0
+  const bool moving = lambdaD.size() == nd && lambdaD.cwiseAbs().maxCoeff() > 0.0;
+  // the rates of F_y and E along the motion, (X(y + e y') - X(y - e y')) / (2 e) (central
+  // difference, Nocedal & Wright 2006, sec. 8.1): the terms (dE/dt)^T lambda_D and the
+  // derivatives of the algebraic rows (d/dt F_Da)^T lambda_D; not needed at lambda_D = 0
+  MatX FyRate = MatX::Zero(L.size, L.size), ERate = MatX::Zero(L.size, L.size);
+  if (moving && yp.cwiseAbs().maxCoeff() > 0.0) {
+    const double e = kCentralDifferenceFraction * std::max(1.0, y.cwiseAbs().maxCoeff()) / yp.cwiseAbs().maxCoeff();
+    MatX FyPlus, EPlus, FyMinus, EMinus;
+    denseJacobians(dae, t + e, y + e * yp, yp, FyPlus, EPlus);
+    denseJacobians(dae, t - e, y - e * yp, yp, FyMinus, EMinus);
+    FyRate = (FyPlus - FyMinus) / (2.0 * e);
+    ERate = (EPlus - EMinus) / (2.0 * e);
+  }
+  const VecX lD = moving ? lambdaD : VecX::Zero(nd);
+  // unknowns x = [lambda_D' (nd); lambda_A (na)] at the given lambda_D
   MatX A = MatX::Zero(L.size, L.size);
   VecX b = VecX::Zero(L.size);
-  // differential rows of E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y = 0 at lambda_D = 0
+  // differential rows of E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y = 0
   A.topLeftCorner(nd, nd) = E.topLeftCorner(nd, nd).transpose();
   A.topRightCorner(nd, na) = -Fy.bottomLeftCorner(na, nd).transpose();
-  b.head(nd) = -gy.head(nd);
+  b.head(nd) = -gy.head(nd) - ERate.topLeftCorner(nd, nd).transpose() * lD + Fy.topLeftCorner(nd, nd).transpose() * lD;
   // algebraic rows: -F_Da^T lambda_D - F_Aa^T lambda_A + g_a = 0 (g holds no multiplier); where
-  // F_Aa's column is empty (a constraint not released) its derivative at lambda_D = 0:
-  // F_Da^T lambda_D' = 0 (the hidden constraint); where not (a released equation's row
-  // lambda_k = 0): F_Aa^T lambda_A = 0
+  // F_Aa's column is empty (a constraint not released) its derivative, the hidden
+  // constraint F_Da^T lambda_D' + (d/dt F_Da)^T lambda_D = 0; where not (a released
+  // equation's row lambda_k = 0) the row itself, F_Aa^T lambda_A = -F_Da^T lambda_D
   for (int j = 0; j < na; ++j) {
     const auto column = Fy.col(nd + j);
-    if (column.tail(na).cwiseAbs().maxCoeff() > 0.0) {
+    if (releasedColumn(Fy, nd, j)) {
       A.row(nd + j).tail(na) = column.tail(na).transpose();
+      b[nd + j] = -column.head(nd).dot(lD);
     } else {
       A.row(nd + j).head(nd) = column.head(nd).transpose();
+      b[nd + j] = -FyRate.col(nd + j).head(nd).dot(lD);
     }
   }
   const VecX x = Eigen::CompleteOrthogonalDecomposition<MatX>(A).solve(b);
   MatX out = MatX::Zero(L.size, 2);
+  out.col(0).head(nd) = lD;
   out.col(0).tail(na) = x.tail(na);
   out.col(1).head(nd) = x.head(nd);
+  return out;
+}
+
+TerminalAdjoint terminalAdjoint(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& cy) {
+  const DaeLayout& L = dae.layout();
+  requireGglLayout(L);
+  MatX Fy, E;
+  denseJacobians(dae, t, y, yp, Fy, E);
+  const int nd = L.nq + L.nv, na = L.size - nd;
+  // c_D = E_DD^T lambda_D + F_AD^T nu with lambda_D on the adjoint's algebraic rows
+  // (F_Da^T lambda_D = 0 where no equation is released; a released row's nu = 0): then
+  // c_D s_D = lambda_D^T E s_D - nu^T F_Ap for every consistent s (F_AD s_D + F_Ap = 0)
+  MatX A = MatX::Zero(L.size, L.size);
+  VecX b = VecX::Zero(L.size);
+  A.topLeftCorner(nd, nd) = E.topLeftCorner(nd, nd).transpose();
+  A.topRightCorner(nd, na) = Fy.bottomLeftCorner(na, nd).transpose();
+  b.head(nd) = cy.head(nd);
+  for (int j = 0; j < na; ++j) {
+    if (releasedColumn(Fy, nd, j)) {
+      A(nd + j, nd + j) = 1.0;  // the released row's nu (its row of F_AD is empty)
+    } else {
+      A.row(nd + j).head(nd) = Fy.col(nd + j).head(nd).transpose();
+    }
+  }
+  const VecX x = Eigen::CompleteOrthogonalDecomposition<MatX>(A).solve(b);
+  TerminalAdjoint out;
+  const MatX values = adjointTerminalValues(dae, t, y, yp, VecX::Zero(L.size), x.head(nd));
+  out.lambda = values.col(0);
+  out.rate = values.col(1);
+  out.nu = VecX::Zero(L.size);
+  out.nu.tail(na) = x.tail(na);
   return out;
 }
 
@@ -376,13 +461,27 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     MatX FyT, ET;
     denseJacobians(dae, tEnd, recording.y(), recording.yp(), FyT, ET);
     VecX gy(n);
+    std::vector<TerminalAdjoint> terminal;
     for (int k = 0; k < count; ++k) {
-      integrals.integrandGradient(k, tEnd, recording.y().data(), gy.data());
-      const MatX terminal = adjointTerminalValues(dae, tEnd, recording.y(), recording.yp(), gy);
-      problem.lambdaT.col(k) = terminal.col(0);
-      problem.lambdaTp.col(k) = terminal.col(1);
-      problem.atolB.col(k) = adjointTolerances(L, choice.options.atol, choice.options.rtol, ET, G[k]);
-      const double g = std::max(std::fabs(G[k]), std::numeric_limits<double>::min() / choice.options.rtol);
+      double size = G[k];  // the output's size, the scale of its adjoint's tolerances
+      if (outputs[static_cast<std::size_t>(k)].terminal) {
+        integrals.valueGradient(k, tEnd, recording.y().data(), gy.data());
+        terminal.push_back(terminalAdjoint(dae, tEnd, recording.y(), recording.yp(), gy));
+        problem.lambdaT.col(k) = terminal.back().lambda;
+        problem.lambdaTp.col(k) = terminal.back().rate;
+        // |c(T)| and its change over the state's scales (atol_j / rtol): a column that is 0
+        // at T still has the size of its motion
+        size = std::fabs(integrals.value(k, tEnd, recording.y().data())) +
+               gy.cwiseAbs().dot(choice.options.atol) / choice.options.rtol;
+      } else {
+        integrals.integrandGradient(k, tEnd, recording.y().data(), gy.data());
+        terminal.emplace_back();
+        const MatX values = adjointTerminalValues(dae, tEnd, recording.y(), recording.yp(), gy, VecX());
+        problem.lambdaT.col(k) = values.col(0);
+        problem.lambdaTp.col(k) = values.col(1);
+      }
+      problem.atolB.col(k) = adjointTolerances(L, choice.options.atol, choice.options.rtol, ET, size);
+      const double g = std::max(std::fabs(size), std::numeric_limits<double>::min() / choice.options.rtol);
       // each gradient to rtol |G| / |p_i| (the change of G over a relative change of p_i of 1)
       for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
     }
@@ -393,6 +492,17 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     for (int k = 0; k < count; ++k) {
       IntegralGradient r{outputs[static_cast<std::size_t>(k)].name, G[k], backward.integral.col(k)};
       r.gradient += (backward.lambda0.col(k).transpose() * E0 * s0.s0).transpose();
+      if (outputs[static_cast<std::size_t>(k)].terminal) {
+        // dc(T)/dp = c_p - nu^T F_p(T) + the adjoint's part above (terminalAdjoint)
+        r.value = integrals.value(k, tEnd, recording.y().data());
+        VecX Fp(n);
+        for (Eigen::Index i = 0; i < np; ++i) {
+          derivatives.residualDerivative(static_cast<int>(i), tEnd, recording.y().data(), recording.yp().data(),
+                                         Fp.data());
+          r.gradient[i] += integrals.explicitDerivative(k, static_cast<int>(i), tEnd, recording.y().data()) -
+                           terminal[static_cast<std::size_t>(k)].nu.dot(Fp);
+        }
+      }
       if (const auto& report = outputs[static_cast<std::size_t>(k)].report) report(tEnd - t0, r.value, r.gradient);
       out.outputs.push_back(std::move(r));
     }

@@ -22,6 +22,8 @@ struct IntegralOutput {
   /// A function of the integral reported instead of it (empty: G itself): from G, dG/dp and
   /// the run's span T - t0, the value and its gradient (a KS aggregate: ln(G / T) / rho).
   std::function<void(double span, double& value, VecX& gradient)> report;
+  /// The output is the integrand's value at T, c(y(T)), not its integral (a terminal output).
+  bool terminal = false;
 };
 
 /// The value and gradient of one integral output.
@@ -43,17 +45,33 @@ struct AdjointSummary {
   double backwardCpuSeconds = 0.0;
 };
 
-/// Consistent terminal values of the adjoint of an integral output at T for the GGL form
-/// (docs/sensitivities.md): lambda_q = lambda_v = 0 (E^T lambda(T) = 0), and lambda_g,
-/// lambda_gv with lambda_q', lambda_v' from the adjoint's differential rows and the
-/// derivatives of its algebraic rows (the hidden constraints G D T^T lambda_q' = 0,
-/// G lambda_v' = 0; a released equation's rows: its adjoint multiplier 0).
+/// Consistent terminal values of the adjoint for the GGL form (docs/sensitivities.md) with
+/// its differential part lambda_D = [lambda_q; lambda_v] given (empty: 0, an integral
+/// output's E^T lambda(T) = 0): lambda_g, lambda_gv and lambda_q', lambda_v' from the
+/// adjoint's differential rows and the derivatives of its algebraic rows (the hidden
+/// constraints G D T^T lambda_q' + (d/dt G D T^T) lambda_q = 0, G lambda_v' + G' lambda_v = 0,
+/// the rates of F_y and E along the motion by central differences; a released equation's
+/// rows: its adjoint multiplier from its row).
 /// @param dae the run's DAE (GGL layout)
 /// @param t the time T
 /// @param y, yp the forward solution at T
 /// @param gy the integrand's gradient at (T, y) (size n)
+/// @param lambdaD lambda_q, lambda_v at T (size nq + nv) or empty for zero
 /// @returns lambda(T) and lambda'(T) as the columns of an n x 2 matrix
-MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy);
+MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& gy,
+                           const VecX& lambdaD);
+
+/// The adjoint of a terminal output c(y(T)) at T: c_y = E^T lambda + F_A^T nu on the
+/// consistent states (lambda_D meeting the adjoint's algebraic rows), so that
+/// dc/dp = c_p - nu^T F_p(T) + lambda(t0)^T E s(t0) - int lambda^T F_p dt with lambda the
+/// homogeneous adjoint from these terminal values (Cao, Li, Petzold and Serban 2003 for the
+/// index-2 case; docs/sensitivities.md).
+struct TerminalAdjoint {
+  VecX lambda, rate;  ///< lambda(T), lambda'(T)
+  VecX nu;            ///< size n, zero on q and v: the constraint rows' weights
+};
+/// @param cy the output's gradient in y at T (zero on the multipliers)
+TerminalAdjoint terminalAdjoint(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& cy);
 
 /// Steps between IDAS's checkpoints of the forward run (the backward integration
 /// recomputes and stores the steps of one interval at a time: memory ~ this many states).

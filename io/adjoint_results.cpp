@@ -71,10 +71,10 @@ IntegralOutput integralOutput(const std::string& spec, const Scene& base, const 
                        "aggregate's sharpness, 1 / the column's unit)");
     }
     column = column.substr(0, last);
-  } else if (kind != "integral" && kind != "integral_square") {
+  } else if (kind != "integral" && kind != "integral_square" && kind != "final") {
     throw InputError("adjoint output '" + spec +
                      "': expected KIND:COLUMN with KIND \"integral\" (int c dt), \"integral_square\" (int c^2 dt) or "
-                     "\"ks\" (ks:COLUMN:RHO, the aggregate ln(int exp(RHO c) dt / T) / RHO)");
+                     "\"ks\" (ks:COLUMN:RHO, the aggregate ln(int exp(RHO c) dt / T) / RHO) or \"final\" (c(T))");
   }
   const ColumnSource source = columnSource(base, column, spec);
   // the scene of each system the integrand can be given (the base and the perturbed ones)
@@ -89,7 +89,8 @@ IntegralOutput integralOutput(const std::string& spec, const Scene& base, const 
     throw std::logic_error("integral output: a system of no scene of the run");
   };
   IntegralOutput out{spec, nullptr, nullptr};
-  if (kind == "integral") {
+  if (kind == "integral" || kind == "final") {
+    out.terminal = kind == "final";
     out.integrand = [value](const System& sys, double, const VecX& q, const VecX& v) { return value(sys, q, v); };
   } else if (kind == "integral_square") {
     out.integrand = [value](const System& sys, double, const VecX& q, const VecX& v) {

@@ -202,6 +202,55 @@ TEST(Adjoint, KsAggregateMatchesClosedForm) {
   }
 }
 
+/// The adjoint gradient of final:COLUMN equals the forward sensitivity of the column at
+/// the last row, to `tolerance` of each (or of the largest, for a derivative near zero).
+void expectTerminalEqualsForward(const char* what, const json& scene, const std::vector<std::string>& paths,
+                                 const std::string& column, double tolerance) {
+  const AdjointSummary s = adjointRun(scene, paths, {"final:" + column});
+  ASSERT_TRUE(s.run.ok) << s.run.message;
+  ASSERT_TRUE(s.backwardOk) << s.backwardMessage;
+  const SensitivityRun forward = runWithSensitivities(scene, paths);
+  ASSERT_TRUE(forward.summary.ok) << forward.summary.message;
+  const std::size_t last = forward.rows.size() - 1;
+  // the two runs take their own steps: their values at T agree to the state's error
+  EXPECT_NEAR(s.outputs[0].value, forward.value(last, column), 1e-7 * (1.0 + std::fabs(forward.value(last, column))));
+  double largest = 0.0;
+  for (std::size_t i = 0; i < paths.size(); ++i) largest = std::max(largest, std::fabs(forward.d(last, column, i)));
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const double got = s.outputs[0].gradient[static_cast<Eigen::Index>(i)], expected = forward.d(last, column, i);
+    std::printf("%s d final(%s) / d %s: adjoint %.10g, forward %.10g (relative %.2g)\n", what, column.c_str(),
+                paths[i].c_str(), got, expected, std::fabs(got - expected) / std::max(std::fabs(expected), 1e-300));
+    EXPECT_NEAR(got, expected, tolerance * std::max(std::fabs(expected), 1e-3 * largest)) << what << ": " << paths[i];
+  }
+}
+
+TEST(Adjoint, TerminalOutputsEqualForwardSensitivities) {
+  // final:COLUMN, the column's value at T: its adjoint starts from E^T lambda(T) = c_y on the
+  // consistent states (terminalAdjoint), with the constraint rows' part nu^T F_p(T). Against
+  // the forward sensitivities at the last row, at the runs' tolerances (both ~1e-8 of the
+  // derivatives at these rtol; 1e-6 holds them).
+  const double kTolerance = 1e-6;
+  expectTerminalEqualsForward("spring-mass-damper", springMassDamper(),
+                              {"forces[0].stiffness", "forces[0].damping", "bodies[0].position[0]"}, "mass.x",
+                              kTolerance);
+  json pendulum = json::parse(R"({
+    "name": "pendulum", "gravity": [0.0, -9.81],
+    "bodies": [{"name": "bob", "type": "rigid", "mass": 1.0, "inertia": 1e-3, "com": [0.0, 0.0],
+                "position": [0.0, 0.0], "angle": 0.3}],
+    "joints": [{"name": "pivot", "type": "revolute", "bodies": ["ground", "bob"], "points": [[0.0, 0.0], [0.0, 0.8]]}],
+    "solver": {"rtol": 1e-11, "atol": 1e-13, "t_end": 2.0, "output_step": 0.05}
+  })");
+  pendulum["bodies"][0]["position"] = {0.8 * std::sin(0.3), -0.8 * std::cos(0.3)};
+  expectTerminalEqualsForward("pendulum", pendulum, {"joints[0].points[1][1]", "bodies[0].inertia", "bodies[0].angle"},
+                              "bob.theta", kTolerance);
+  expectTerminalEqualsForward("pendulum", pendulum, {"joints[0].points[1][1]", "bodies[0].angle"}, "bob.x_dot",
+                              kTolerance);
+  expectTerminalEqualsForward("free crank", freeCrank(3.0, 1e-11),
+                              {"joints[1].points[0][0]", "joints[2].points[0][0]", "bodies[2].mass",
+                               "bodies[0].angular_velocity"},
+                              "slider.x", kTolerance);
+}
+
 TEST(Adjoint, PendulumIntegralEqualsForwardGradient) {
   // A bob on a massless length L = 0.8 m released at 0.3 rad (tests/test_sensitivities.cpp):
   // one constraint pair, so the adjoint multipliers and their terminal values take part.
