@@ -249,6 +249,16 @@ TEST(Adjoint, TerminalOutputsEqualForwardSensitivities) {
                               {"joints[1].points[0][0]", "joints[2].points[0][0]", "bodies[2].mass",
                                "bodies[0].angular_velocity"},
                               "slider.x", kTolerance);
+  // the elastic crank (2 nodal elements, 5 ms, rtol 1e-9): M(q) moves, so (dE/dt)^T lambda
+  // and the rates of F_y enter the terminal values; the deflection at T by E and the height
+  json elastic = exampleScene("slider_crank_elastic.json");
+  elastic["bodies"][1]["beam"]["elements"] = 2;
+  elastic["solver"]["rtol"] = 1e-9;
+  elastic["solver"]["atol"] = 1e-11;
+  elastic["solver"]["t_end"] = 0.005;
+  const double kElasticTolerance = 1e-5;  // the runs' errors at rtol 1e-9 over a bending period
+  expectTerminalEqualsForward("elastic crank", elastic, {"bodies[1].section.youngs_modulus", "bodies[1].section.height"},
+                              "mid.uy", kElasticTolerance);
 }
 
 TEST(Adjoint, PendulumIntegralEqualsForwardGradient) {

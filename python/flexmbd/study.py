@@ -35,7 +35,7 @@ DIFFERENTIABLE_OUTPUTS = ("max_abs", "max", "min", "final")
 AXIS_KEYS = {"name", "key", "values", "range", "count", "spacing"}
 OUTPUT_KEYS = {"summary", "max_abs", "max", "min", "final", "at", "after", "functions", "integrals"}
 # the kinds of an adjoint integral output "KIND:COLUMN" (docs/sensitivities.md)
-INTEGRAL_KINDS = ("integral", "integral_square", "ks")
+INTEGRAL_KINDS = ("integral", "integral_square", "ks", "final")
 PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
 PLOT_FILE_TYPES = (".png", ".svg", ".pdf")
 MAX_TITLE_LENGTH = 300  # a title is one line over the figure; matplotlib fails on 100 kB ("raster overflow")
