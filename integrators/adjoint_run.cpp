@@ -403,12 +403,10 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
 
   // start: the consistent state, the perturbed DAEs, the initial sensitivities (the
   // gradient's term lambda(t0)^T E s(t0))
-  ReleasedEquations released;
-  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
-  const ConsistentState init =
-      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
-  const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
-  const PerturbedDaes perturbed = perturbedDaes(dae, params);
+  const SensitivityStart begin = startSensitivityRun(sys, settings, params);
+  const ConsistentState& init = begin.init;
+  const DaeSystem& dae = *begin.dae;
+  const PerturbedDaes& perturbed = begin.perturbed;
   const InitialSensitivities s0 = initialSensitivities(dae, perturbed.pairs, init, t0);
   const RunStart start = startRun(dae, init, t0);
 

@@ -262,6 +262,17 @@ PerturbedDaes perturbedDaes(const DaeSystem& base, const std::vector<Sensitivity
   return out;
 }
 
+SensitivityStart startSensitivityRun(const System& sys, const SolverSettings& settings,
+                                     const std::vector<SensitivityParameter>& params) {
+  ReleasedEquations released;
+  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
+  SensitivityStart out;
+  out.init = computeConsistentState(sys, settings.tStart, sys.initialCoordinates(), sys.initialVelocities(), released);
+  out.dae = std::make_unique<DaeSystem>(sys, settings.formulation, defaultStabilisationMetric(sys), out.init.released);
+  out.perturbed = perturbedDaes(*out.dae, params);
+  return out;
+}
+
 SimulationSummary simulateWithSensitivities(const System& sys, const std::vector<SensitivityParameter>& params,
                                             const SolverSettings& given, const SensitivitySettings& sensitivity,
                                             const SensitivityCallback& onOutput) {
@@ -271,14 +282,11 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
   const double t0 = settings.tStart, tEnd = settings.tEnd;
 
   // start: the consistent state, the perturbed DAEs (same structure), s0 and s0'
-  ReleasedEquations released;
-  released.detect = settings.redundantConstraints == RedundantConstraints::Resolve;
-  const ConsistentState init =
-      computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
-  const DaeSystem dae(sys, settings.formulation, defaultStabilisationMetric(sys), init.released);
-  const PerturbedDaes perturbed = perturbedDaes(dae, params);
-  const std::vector<ResidualDifferences::Pair>& pairs = perturbed.pairs;
-  const VecX& scales = perturbed.scales;
+  const SensitivityStart begin = startSensitivityRun(sys, settings, params);
+  const ConsistentState& init = begin.init;
+  const DaeSystem& dae = *begin.dae;
+  const std::vector<ResidualDifferences::Pair>& pairs = begin.perturbed.pairs;
+  const VecX& scales = begin.perturbed.scales;
   const InitialSensitivities s0 = initialSensitivities(dae, pairs, init, t0);
   const RunStart start = startRun(dae, init, t0);
 

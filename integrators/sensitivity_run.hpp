@@ -138,6 +138,18 @@ struct PerturbedDaes {
 /// @throws InputError naming a parameter without a finalized system or one that changes the structure.
 PerturbedDaes perturbedDaes(const DaeSystem& base, const std::vector<SensitivityParameter>& parameters);
 
+/// Stage "start" of a run with sensitivities (forward or adjoint): the consistent state of
+/// the system's initial values (released equations as the settings say), its DAE and the
+/// parameters' perturbed DAEs.
+struct SensitivityStart {
+  ConsistentState init;
+  std::unique_ptr<DaeSystem> dae;
+  PerturbedDaes perturbed;
+};
+/// @throws as computeConsistentState and perturbedDaes.
+SensitivityStart startSensitivityRun(const System& sys, const SolverSettings& settings,
+                                     const std::vector<SensitivityParameter>& parameters);
+
 /// simulateKeepingFailures with forward sensitivities, on IDA(S) only (no hand-over to
 /// Radau IIA, no singular crossing: a run that fails stops there, rows kept). `onOutput`
 /// gets every output with its sensitivities.

@@ -233,17 +233,9 @@ TEST(Adjoint, TerminalOutputsEqualForwardSensitivities) {
   expectTerminalEqualsForward("spring-mass-damper", springMassDamper(),
                               {"forces[0].stiffness", "forces[0].damping", "bodies[0].position[0]"}, "mass.x",
                               kTolerance);
-  json pendulum = json::parse(R"({
-    "name": "pendulum", "gravity": [0.0, -9.81],
-    "bodies": [{"name": "bob", "type": "rigid", "mass": 1.0, "inertia": 1e-3, "com": [0.0, 0.0],
-                "position": [0.0, 0.0], "angle": 0.3}],
-    "joints": [{"name": "pivot", "type": "revolute", "bodies": ["ground", "bob"], "points": [[0.0, 0.0], [0.0, 0.8]]}],
-    "solver": {"rtol": 1e-11, "atol": 1e-13, "t_end": 2.0, "output_step": 0.05}
-  })");
-  pendulum["bodies"][0]["position"] = {0.8 * std::sin(0.3), -0.8 * std::cos(0.3)};
-  expectTerminalEqualsForward("pendulum", pendulum, {"joints[0].points[1][1]", "bodies[0].inertia", "bodies[0].angle"},
+  expectTerminalEqualsForward("pendulum", pendulum(), {"joints[0].points[1][1]", "bodies[0].inertia", "bodies[0].angle"},
                               "bob.theta", kTolerance);
-  expectTerminalEqualsForward("pendulum", pendulum, {"joints[0].points[1][1]", "bodies[0].angle"}, "bob.x_dot",
+  expectTerminalEqualsForward("pendulum", pendulum(), {"joints[0].points[1][1]", "bodies[0].angle"}, "bob.x_dot",
                               kTolerance);
   expectTerminalEqualsForward("free crank", freeCrank(3.0, 1e-11),
                               {"joints[1].points[0][0]", "joints[2].points[0][0]", "bodies[2].mass",
@@ -265,14 +257,7 @@ TEST(Adjoint, PendulumIntegralEqualsForwardGradient) {
   // A bob on a massless length L = 0.8 m released at 0.3 rad (tests/test_sensitivities.cpp):
   // one constraint pair, so the adjoint multipliers and their terminal values take part.
   // int theta^2 over 2 s with respect to L, the bob's inertia, the release angle.
-  json j = json::parse(R"({
-    "name": "pendulum", "gravity": [0.0, -9.81],
-    "bodies": [{"name": "bob", "type": "rigid", "mass": 1.0, "inertia": 1e-3, "com": [0.0, 0.0],
-                "position": [0.0, 0.0], "angle": 0.3}],
-    "joints": [{"name": "pivot", "type": "revolute", "bodies": ["ground", "bob"], "points": [[0.0, 0.0], [0.0, 0.8]]}],
-    "solver": {"rtol": 1e-11, "atol": 1e-13, "t_end": 2.0, "output_step": 0.05}
-  })");
-  j["bodies"][0]["position"] = {0.8 * std::sin(0.3), -0.8 * std::cos(0.3)};
+  const json j = pendulum();
   // Both integrated at rtol 1e-11 over ~1 period: their global errors ~1e-9 of the
   // gradient; Simpson at h = 5e-4 s (omega = 3.5 rad/s) adds 1e-13. 1e-7 holds both.
   const double kTolerance = 1e-7;

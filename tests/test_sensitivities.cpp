@@ -80,20 +80,6 @@ TEST(Sensitivities, SpringMassDamperMatchesClosedFormDerivatives) {
 
 // ----- (b) a rigid pendulum: central differences of whole runs --------------------------
 
-/// A bob of 1 kg (small inertia) on a massless length L = 0.8 m from a pivot at the origin,
-/// released at 0.3 rad: joints[0].points[1][1] is L (the pivot in the bob's frame).
-json pendulum() {
-  const double L = 0.8, th = 0.3;
-  json j = json::parse(R"({
-    "name": "pendulum", "gravity": [0.0, -9.81],
-    "bodies": [{"name": "bob", "type": "rigid", "mass": 1.0, "inertia": 1e-3, "com": [0.0, 0.0],
-                "position": [0.0, 0.0], "angle": 0.3}],
-    "joints": [{"name": "pivot", "type": "revolute", "bodies": ["ground", "bob"], "points": [[0.0, 0.0], [0.0, 0.8]]}],
-    "solver": {"rtol": 1e-11, "atol": 1e-13, "t_end": 2.0, "output_step": 0.05}
-  })");
-  j["bodies"][0]["position"] = {L * std::sin(th), -L * std::cos(th)};
-  return j;
-}
 
 TEST(Sensitivities, PendulumAngleByLengthMatchesWholeRuns) {
   const json scene = pendulum();
