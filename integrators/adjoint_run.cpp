@@ -298,10 +298,11 @@ TerminalAdjoint terminalAdjoint(const DaeSystem& dae, double t, const VecX& y, c
 
 namespace {
 
-/// The tolerances of the adjoint of an output of value G (docs/sensitivities.md): M lambda_v
-/// = dG/dv(t) and lambda_q = dG/dq(t) (the output's derivative with respect to the state at
-/// t) are held to rtol |G| over the state's scale, y_scale = atol_j rtol-free scale of the
-/// run's own tolerances (atol_j / rtol); the adjoint multipliers like lambda_q.
+/// The absolute tolerances of the adjoint of an output of size G (docs/sensitivities.md):
+/// lambda_q = dG/dq(t) and M lambda_v = dG/dv(t) (the output's derivative with respect to
+/// the state at t) are held to rtol |G| over the state's scale of each entry, atol_j / rtol
+/// (the run's own tolerances), velocities' over the mass diagonal too; the adjoint
+/// multipliers (out of the error test) likewise.
 VecX adjointTolerances(const DaeLayout& L, const VecX& atol, double rtol, const MatX& E, double value) {
   const double g = std::max(std::fabs(value), std::numeric_limits<double>::min() / rtol);
   VecX out(atol.size());
@@ -313,10 +314,6 @@ VecX adjointTolerances(const DaeLayout& L, const VecX& atol, double rtol, const 
   }
   return out;
 }
-
-}  // namespace
-
-namespace {
 
 /// Memory of one recording: IDAS keeps one vector of the DAE's size per step.
 constexpr double kRecordingBytes = 512.0 * 1024 * 1024;
@@ -363,8 +360,8 @@ std::string algebraicAdjointWarning(const System& sys, const DaeSystem& dae, con
 }
 
 /// Stage "record again": the run from t0 once more, as one recording whose store holds
-/// twice the steps the run took (up to kRecordingBytes; four times more if it took more
-/// still). Only the first checkpoint's interval is recomputed exactly by IDAS (a restored
+/// twice the steps the run took (four times more if it took more still), up to
+/// kRecordingBytes. Only the first checkpoint's interval is recomputed exactly by IDAS (a restored
 /// later checkpoint takes a fresh Jacobian where the first pass had an older one, and IDAS
 /// 6.4 overran its step store when that took more steps: SUNDIALS issue 49). Recording the
 /// backward pass in segments from the run's outputs was tried: a recording restarted mid-run
@@ -373,16 +370,17 @@ std::string algebraicAdjointWarning(const System& sys, const DaeSystem& dae, con
 std::unique_ptr<IdaSolver> recordAgain(const DaeSystem& dae, const IntegratorOptions& options, SystemIntegrals& integrals,
                                        const RunStart& start, double t0, double tEnd, long runSteps) {
   const long limit = recordingSteps(dae);
-  for (long store = 2 * runSteps + kRecordingExtraSteps;; store *= 4) {
-    if (store > limit) {
+  for (long store = std::min(limit, 2 * runSteps + kRecordingExtraSteps);; store = std::min(limit, 4 * store)) {
+    auto recording = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, options, integrals, store);
+    recording->advance(tEnd, tEnd);
+    if (recording->checkpoints() <= 1) return recording;
+    if (store >= limit) {
       throw SolverError("adjoint: the run's " + std::to_string(runSteps) + " steps of " + std::to_string(dae.size()) +
-                            " unknowns need more than the " + std::to_string(static_cast<long>(kRecordingBytes / 1048576)) +
+                            " unknowns need more than the " +
+                            std::to_string(static_cast<long>(kRecordingBytes / 1048576)) +
                             " MiB one recording may take: shorten the run (t_end) or loosen rtol",
                         t0, 0.0);
     }
-    auto recording = std::make_unique<IdaSolver>(dae, t0, start.y0, start.yp0, options, integrals, std::min(store, limit));
-    recording->advance(tEnd, tEnd);
-    if (recording->checkpoints() <= 1) return recording;
   }
 }
 
