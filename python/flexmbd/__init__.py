@@ -238,8 +238,9 @@ class Scene:
         values (``summary["sensitivities"]``). Needs a scene read from a file or a dict
         (load_scene, scene_from_dict): each parameter's scene is read again a step away.
 
-        ``adjoint``: integral outputs "KIND:COLUMN" (KIND "integral" or "integral_square" of
-        a coordinate, velocity or scene output column) whose gradients with respect to the
+        ``adjoint``: outputs "KIND:COLUMN" (KIND "integral", "integral_square", "final" or
+        "ks" as "ks:COLUMN:RHO", of a coordinate, velocity or scene output column,
+        docs/sensitivities.md) whose gradients with respect to the
         ``sensitivities`` parameters the adjoint method gives instead of the derivative
         columns: one backward integration per output, whatever the number of parameters
         (``summary["sensitivities"]["integrals"][OUTPUT]`` holds "value" and "gradient";
