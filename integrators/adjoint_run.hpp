@@ -70,6 +70,9 @@ struct TerminalAdjoint {
   VecX lambda, rate;  ///< lambda(T), lambda'(T)
   VecX nu;            ///< size n, zero on q and v: the constraint rows' weights
 };
+/// @param dae the run's DAE (GGL layout)
+/// @param t the time T
+/// @param y, yp the forward solution at T
 /// @param cy the output's gradient in y at T (zero on the multipliers)
 TerminalAdjoint terminalAdjoint(const DaeSystem& dae, double t, const VecX& y, const VecX& yp, const VecX& cy);
 
