@@ -239,12 +239,16 @@ std::vector<ParameterModeDerivatives> modeSensitivities(const SensitivityScenes&
   for (std::size_t i = 0; i < scenes.parameters.size(); ++i) {
     const SensitivityParameter& p = scenes.parameters[i];
     try {
-      const LinearizedSystem plus = linearize(scenes.plus[i]->system, initialReference(*scenes.plus[i], steady));
-      const LinearizedSystem minus = linearize(scenes.minus[i]->system, initialReference(*scenes.minus[i], steady));
-      out.push_back({p.name, modeDerivatives(lin, red, modes, plus, minus, p.step)});
+      std::array<LinearizedSystem, kStencilPoints> perturbed;
+      for (std::size_t j = 0; j < kStencilPoints; ++j) {
+        const Scene& s = *scenes.perturbed[i][j];
+        perturbed[j] = linearize(s.system, initialReference(s, steady));
+      }
+      out.push_back({p.name, modeDerivatives(lin, red, modes, perturbed, p.step)});
     } catch (const InputError& e) {
       throw InputError("sensitivity parameter '" + p.name + "': the model at " + p.name + " = " + fmt(p.value) +
-                       " +- " + fmt(p.step) + " (the steps of the central difference): " + e.what());
+                       " +- " + fmt(p.step) + " or +- " + fmt(2.0 * p.step) +
+                       " (the steps of the five-point difference): " + e.what());
     }
   }
   return out;
@@ -462,7 +466,7 @@ int runModesCommand(const std::vector<std::string>& args) {
   ModesCommandOptions o;
   nlohmann::json base;
   std::optional<Scene> scene;
-  std::optional<SensitivityScenes> sensitivities;  // --sensitivity: the scenes at p +- h
+  std::optional<SensitivityScenes> sensitivities;  // --sensitivity: the scenes at p +- h, p +- 2 h
   try {
     o = parseOptions(args);
     const std::string text = readText(o.scenePath);
@@ -472,8 +476,8 @@ int runModesCommand(const std::vector<std::string>& args) {
       sensitivities.emplace(buildSensitivityScenes(text, o.scenePath, *scene, o.sensitivities));
       const DaeSystem dae(scene->system, Formulation::Ggl);
       for (std::size_t i = 0; i < sensitivities->parameters.size(); ++i) {
-        for (const auto* perturbed : {&sensitivities->plus[i]->system, &sensitivities->minus[i]->system}) {
-          requireSameStructure(dae, DaeSystem(*perturbed, Formulation::Ggl), sensitivities->parameters[i].name);
+        for (const auto& perturbed : sensitivities->perturbed[i]) {
+          requireSameStructure(dae, DaeSystem(perturbed->system, Formulation::Ggl), sensitivities->parameters[i].name);
         }
       }
     }

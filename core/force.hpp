@@ -50,6 +50,10 @@ class Force {
   /// True if the force is the negative gradient of potentialEnergy (no damping, no
   /// prescribed loads): then the total energy of an undriven model is conserved.
   virtual bool isConservative() const = 0;
+  /// True if Q depends on time explicitly (a prescribed load, a user law of t); false for
+  /// a force of the state only, which a sensitivity run leaves out of dF/dp where its terms
+  /// do not change with the parameter (ResidualDifferences).
+  virtual bool dependsOnTime() const { return true; }
 
  private:
   std::string name_;

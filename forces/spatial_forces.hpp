@@ -46,6 +46,7 @@ class SpatialSpringDamper final : public Force {
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0 && !law_; }
+  bool dependsOnTime() const override { return law_ != nullptr; }
   /// The current length l.
   double length(const BodyStates& bodies) const;
 
@@ -74,6 +75,7 @@ class SpatialRotationalSpringDamper final : public Force {
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0 && !law_; }
+  bool dependsOnTime() const override { return law_ != nullptr; }
 
  private:
   JointFrame frameI_, frameJ_;
@@ -100,6 +102,7 @@ class SpatialBushing final : public Force {
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override;
+  bool dependsOnTime() const override { return false; }
 
  private:
   /// c_k with its gradient into `grad` and, if H, its d(grad^T)/dq into *H (work rows used).

@@ -22,6 +22,7 @@ class SpringDamper final : public Force {
   using Force::addForce;
   double potentialEnergy(const BodyStates& bodies) const override;
   bool isConservative() const override { return damping_ == 0.0 && !law_; }
+  bool dependsOnTime() const override { return law_ != nullptr; }
   std::vector<Attachment> attachments() const override {
     return {{bodies()[0], lift(pointI_)}, {bodies()[1], lift(pointJ_)}};
   }

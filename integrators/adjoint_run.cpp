@@ -69,9 +69,11 @@ class SystemIntegrals final : public IntegralOutputs {
     const auto K = static_cast<std::size_t>(k), I = static_cast<std::size_t>(i);
     if (!explicitParameters_[K][I]) return 0.0;
     unpack(y);
-    const double plus = outputs_[K].integrand(*params_[I].plus, t, q_, v_);
-    const double minus = outputs_[K].integrand(*params_[I].minus, t, q_, v_);
-    return (plus - minus) / (2.0 * params_[I].step);  // central difference, Nocedal & Wright 2006, sec. 8.1
+    const SensitivityParameter& p = params_[I];
+    // five-point difference (Abramowitz & Stegun 1964, eq. 25.3.6), as dF/dp
+    return stencilDerivative<double>(p.step, [&](int j) {
+      return outputs_[K].integrand(*p.systems[static_cast<std::size_t>(j)], t, q_, v_);
+    });
   }
 
   /// dc/dy of output k's integrand (its value for a terminal output) at (t, y) into gy.
@@ -114,8 +116,12 @@ class SystemIntegrals final : public IntegralOutputs {
     q_ = Eigen::Map<const VecX>(y + L.q, L.nq);
     v_ = Eigen::Map<const VecX>(y + L.v, L.nv);
   }
-  /// The step of entry j of y: eps^(1/3) max(|y_j|, 1) (as parameterStep).
-  static double stepOf(double value) { return parameterStep(value); }
+  /// The step of entry j of y: eps^(1/3) max(|y_j|, 1) (three-point difference).
+  static double stepOf(double value) {
+    const double h = kCentralDifferenceFraction * std::max(std::fabs(value), 1.0);
+    const volatile double shifted = value + h;  // the step actually taken (Press et al. 2007, sec. 5.7)
+    return shifted - value;
+  }
   /// dg_k/dy_j by a central difference at the unpacked state (restored after).
   double difference(int k, double t, int j) {
     const DaeLayout& L = dae_.layout();
@@ -160,7 +166,9 @@ class SystemIntegrals final : public IntegralOutputs {
       for (std::size_t i = 0; i < params_.size(); ++i) {
         for (const VecX& y : states) {
           unpack(y.data());
-          if (!(g(*params_[i].plus, t0, q_, v_) == g(*params_[i].minus, t0, q_, v_))) explicitParameters_[k][i] = 1;
+          if (!(g(*params_[i].systems[0], t0, q_, v_) == g(*params_[i].systems[1], t0, q_, v_))) {
+            explicitParameters_[k][i] = 1;
+          }
         }
       }
     }
@@ -405,7 +413,7 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
   const ConsistentState& init = begin.init;
   const DaeSystem& dae = *begin.dae;
   const PerturbedDaes& perturbed = begin.perturbed;
-  const InitialSensitivities s0 = initialSensitivities(dae, perturbed.pairs, init, t0);
+  const InitialSensitivities s0 = initialSensitivities(dae, perturbed.stencils, init, t0);
   const RunStart start = startRun(dae, init, t0);
 
   AdjointSummary out;
@@ -420,7 +428,7 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
 
   // forward: the run, with the outputs' integrals, recorded for the backward pass on the
   // way (one checkpoint: IDAS's recomputation repeats this pass exactly)
-  ResidualDifferences derivatives(perturbed.pairs, t0, start.y0, start.yp0);
+  ResidualDifferences derivatives(perturbed.stencils, t0, start.y0, start.yp0);
   SystemIntegrals integrals(dae, params, outputs, derivatives, t0, start.y0);
   RunState state;
   state.kind = IntegratorKind::Ida;

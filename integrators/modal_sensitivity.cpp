@@ -36,22 +36,25 @@ CVec nullVector(const Eigen::PartialPivLU<CMat>& lu, Eigen::Index n) {
 }  // namespace
 
 std::vector<ModeDerivative> modeDerivatives(const LinearizedSystem& lin, const ReducedSystem& red,
-                                            const std::vector<Mode>& modes, const LinearizedSystem& plus,
-                                            const LinearizedSystem& minus, double h) {
-  for (const LinearizedSystem* p : {&plus, &minus}) {
-    if (p->M.rows() != lin.M.rows() || p->G.rows() != lin.G.rows()) {
-      throw InputError("eigenvalue sensitivity: the perturbed model has " + std::to_string(p->M.rows()) +
-                       " velocities and " + std::to_string(p->G.rows()) + " constraint equations, the model " +
+                                            const std::vector<Mode>& modes,
+                                            const std::array<LinearizedSystem, kStencilPoints>& perturbed, double h) {
+  for (const LinearizedSystem& p : perturbed) {
+    if (p.M.rows() != lin.M.rows() || p.G.rows() != lin.G.rows()) {
+      throw InputError("eigenvalue sensitivity: the perturbed model has " + std::to_string(p.M.rows()) +
+                       " velocities and " + std::to_string(p.G.rows()) + " constraint equations, the model " +
                        std::to_string(lin.M.rows()) + " and " + std::to_string(lin.G.rows()));
     }
   }
-  // the reduced matrices at p +- h in the base's basis moved onto their null spaces
+  // the reduced matrices at p + o_j h in the base's basis moved onto their null spaces
   const std::vector<int> dep = dependentVelocities(lin);
-  const ReducedSystem rp = reduceNear(plus, red.N, dep), rm = reduceNear(minus, red.N, dep);
-  // central differences: error h^2 |d3K/dp3| / 6 + eps |K| / h (docs/modes.md)
-  const MatX dM = (MatX(rp.M) - MatX(rm.M)) / (2.0 * h);
-  const MatX dC = (MatX(rp.C) - MatX(rm.C)) / (2.0 * h);
-  const MatX dK = (MatX(rp.K) - MatX(rm.K)) / (2.0 * h);
+  std::array<ReducedSystem, kStencilPoints> r;
+  for (std::size_t j = 0; j < kStencilPoints; ++j) r[j] = reduceNear(perturbed[j], red.N, dep);
+  // five-point differences (Abramowitz & Stegun 1964, eq. 25.3.6): error h^4 |d5K/dp5| / 30
+  // + 0.95 eps |K| / h (docs/modes.md)
+  const auto at = [&](int j) -> const ReducedSystem& { return r[static_cast<std::size_t>(j)]; };
+  const MatX dM = stencilDerivative<MatX>(h, [&](int j) { return MatX(at(j).M); });
+  const MatX dC = stencilDerivative<MatX>(h, [&](int j) { return MatX(at(j).C); });
+  const MatX dK = stencilDerivative<MatX>(h, [&](int j) { return MatX(at(j).K); });
   const CMat M = MatX(red.M).cast<std::complex<double>>(), C = MatX(red.C).cast<std::complex<double>>(),
              K = MatX(red.K).cast<std::complex<double>>();
   const Eigen::Index n = M.rows();

@@ -9,10 +9,12 @@
 /// eigenvectors).
 #pragma once
 
+#include <array>
 #include <complex>
 #include <vector>
 
 #include "integrators/linearization.hpp"
+#include "integrators/sensitivity_problem.hpp"
 
 namespace flexmbd {
 
@@ -37,15 +39,15 @@ inline constexpr double kRepeatedEigenvalueFraction = 1e-6;
 ///
 /// (the derivative of w^T Q(s(p), p) x = 0; for undamped symmetric modes w = x, s = i omega
 /// and it is the Rayleigh quotient's d(omega^2)/dp = x^T (dK/dp - omega^2 dM/dp) x / x^T M x).
-/// dMr/dp, dCr/dp, dKr/dp: central differences of the reduced matrices of `plus` and
-/// `minus` (the linearisations at p + h and p - h, each about its own reference state), in
-/// red.N moved onto their null spaces (reduceNear, with the base's dependent velocities),
-/// error O(h^2) + eps |K| / h. A zero eigenvalue (a rigid-body mode) has derivative 0; an
+/// dMr/dp, dCr/dp, dKr/dp: five-point differences (stencilDerivative) of the reduced
+/// matrices of `perturbed` (the linearisations at p + kStencilOffsets[j] h, each about its
+/// own reference state), in red.N moved onto their null spaces (reduceNear, with the base's
+/// dependent velocities), error O(h^4) + eps |K| / h. A zero eigenvalue (a rigid-body mode) has derivative 0; an
 /// eigenvalue within kRepeatedEigenvalueFraction of another of `modes` is not
 /// differentiable (defined false).
-/// @throws InputError if plus or minus has another number of velocities or constraints.
+/// @throws InputError if a perturbed model has another number of velocities or constraints.
 std::vector<ModeDerivative> modeDerivatives(const LinearizedSystem& lin, const ReducedSystem& red,
-                                            const std::vector<Mode>& modes, const LinearizedSystem& plus,
-                                            const LinearizedSystem& minus, double h);
+                                            const std::vector<Mode>& modes,
+                                            const std::array<LinearizedSystem, kStencilPoints>& perturbed, double h);
 
 }  // namespace flexmbd

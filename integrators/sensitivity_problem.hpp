@@ -4,6 +4,7 @@
 /// sensitivities and how the sensitivities enter the error test.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include "core/sparse_pattern.hpp"
@@ -14,6 +15,23 @@ namespace flexmbd {
 /// Relative step of the engine's central differences: eps^(1/3) balances their truncation
 /// error h^2 |f^(3)| / 6 against the round-off eps |f| / h (Nocedal & Wright 2006, sec. 8.1).
 inline const double kCentralDifferenceFraction = std::cbrt(2.220446049250313e-16);
+
+/// The five-point central difference of the parameter derivatives (fourth order,
+/// Abramowitz & Stegun 1964, eq. 25.3.6): f'(p) = sum_j w_j f(p + o_j h) / h + h^4 f^(5) / 30,
+/// with round-off sqrt(2 (8^2 + 1)) / 12 eps |f| / h = 0.95 eps |f| / h. Its points o_j h:
+inline constexpr int kStencilPoints = 4;
+inline constexpr std::array<double, kStencilPoints> kStencilOffsets{1.0, -1.0, 2.0, -2.0};
+/// and weights w_j (the same order).
+inline constexpr std::array<double, kStencilPoints> kStencilWeights{8.0 / 12.0, -8.0 / 12.0, -1.0 / 12.0, 1.0 / 12.0};
+
+/// sum_j w_j f_j / h for the values f_j = at(j) at the stencil's points (a number or an
+/// Eigen vector or matrix; those allocate).
+template <class Value, class At>
+Value stencilDerivative(double h, At&& at) {
+  Value d = (kStencilWeights[0] / h) * at(0);
+  for (int j = 1; j < kStencilPoints; ++j) d += (kStencilWeights[static_cast<std::size_t>(j)] / h) * at(j);
+  return d;
+}
 
 /// r += A x for A in CSC values on `pattern` (the sensitivity residual's F_y s, the
 /// projection of the initial sensitivities). Allocates nothing.

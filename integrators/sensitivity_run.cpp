@@ -1,8 +1,10 @@
 #include "integrators/sensitivity_run.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <exception>
+#include <limits>
 
 #include <Eigen/QR>
 
@@ -17,7 +19,7 @@
 namespace flexmbd {
 
 double parameterStep(double p, double typical) {
-  const double h = kCentralDifferenceFraction * std::max(std::fabs(p), typical);
+  const double h = kParameterStepFraction * (p != 0.0 ? std::fabs(p) : typical);
   // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, sec. 5.7)
   const volatile double shifted = p + h;
   return shifted - p;
@@ -30,38 +32,91 @@ MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize,
   return out;
 }
 
-// ----- dF/dp by central differences of the perturbed residuals ------------------------
+// ----- dF/dp by five-point differences of the perturbed residuals ---------------------
 
 namespace {
 
-/// The bodies whose residual terms differ between the systems of `p` at one of the test
-/// states; all forces and constraints (they may depend on time, so agreeing at a test time
-/// proves nothing).
-ResidualParts differingParts(const ResidualDifferences::Pair& p, double t0, const std::vector<VecX>& ys,
-                             const std::vector<VecX>& yps, DaeScratch& plusScratch, DaeScratch& minusScratch) {
-  const System& sys = p.plus->system();
-  ResidualParts parts = ResidualParts::none(sys);
-  std::fill(parts.forces.begin(), parts.forces.end(), 1);
-  std::fill(parts.constraints.begin(), parts.constraints.end(), 1);
-  ResidualParts one = ResidualParts::none(sys);
-  VecX Fplus(p.plus->size()), Fminus(p.plus->size());
-  for (int b = 0; b < sys.numBodies(); ++b) {
-    one.bodies[static_cast<std::size_t>(b)] = 1;
-    for (std::size_t k = 0; k < ys.size() && !parts.bodies[static_cast<std::size_t>(b)]; ++k) {
-      p.plus->residualOfParts(t0, ys[k].data(), yps[k].data(), Fplus.data(), one, plusScratch);
-      p.minus->residualOfParts(t0, ys[k].data(), yps[k].data(), Fminus.data(), one, minusScratch);
-      // bit-identical terms (NaN never compares equal: such a body is kept)
-      if (!(Fplus.array() == Fminus.array()).all()) parts.bodies[static_cast<std::size_t>(b)] = 1;
+bool any(const ResidualParts& p) {
+  const auto set = [](const std::vector<char>& v) { return std::find(v.begin(), v.end(), 1) != v.end(); };
+  return set(p.bodies) || set(p.forces) || set(p.constraints);
+}
+
+/// Which terms of the systems of `p` can differ (ResidualDifferences): those of time, and
+/// those of the state whose terms differ between the systems at p + h and p - h at one of
+/// the test states; and whether the latter are linear in p there.
+ResidualDifferences::Split splitParts(const ResidualDifferences::Stencil& p, double t0, const std::vector<VecX>& ys,
+                                      const std::vector<VecX>& yps,
+                                      const std::array<std::unique_ptr<DaeScratch>, kStencilPoints>& scratch) {
+  const System& sys = p.daes[0]->system();
+  const auto n = static_cast<Eigen::Index>(p.daes[0]->size());
+  std::array<VecX, kStencilPoints> F;
+  for (VecX& f : F) f = VecX(n);
+  const auto evaluate = [&](const ResidualParts& parts, const VecX& y, const VecX& yp, int points) {
+    for (int j = 0; j < points; ++j) {
+      const auto J = static_cast<std::size_t>(j);
+      p.daes[J]->residualOfParts(t0, y.data(), yp.data(), F[J].data(), parts, *scratch[J]);
     }
-    one.bodies[static_cast<std::size_t>(b)] = 0;
+  };
+  // the terms of the state that differ (bit-identical terms cancel; NaN never compares equal: kept)
+  ResidualParts time = ResidualParts::none(sys), state = ResidualParts::none(sys);
+  const auto differs = [&](const ResidualParts& one) {
+    for (std::size_t k = 0; k < ys.size(); ++k) {
+      evaluate(one, ys[k], yps[k], 2);
+      if (!(F[0].array() == F[1].array()).all()) return true;
+    }
+    return false;
+  };
+  ResidualParts one = ResidualParts::none(sys);
+  const auto classify = [&](std::vector<char>& flag, std::vector<char>& timeFlag, std::vector<char>& stateFlag,
+                            std::size_t k, bool ofTime) {
+    if (ofTime) {
+      timeFlag[k] = 1;
+      return;
+    }
+    flag[k] = 1;
+    if (differs(one)) stateFlag[k] = 1;
+    flag[k] = 0;
+  };
+  for (int b = 0; b < sys.numBodies(); ++b) {
+    classify(one.bodies, time.bodies, state.bodies, static_cast<std::size_t>(b), false);
   }
-  return parts;
+  for (int c = 0; c < sys.numConstraints(); ++c) {
+    classify(one.constraints, time.constraints, state.constraints, static_cast<std::size_t>(c),
+             sys.constraintIsDriver(ConstraintIndex(c)));
+  }
+  for (int f = 0; f < sys.numForces(); ++f) {
+    classify(one.forces, time.forces, state.forces, static_cast<std::size_t>(f), sys.force(ForceIndex(f)).dependsOnTime());
+  }
+  // linear in p: the two-point differences at p +- h and p +- 2 h agree to their round-off
+  // on every row at every test state
+  bool linear = any(state);
+  const double h = p.step, kRoundOffs = 8.0 * std::numeric_limits<double>::epsilon();
+  for (std::size_t k = 0; k < ys.size() && linear; ++k) {
+    evaluate(state, ys[k], yps[k], kStencilPoints);
+    for (Eigen::Index r = 0; r < n && linear; ++r) {
+      const double inner = (F[0][r] - F[1][r]) / (2.0 * h), outer = (F[2][r] - F[3][r]) / (4.0 * h);
+      const double size = std::fabs(F[0][r]) + std::fabs(F[1][r]) + std::fabs(F[2][r]) + std::fabs(F[3][r]);
+      linear = std::fabs(inner - outer) <= kRoundOffs * size / h;  // false for NaN
+    }
+  }
+  ResidualDifferences::Split out;
+  out.all = ResidualParts::none(sys);
+  for (const auto member : {&ResidualParts::bodies, &ResidualParts::forces, &ResidualParts::constraints}) {
+    for (std::size_t k = 0; k < (out.all.*member).size(); ++k) {
+      (out.all.*member)[k] = static_cast<char>((time.*member)[k] || (state.*member)[k]);
+    }
+  }
+  out.stencil = linear ? time : out.all;
+  out.pair = linear ? state : ResidualParts::none(sys);
+  out.anyStencil = any(out.stencil);
+  out.anyPair = any(out.pair);
+  return out;
 }
 
 }  // namespace
 
-ResidualDifferences::ResidualDifferences(std::vector<Pair> pairs, double t0, const VecX& y0, const VecX& yp0)
-    : pairs_(std::move(pairs)) {
+ResidualDifferences::ResidualDifferences(std::vector<Stencil> stencils, double t0, const VecX& y0, const VecX& yp0)
+    : stencils_(std::move(stencils)) {
   // the test states: the initial one and every entry moved by a deterministic, irregular
   // fraction of its size (a generic state: no velocity or elastic coordinate left at zero)
   std::vector<VecX> ys{y0}, yps{yp0};
@@ -72,24 +127,32 @@ ResidualDifferences::ResidualDifferences(std::vector<Pair> pairs, double t0, con
     ys[1][k] += 1e-2 * a * (1.0 + std::fabs(y0[k]));
     yps[1][k] += 1e-2 * (0.5 - a) * (1.0 + std::fabs(yp0[k]));
   }
-  for (const Pair& p : pairs_) {
-    plusScratch_.push_back(p.plus->makeScratch());
-    minusScratch_.push_back(p.minus->makeScratch());
-    parts_.push_back(differingParts(p, t0, ys, yps, *plusScratch_.back(), *minusScratch_.back()));
+  for (const Stencil& p : stencils_) {
+    std::array<std::unique_ptr<DaeScratch>, kStencilPoints> scratch;
+    for (std::size_t j = 0; j < kStencilPoints; ++j) scratch[j] = p.daes[j]->makeScratch();
+    parts_.push_back(splitParts(p, t0, ys, yps, scratch));
+    scratch_.push_back(std::move(scratch));
   }
-  if (!pairs_.empty()) minusResidual_ = VecX::Zero(pairs_.front().plus->size());
+  if (!stencils_.empty()) term_ = VecX::Zero(stencils_.front().daes[0]->size());
 }
 
 void ResidualDifferences::residualDerivative(int i, double t, const double* y, const double* yp, double* dFdp) {
   const auto k = static_cast<std::size_t>(i);
-  const Pair& p = pairs_[k];
-  // the terms of the parts that differ; the others cancel exactly in the difference
-  p.plus->residualOfParts(t, y, yp, dFdp, parts_[k], *plusScratch_[k]);
-  p.minus->residualOfParts(t, y, yp, minusResidual_.data(), parts_[k], *minusScratch_[k]);
-  const auto n = minusResidual_.size();
-  // dF/dp = (F(p + h) - F(p - h)) / (2 h) + O(h^2) (central difference, Nocedal & Wright 2006, sec. 8.1)
-  Eigen::Map<VecX> d(dFdp, n);
-  d = (d - minusResidual_) / (2.0 * p.step);
+  const Stencil& p = stencils_[k];
+  const Split& parts = parts_[k];
+  Eigen::Map<VecX> d(dFdp, term_.size());
+  d.setZero();
+  // the terms that differ (the others cancel exactly in the differences):
+  // sum_j w_j F(p + o_j h) / h + O(h^4) (five-point difference, Abramowitz & Stegun 1964, eq. 25.3.6)
+  for (std::size_t j = 0; j < kStencilPoints && parts.anyStencil; ++j) {
+    p.daes[j]->residualOfParts(t, y, yp, term_.data(), parts.stencil, *scratch_[k][j]);
+    d += (kStencilWeights[j] / p.step) * term_;
+  }
+  // and the terms linear in p: (F(p + 2h) - F(p - 2h)) / (4 h), exact for them
+  for (std::size_t j = 2; j < kStencilPoints && parts.anyPair; ++j) {
+    p.daes[j]->residualOfParts(t, y, yp, term_.data(), parts.pair, *scratch_[k][j]);
+    d += ((kStencilOffsets[j] > 0.0 ? 1.0 : -1.0) / (4.0 * p.step)) * term_;  // the points p + 2h, p - 2h
+  }
 }
 
 // ----- structure and initial sensitivities ------------------------------------------
@@ -116,26 +179,28 @@ void requireSameStructure(const DaeSystem& base, const DaeSystem& perturbed, con
   }
 }
 
-InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
+InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vector<ResidualDifferences::Stencil>& stencils,
                                           const ConsistentState& init, double t0) {
   const int n = base.size();
-  InitialSensitivities s{MatX::Zero(n, static_cast<Eigen::Index>(pairs.size())),
-                         MatX::Zero(n, static_cast<Eigen::Index>(pairs.size()))};
+  InitialSensitivities s{MatX::Zero(n, static_cast<Eigen::Index>(stencils.size())),
+                         MatX::Zero(n, static_cast<Eigen::Index>(stencils.size()))};
   const ReleasedEquations released{false, init.released};
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    VecX yPlus, ypPlus, yMinus, ypMinus;
-    for (const auto& [dae, y, yp] : {std::tuple{pairs[i].plus, &yPlus, &ypPlus}, std::tuple{pairs[i].minus, &yMinus, &ypMinus}}) {
-      const System& sys = dae->system();
+  for (std::size_t i = 0; i < stencils.size(); ++i) {
+    std::array<VecX, kStencilPoints> y, yp;
+    for (std::size_t j = 0; j < kStencilPoints; ++j) {
+      const DaeSystem& dae = *stencils[i].daes[j];
+      const System& sys = dae.system();
       // the perturbed system's own consistent state from its own initial values (q0(p), v0(p))
       const ConsistentState c = computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
-      dae->packState(c.q, c.v, c.a, c.lambda, *y, *yp);
+      dae.packState(c.q, c.v, c.a, c.lambda, y[j], yp[j]);
     }
-    // s0 = dy0/dp, s0' = dy0'/dp: central differences (Nocedal & Wright 2006, sec. 8.1) of the
-    // consistent initialisation (docs/sensitivities.md, "Consistent initial sensitivities")
-    s.s0.col(static_cast<Eigen::Index>(i)) = (yPlus - yMinus) / (2.0 * pairs[i].step);
-    s.sp0.col(static_cast<Eigen::Index>(i)) = (ypPlus - ypMinus) / (2.0 * pairs[i].step);
+    // s0 = dy0/dp, s0' = dy0'/dp: five-point differences (Abramowitz & Stegun 1964, eq. 25.3.6)
+    // of the consistent initialisation (docs/sensitivities.md, "Consistent initial sensitivities")
+    const double h = stencils[i].step;
+    s.s0.col(static_cast<Eigen::Index>(i)) = stencilDerivative<VecX>(h, [&](int j) { return y[static_cast<std::size_t>(j)]; });
+    s.sp0.col(static_cast<Eigen::Index>(i)) = stencilDerivative<VecX>(h, [&](int j) { return yp[static_cast<std::size_t>(j)]; });
   }
-  projectOntoConstraints(base, pairs, init, t0, s.s0);
+  projectOntoConstraints(base, stencils, init, t0, s.s0);
   return s;
 }
 
@@ -155,7 +220,7 @@ MatX denseBlock(const SparsePattern& p, const std::vector<double>& values, int r
 
 }  // namespace
 
-void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDifferences::Pair>& pairs,
+void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDifferences::Stencil>& stencils,
                             const ConsistentState& init, double t0, MatX& s0) {
   if (base.formulation() == Formulation::Index1) return;  // no position-level rows
   const DaeLayout& L = base.layout();
@@ -171,16 +236,18 @@ void projectOntoConstraints(const DaeSystem& base, const std::vector<ResidualDif
   const Eigen::CompleteOrthogonalDecomposition<MatX> Gq(denseBlock(P, J0, L.lambda, L.m, L.q, L.nq));
   const bool ggl = L.mu >= 0;
   const Eigen::CompleteOrthogonalDecomposition<MatX> Gv(ggl ? denseBlock(P, J0, L.mu, L.m, L.v, L.nv) : MatX());
-  VecX Fplus(L.size), Fminus(L.size), r(L.size);
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
+  VecX F(L.size), r(L.size);
+  for (std::size_t i = 0; i < stencils.size(); ++i) {
     auto col = s0.col(static_cast<Eigen::Index>(i));
     // dF/dp at the base state: the constraint rows of F_y s + F_p, which must vanish
-    pairs[i].plus->residual(t0, y.data(), yp.data(), Fplus.data());
-    pairs[i].minus->residual(t0, y.data(), yp.data(), Fminus.data());
+    const VecX dFdp = stencilDerivative<VecX>(stencils[i].step, [&](int j) {
+      stencils[i].daes[static_cast<std::size_t>(j)]->residual(t0, y.data(), yp.data(), F.data());
+      return F;
+    });
     const auto residualOfRows = [&](int row0) {
       r.setZero();
       addPatternProduct(P, J0.data(), col.data(), r.data());
-      return VecX(r.segment(row0, L.m) + (Fplus - Fminus).segment(row0, L.m) / (2.0 * pairs[i].step));
+      return VecX(r.segment(row0, L.m) + dFdp.segment(row0, L.m));
     };
     // G s_q + g_p = 0 (positions), then d/dp (G v + g_t) = 0 (velocities) with the new s_q
     col.segment(L.q, L.nq) -= Gq.solve(residualOfRows(L.lambda));
@@ -216,11 +283,13 @@ SensitivitySample sensitivitySample(const DaeLayout& L, const MatX& S, const std
   out.v = S.middleRows(L.v, L.nv);
   for (std::size_t i = 0; i < params.size(); ++i) {
     const auto c = static_cast<Eigen::Index>(i);
-    const double h = params[i].step;
-    out.perturbed.push_back({perturbedSample(*params[i].plus, base.t, base.q + h * out.q.col(c),
-                                             base.v + h * out.v.col(c), released),
-                             perturbedSample(*params[i].minus, base.t, base.q - h * out.q.col(c),
-                                             base.v - h * out.v.col(c), released)});
+    PerturbedSamples samples;
+    for (std::size_t j = 0; j < kStencilPoints; ++j) {
+      const double e = kStencilOffsets[j] * params[i].step;
+      samples.at[j] = perturbedSample(*params[i].systems[j], base.t, base.q + e * out.q.col(c), base.v + e * out.v.col(c),
+                                      released);
+    }
+    out.perturbed.push_back(std::move(samples));
   }
   return out;
 }
@@ -250,13 +319,16 @@ PerturbedDaes perturbedDaes(const DaeSystem& base, const std::vector<Sensitivity
   out.scales = VecX(static_cast<Eigen::Index>(params.size()));
   for (std::size_t i = 0; i < params.size(); ++i) {
     const SensitivityParameter& p = params[i];
-    for (const System* s : {p.plus, p.minus}) {
+    ResidualDifferences::Stencil stencil{{}, p.step};
+    for (std::size_t j = 0; j < kStencilPoints; ++j) {
+      const System* s = p.systems[j];
       if (!s || !s->isFinalized()) throw InputError("sensitivity parameter '" + p.name + "': no finalized system");
       out.daes.push_back(std::make_unique<DaeSystem>(*s, base.formulation(), defaultStabilisationMetric(*s),
                                                      base.releasedEquations()));
       requireSameStructure(base, *out.daes.back(), p.name);
+      stencil.daes[j] = out.daes.back().get();
     }
-    out.pairs.push_back({out.daes[out.daes.size() - 2].get(), out.daes.back().get(), p.step});
+    out.stencils.push_back(stencil);
     out.scales[static_cast<Eigen::Index>(i)] = std::max(std::fabs(p.value), kParameterTypicalMagnitude);
   }
   return out;
@@ -285,9 +357,9 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
   const SensitivityStart begin = startSensitivityRun(sys, settings, params);
   const ConsistentState& init = begin.init;
   const DaeSystem& dae = *begin.dae;
-  const std::vector<ResidualDifferences::Pair>& pairs = begin.perturbed.pairs;
+  const std::vector<ResidualDifferences::Stencil>& stencils = begin.perturbed.stencils;
   const VecX& scales = begin.perturbed.scales;
-  const InitialSensitivities s0 = initialSensitivities(dae, pairs, init, t0);
+  const InitialSensitivities s0 = initialSensitivities(dae, stencils, init, t0);
   const RunStart start = startRun(dae, init, t0);
 
   // the outputs: the recorder's sample with the sensitivities of the state it was made from
@@ -306,7 +378,7 @@ SimulationSummary simulateWithSensitivities(const System& sys, const std::vector
   choice.reason = "forward sensitivities are computed by IDAS";
 
   // integrate output by output
-  ResidualDifferences derivatives(pairs, t0, start.y0, start.yp0);
+  ResidualDifferences derivatives(stencils, t0, start.y0, start.yp0);
   const SensitivityProblem problem{&derivatives, s0.s0, s0.sp0, scales,
                                    sensitivityTolerances(choice.options.atol, choice.tolerances.position,
                                                          start.modelSize, scales),

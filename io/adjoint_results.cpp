@@ -79,8 +79,8 @@ IntegralOutput integralOutput(const std::string& spec, const Scene& base, const 
   const ColumnSource source = columnSource(base, column, spec);
   // the scene of each system the integrand can be given (the base and the perturbed ones)
   std::vector<std::pair<const System*, const Scene*>> sceneOf{{&base.system, &base}};
-  for (const auto& list : {&scenes.plus, &scenes.minus}) {
-    for (const auto& s : *list) sceneOf.emplace_back(&s->system, s.get());
+  for (const auto& points : scenes.perturbed) {
+    for (const auto& s : points) sceneOf.emplace_back(&s->system, s.get());
   }
   const auto value = [sceneOf, source](const System& sys, const VecX& q, const VecX& v) {
     for (const auto& [system, scene] : sceneOf) {

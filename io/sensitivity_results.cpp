@@ -48,23 +48,20 @@ SensitivityScenes buildSensitivityScenes(const std::string& sceneText, const std
     } catch (const InputError& e) {
       throw InputError("sensitivity parameter: " + std::string(e.what()));
     }
-    double h = parameterStep(p);
-    if (std::fabs(p) < kParameterTypicalMagnitude && p != 0.0 && h >= std::fabs(p)) {
-      // a small non-zero value (an inertia of 1e-6 kg m^2): the step of the typical magnitude
-      // would cross zero, where the scene may not be valid (a mass, an inertia); the relative
-      // step keeps the sign (its truncation error is relative to p as well)
-      h = parameterStep(p, std::fabs(p));
-    }
-    out.plus.push_back(sceneAt(j, source, path, p + h));
-    out.minus.push_back(sceneAt(j, source, path, p - h));
-    for (const Scene* s : {out.plus.back().get(), out.minus.back().get()}) {
-      if (resultColumns(*s) != columns) {
+    const double h = parameterStep(p);
+    SensitivityParameter parameter{path, p, h, {}};
+    std::array<std::unique_ptr<Scene>, kStencilPoints> scenes;
+    for (std::size_t k = 0; k < kStencilPoints; ++k) {
+      scenes[k] = sceneAt(j, source, path, p + kStencilOffsets[k] * h);
+      if (resultColumns(*scenes[k]) != columns) {
         throw InputError("sensitivity parameter '" + path +
                          "': changing it changes the results columns: expected a parameter that keeps the model's "
                          "structure");
       }
+      parameter.systems[k] = &scenes[k]->system;
     }
-    out.parameters.push_back({path, p, h, &out.plus.back()->system, &out.minus.back()->system});
+    out.perturbed.push_back(std::move(scenes));
+    out.parameters.push_back(parameter);
   }
   return out;
 }
@@ -81,13 +78,16 @@ std::vector<std::string> sensitivityColumns(const std::vector<std::string>& colu
 void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::string>& columns,
                     const SensitivitySample& sample, std::vector<double>& values) {
   values.clear();
-  std::vector<double> plus, minus;
+  std::array<std::vector<double>, kStencilPoints> rows;
   for (std::size_t i = 0; i < scenes.parameters.size(); ++i) {
-    resultRow(*scenes.plus[i], columns, sample.perturbed[i].plus, plus);
-    resultRow(*scenes.minus[i], columns, sample.perturbed[i].minus, minus);
+    for (std::size_t j = 0; j < kStencilPoints; ++j) {
+      resultRow(*scenes.perturbed[i][j], columns, sample.perturbed[i].at[j], rows[j]);
+    }
     const double h = scenes.parameters[i].step;
-    // dc/dp = (c(p + h, y + h s) - c(p - h, y - h s)) / (2 h) + O(h^2) (docs/sensitivities.md, "Output derivatives")
-    for (std::size_t c = 1; c < columns.size(); ++c) values.push_back((plus[c] - minus[c]) / (2.0 * h));
+    // dc/dp = sum_j w_j c(p + o_j h, y + o_j h s) / h + O(h^4) (docs/sensitivities.md, "Output derivatives")
+    for (std::size_t c = 1; c < columns.size(); ++c) {
+      values.push_back(stencilDerivative<double>(h, [&](int j) { return rows[static_cast<std::size_t>(j)][c]; }));
+    }
   }
 }
 

@@ -1,9 +1,10 @@
 /// @file
 /// The scene side of a sensitivity run (docs/sensitivities.md): the parameters named by
-/// scene paths, the scenes rebuilt with each parameter a step up and down, the results
+/// scene paths, the scenes rebuilt with each parameter one and two steps up and down, the results
 /// columns d\<column\>/d\<parameter\> and the gradients of the summary's scalars.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -16,11 +17,12 @@
 
 namespace flexmbd {
 
-/// The parameters of a run and, per parameter, the scene read with p + h and with p - h
-/// by the same reader as the scene itself (every numeric scene key can be a parameter).
+/// The parameters of a run and, per parameter, the scenes read with p + kStencilOffsets[j] h
+/// (p +- h, p +- 2 h) by the same reader as the scene itself (every numeric scene key can
+/// be a parameter).
 struct SensitivityScenes {
-  std::vector<std::unique_ptr<Scene>> plus, minus;
-  std::vector<SensitivityParameter> parameters;  ///< their systems are those of plus, minus
+  std::vector<std::array<std::unique_ptr<Scene>, kStencilPoints>> perturbed;  ///< [parameter][point]
+  std::vector<SensitivityParameter> parameters;  ///< their systems are those of `perturbed`
 };
 
 /// Reads the parameters `paths` (dotted scene paths, io/scene_path.hpp) from the scene
@@ -36,7 +38,7 @@ std::vector<std::string> sensitivityColumns(const std::vector<std::string>& colu
                                             const std::vector<SensitivityParameter>& parameters);
 
 /// The derivatives of one row (sensitivityColumns' order): for each parameter and column,
-/// (c(plus) - c(minus)) / (2 h), c evaluated by resultRow on the perturbed scenes.
+/// sum_j w_j c(at[j]) / h (stencilDerivative), c evaluated by resultRow on the perturbed scenes.
 void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::string>& columns,
                     const SensitivitySample& sample, std::vector<double>& values);
 

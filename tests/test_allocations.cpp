@@ -167,11 +167,11 @@ TEST(Allocations, SensitivityResidualDerivative) {
   const std::string text = jsonread::readSceneFile(path);
   const Scene base = parseSceneText(text, path);
   const SensitivityScenes sc = buildSensitivityScenes(text, path, base, {"bodies[1].section.density"});
-  const DaeSystem dae(base.system, Formulation::Ggl), plus(sc.plus[0]->system, Formulation::Ggl),
-      minus(sc.minus[0]->system, Formulation::Ggl);
+  const DaeSystem dae(base.system, Formulation::Ggl);
+  const PerturbedDaes perturbed = perturbedDaes(dae, sc.parameters);
   VecX y, yp, dFdp(dae.size());
   genericState(dae, y, yp);
-  ResidualDifferences d({{&plus, &minus, sc.parameters[0].step}}, 0.0, y, yp);
+  ResidualDifferences d(perturbed.stencils, 0.0, y, yp);
   d.residualDerivative(0, 0.01, y.data(), yp.data(), dFdp.data());
   EXPECT_EQ(allocationsIn([&] { d.residualDerivative(0, 0.02, y.data(), yp.data(), dFdp.data()); }), 0)
       << "heap allocations in one dF/dp";

@@ -72,17 +72,16 @@ TEST_F(Cli, ModesSensitivityOfACantileverMatchesTheClosedForms) {
   // (rho A)) of the discretised beam, I = b h^3 / 12, A = b h (e.g. Meirovitch, Elements of
   // Vibration Analysis, sec. 5.x), so f ∝ sqrt(E) and f ∝ h:
   //   df/dE = f / (2 E),   df/dh = f / h   (exact for the discrete model too).
-  // Tolerances: E enters K linearly, so dK/dE by central differences is exact up to the
-  // round-off eps |K| / (2 step) ~ 2e-11 relative (step 6.1e-6 E); the quotient
+  // Tolerances: E enters K linearly, so dK/dE by the five-point difference is exact up to
+  // the round-off 0.95 eps |K| / step ~ 2e-13 relative (step 1e-3 E); the quotient
   // x^T K x / x^T M x of the lowest mode loses eps (omega_max / omega_1)^2 to cancellation
   // (|K| ~ omega_max^2 |M|, the axial modes of 6 elements up to ~1e5 rad/s against 52 rad/s:
-  // 1e-9; measured 9.3e-9, 3.2e-10, 8.4e-11 for modes 1-3); 1e-7 holds it.
-  const double kYoungsTolerance = 1e-7;
-  // h enters K as h^3 (bending) and h (axial), M as h: the central difference of h^3 with
-  // the step d is 3 h^2 + d^2, so d(omega^2)/dh = omega^2 (3 (1 + d^2 / 3 h^2) - 1) / h and
-  // df/dh carries the relative error d^2 / (2 h^2) = 1.9e-7 with d = 6.1e-6 m
-  // (parameterStep: eps^(1/3) max(|h|, 1), the parameter below 1 m); 1e-6 holds it.
-  const double kHeightTolerance = 1e-6;
+  // 1e-9; measured 1.4e-10, 2.3e-12, 6.8e-13 for modes 1-3); 1e-8 holds it.
+  const double kYoungsTolerance = 1e-8;
+  // h enters K as h^3 (bending) and h (axial), M as h: polynomials of degree 3, whose
+  // five-point difference is exact (its error is h^4 f^(5) / 30), so df/dh carries the same
+  // round-off and cancellation as df/dE (measured 4.2e-11, 1.9e-12, 1e-16); 1e-8 holds it.
+  const double kHeightTolerance = 1e-8;
   const double Ev = 2.1e11, hv = 0.01;
   for (std::size_t k = 0; k < 3; ++k) {
     EXPECT_GT(f[k], 1.0) << "mode " << k + 1 << " is not an elastic one";

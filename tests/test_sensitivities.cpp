@@ -164,45 +164,60 @@ TEST(Sensitivities, InitialSensitivitiesSatisfyTheDifferentiatedConstraints) {
   const System& sys = base.system;
   const double t0 = base.solver.tStart;
   const ConsistentState init = computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities());
-  const DaeSystem dae(sys, Formulation::Ggl), plus(sc.plus[0]->system, Formulation::Ggl),
-      minus(sc.minus[0]->system, Formulation::Ggl);
+  const DaeSystem dae(sys, Formulation::Ggl);
+  const PerturbedDaes perturbed = perturbedDaes(dae, sc.parameters);
+  const ResidualDifferences::Stencil& stencil = perturbed.stencils[0];
   const double h = sc.parameters[0].step;
-  const InitialSensitivities s = initialSensitivities(dae, {{&plus, &minus, h}}, init, t0);
+  const InitialSensitivities s = initialSensitivities(dae, perturbed.stencils, init, t0);
   const DaeLayout& L = dae.layout();
   const VecX sq = s.s0.col(0).segment(L.q, L.nq), sv = s.s0.col(0).segment(L.v, L.nv);
   EXPECT_NEAR(sq[7 - 1], 1.0, 1e-9);  // slider.x moves with the rod's length at theta = 0
-  // d/dp g(q(p), p) = G s_q + g_p and d/dp (G v + g_t) = 0, as the central difference of
-  // the constraints of the perturbed systems along s: exact to O(h^2) ~ 4e-11 and the
-  // Newton tolerance of the projection over h (1e-15 / 6e-6); 1e-8 holds both.
-  const double kTolerance = 1e-8;
-  VecX gp, gm;
-  evaluateConstraints(plus.system(), init.q + h * sq, t0, &gp, nullptr);
-  evaluateConstraints(minus.system(), init.q - h * sq, t0, &gm, nullptr);
-  EXPECT_LT(((gp - gm) / (2 * h)).lpNorm<Eigen::Infinity>(), kTolerance);
-  const VecX cp = velocityConstraintResidual(plus.system(), init.q + h * sq, init.v + h * sv, t0);
-  const VecX cm = velocityConstraintResidual(minus.system(), init.q - h * sq, init.v - h * sv, t0);
-  EXPECT_LT(((cp - cm) / (2 * h)).lpNorm<Eigen::Infinity>(), kTolerance);
+  // d/dp g(q(p), p) = G s_q + g_p and d/dp (G v + g_t) = 0, as the five-point difference of
+  // the constraints of the perturbed systems along s: exact to O(h^4) ~ 1e-12 (h = 1e-3),
+  // its round-off 0.95 eps |g| / h ~ 1e-13 and the Newton tolerance of the projection over
+  // h (1e-15 / 1e-3); 1e-10 holds them all.
+  const double kTolerance = 1e-10;
+  const auto along = [&](int j) {  // the state moved along s on the system at p + o_j h
+    const double e = kStencilOffsets[static_cast<std::size_t>(j)] * h;
+    return std::pair<VecX, VecX>{init.q + e * sq, init.v + e * sv};
+  };
+  const auto system = [&](int j) -> const System& { return stencil.daes[static_cast<std::size_t>(j)]->system(); };
+  const VecX dg = stencilDerivative<VecX>(h, [&](int j) {
+    VecX g;
+    evaluateConstraints(system(j), along(j).first, t0, &g, nullptr);
+    return g;
+  });
+  EXPECT_LT(dg.lpNorm<Eigen::Infinity>(), kTolerance);
+  const VecX dc = stencilDerivative<VecX>(
+      h, [&](int j) { return VecX(velocityConstraintResidual(system(j), along(j).first, along(j).second, t0)); });
+  EXPECT_LT(dc.lpNorm<Eigen::Infinity>(), kTolerance);
   // and the whole sensitivity residual F_y s0 + F_y' s0' + F_p at t0 (same difference)
-  VecX y0, yp0, Fp(dae.size()), Fm(dae.size());
+  VecX y0, yp0;
   dae.packState(init.q, init.v, init.a, init.lambda, y0, yp0);
-  const VecX yP = y0 + h * s.s0.col(0), ypP = yp0 + h * s.sp0.col(0);
-  const VecX yM = y0 - h * s.s0.col(0), ypM = yp0 - h * s.sp0.col(0);
-  plus.residual(t0, yP.data(), ypP.data(), Fp.data());
-  minus.residual(t0, yM.data(), ypM.data(), Fm.data());
+  const VecX dF = stencilDerivative<VecX>(h, [&](int j) {
+    const double e = kStencilOffsets[static_cast<std::size_t>(j)] * h;
+    const VecX y = y0 + e * s.s0.col(0), yp = yp0 + e * s.sp0.col(0);
+    VecX F(dae.size());
+    stencil.daes[static_cast<std::size_t>(j)]->residual(t0, y.data(), yp.data(), F.data());
+    return F;
+  });
   // scaled by the largest |dF/dp| (the reaction forces' scale, ~1 N/m here)
-  EXPECT_LT(((Fp - Fm) / (2 * h)).lpNorm<Eigen::Infinity>(), 1e-6);
+  EXPECT_LT(dF.lpNorm<Eigen::Infinity>(), 1e-6);
   // without the projection the sensitivity would be 0 (the given position does not move)
   EXPECT_GT(sq.lpNorm<Eigen::Infinity>(), 0.5);
 }
 
 // ----- scene paths ---------------------------------------------------------------------
 
-// dF/dp from the parts that differ (ResidualDifferences, DaeSystem::residualOfParts): a
+// dF/dp from the terms that differ (ResidualDifferences, DaeSystem::residualOfParts): a
 // section dimension of the rod takes the rod's terms only, the slider's mass the slider's,
-// a joint point and a drive speed no body's; and the derivative equals the central
-// difference of the whole residuals to the latter's round-off, kRoundOff (|F+| + |F-|) / (2 h)
+// a joint point that joint's and no body's, a drive speed the driver's only (every one the
+// driver's: a term of time); the slider's mass and the joint point are linear (two-point
+// difference: a revolute joint's rows are linear in its body-frame points), the section
+// height is not (h^3), the drive speed has no term of the state; and the derivative
+// equals the five-point difference of the whole residuals to the latter's round-off, kRoundOff sum_j |w_j F_j| / h
 // per row (the parts' difference leaves out terms that cancel, so it is the more exact).
-TEST(Sensitivities, ParameterDerivativeTakesOnlyTheBodiesThatDiffer) {
+TEST(Sensitivities, ParameterDerivativeTakesOnlyTheTermsThatDiffer) {
   constexpr double kRoundOff = 8.0 * std::numeric_limits<double>::epsilon();
   const std::string path = std::string(FLEXMBD_SOURCE_DIR) + "/examples/slider_crank_elastic.json";
   const std::string text = json::parse(readFile(path)).dump();
@@ -210,15 +225,11 @@ TEST(Sensitivities, ParameterDerivativeTakesOnlyTheBodiesThatDiffer) {
   const std::vector<std::string> paths{"bodies[1].section.height", "bodies[2].mass", "joints[1].points[0][0]",
                                        "drivers[0].law.speed"};
   const std::vector<std::vector<std::string>> expectedBodies{{"rod"}, {"slider"}, {}, {}};
+  const std::vector<std::vector<std::string>> expectedConstraints{{"motor"}, {"motor"}, {"O2", "motor"}, {"motor"}};
+  const std::vector<bool> expectedLinear{false, true, true, false};
   const SensitivityScenes sc = buildSensitivityScenes(text, path, base, paths);
   const DaeSystem dae(base.system, Formulation::Ggl);
-  std::vector<std::unique_ptr<DaeSystem>> systems;
-  std::vector<ResidualDifferences::Pair> pairs;
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    systems.push_back(std::make_unique<DaeSystem>(sc.plus[i]->system, Formulation::Ggl));
-    systems.push_back(std::make_unique<DaeSystem>(sc.minus[i]->system, Formulation::Ggl));
-    pairs.push_back({systems[systems.size() - 2].get(), systems.back().get(), sc.parameters[i].step});
-  }
+  const PerturbedDaes perturbed = perturbedDaes(dae, sc.parameters);
   // a generic state: every entry non-zero
   const int n = dae.size();
   VecX y(n), yp(n);
@@ -226,7 +237,7 @@ TEST(Sensitivities, ParameterDerivativeTakesOnlyTheBodiesThatDiffer) {
     y[k] = 0.3 * std::cos(1.7 * k) + 0.01 * k;
     yp[k] = 0.5 * std::sin(2.3 * k + 0.4);
   }
-  ResidualDifferences d(pairs, 0.0, y, yp);
+  ResidualDifferences d(perturbed.stencils, 0.0, y, yp);
   const System& sys = base.system;
   for (std::size_t i = 0; i < paths.size(); ++i) {
     std::vector<std::string> taken;
@@ -234,16 +245,28 @@ TEST(Sensitivities, ParameterDerivativeTakesOnlyTheBodiesThatDiffer) {
       if (d.parts(static_cast<int>(i)).bodies[static_cast<std::size_t>(b)]) taken.push_back(sys.body(BodyIndex(b)).name());
     }
     EXPECT_EQ(taken, expectedBodies[i]) << paths[i];
-    VecX dFdp(n), Fplus(n), Fminus(n);
+    std::vector<std::string> constraints;
+    for (int c = 0; c < sys.numConstraints(); ++c) {
+      if (d.parts(static_cast<int>(i)).constraints[static_cast<std::size_t>(c)]) {
+        constraints.push_back(sys.constraint(ConstraintIndex(c)).name());
+      }
+    }
+    EXPECT_EQ(constraints, expectedConstraints[i]) << paths[i];
+    EXPECT_EQ(d.linearTerms(static_cast<int>(i)), expectedLinear[i]) << paths[i];
+    VecX dFdp(n);
     const double t = 0.013;
     d.residualDerivative(static_cast<int>(i), t, y.data(), yp.data(), dFdp.data());
-    pairs[i].plus->residual(t, y.data(), yp.data(), Fplus.data());
-    pairs[i].minus->residual(t, y.data(), yp.data(), Fminus.data());
+    std::array<VecX, kStencilPoints> F;
+    for (std::size_t j = 0; j < kStencilPoints; ++j) {
+      F[j] = VecX(n);
+      perturbed.stencils[i].daes[j]->residual(t, y.data(), yp.data(), F[j].data());
+    }
     const double h = sc.parameters[i].step;
-    const VecX whole = (Fplus - Fminus) / (2.0 * h);
+    const VecX whole = stencilDerivative<VecX>(h, [&](int j) { return F[static_cast<std::size_t>(j)]; });
     EXPECT_GT(whole.cwiseAbs().maxCoeff(), 0.0) << paths[i] << ": the residual depends on it";
     for (int k = 0; k < n; ++k) {
-      const double bound = kRoundOff * (std::fabs(Fplus[k]) + std::fabs(Fminus[k])) / (2.0 * h);
+      double bound = 0.0;
+      for (std::size_t j = 0; j < kStencilPoints; ++j) bound += kRoundOff * std::fabs(kStencilWeights[j] * F[j][k]) / h;
       EXPECT_LE(std::fabs(dFdp[k] - whole[k]), bound) << paths[i] << ", row " << k;
     }
   }
