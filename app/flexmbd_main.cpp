@@ -284,6 +284,28 @@ SimulationSummary runWithSensitivities(const Scene& scene, const SensitivityScen
                              });
 }
 
+/// What the run computes besides its results: the command line's --sensitivity and
+/// --adjoint lists, each where given and the scene's "sensitivity" lists otherwise; the
+/// error control off if either says so (docs/sensitivities.md, "Requesting sensitivities").
+/// @throws InputError: adjoint outputs without parameters, or with the error control off.
+SensitivityRequest sensitivityRequest(const Options& o, const SensitivityRequest& scene) {
+  SensitivityRequest r;
+  r.parameters = o.sensitivities.empty() ? scene.parameters : o.sensitivities;
+  r.adjoint = o.adjoint.empty() ? scene.adjoint : o.adjoint;
+  r.errorControl = o.sensitivityErrorControl && scene.errorControl;
+  if (!r.adjoint.empty() && r.parameters.empty()) {
+    throw InputError("option --adjoint needs the parameters of its gradients: one --sensitivity PATH or more (or the "
+                     "scene's sensitivity.parameters)");
+  }
+  if (!r.adjoint.empty() && !r.errorControl) {
+    throw InputError(std::string(o.sensitivityErrorControl ? "the scene's sensitivity.error_control false"
+                                                           : "option --no-sensitivity-error-control") +
+                     " is for the forward sensitivities, not with adjoint outputs (" +
+                     (o.adjoint.empty() ? "the scene's sensitivity.adjoint" : "--adjoint") + ")");
+  }
+  return r;
+}
+
 int runCommand(const Options& o) {
   if (isTensegrityScene(o.scenePath)) {  // "model": "tensegrity" (app/tensegrity_command.cpp)
     if (!o.sensitivities.empty() || !o.adjoint.empty()) {
@@ -311,6 +333,7 @@ int runCommand(const Options& o) {
   // ----- input: scene, overrides, settings (exit 2 on any error) -----
   std::optional<Scene> scene;
   std::optional<SensitivityScenes> sensitivities;
+  SensitivityRequest request;
   try {
     scene.emplace(loadScene(o.scenePath));
     SolverSettings& s = scene->solver;
@@ -324,16 +347,11 @@ int runCommand(const Options& o) {
     overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (integrators/tolerances.hpp)
     s.progress = !o.quiet;
     checkSolverSettings(s);
-    if (!o.adjoint.empty() && o.sensitivities.empty()) {
-      throw InputError("option --adjoint needs the parameters of its gradients: one --sensitivity PATH or more");
-    }
-    if (!o.adjoint.empty() && !o.sensitivityErrorControl) {
-      throw InputError("option --no-sensitivity-error-control is for the forward sensitivities, not with --adjoint");
-    }
-    if (!o.sensitivities.empty()) {  // the scene read again with each parameter a step up and down
+    request = sensitivityRequest(o, scene->sensitivity);
+    if (!request.parameters.empty()) {  // the scene read again with each parameter one and two steps up and down
       sensitivities.emplace(
-          buildSensitivityScenes(jsonread::readSceneFile(o.scenePath), o.scenePath, *scene, o.sensitivities));
-      for (const std::string& spec : o.adjoint) integralOutput(spec, *scene, *sensitivities);  // refused before the run
+          buildSensitivityScenes(jsonread::readSceneFile(o.scenePath), o.scenePath, *scene, request.parameters));
+      for (const std::string& spec : request.adjoint) integralOutput(spec, *scene, *sensitivities);  // refused before the run
     }
   } catch (const std::exception& e) {
     return reportInputError(outDir, e.what());
@@ -345,7 +363,7 @@ int runCommand(const Options& o) {
   try {
     writer.emplace(outDir, *scene, o.format);
     sceneColumns = writer->columns();
-    if (sensitivities && o.adjoint.empty()) {
+    if (sensitivities && request.adjoint.empty()) {
       writer->addColumns(sensitivityColumns(sceneColumns, sensitivities->parameters));
     }
     if (o.vtk) {
@@ -370,8 +388,8 @@ int runCommand(const Options& o) {
   std::optional<nlohmann::json> adjointSummary;
   try {
     const StopOnSignals stop;  // a signal stops the run within its step
-    if (!o.adjoint.empty()) {
-      const AdjointSummary adjoint = runAdjointScene(*scene, *sensitivities, o.adjoint, [&](const OutputSample& sample) {
+    if (!request.adjoint.empty()) {
+      const AdjointSummary adjoint = runAdjointScene(*scene, *sensitivities, request.adjoint, [&](const OutputSample& sample) {
         writer->write(sample);
         if (vtk) vtk->write(sample);
         if (sample.t < scene->solver.tEnd) stopIfSignalled(sample.t);
@@ -384,7 +402,7 @@ int runCommand(const Options& o) {
       }
     } else if (sensitivities) {
       gradients.emplace(sceneColumns, sensitivities->parameters);
-      summary = runWithSensitivities(*scene, *sensitivities, o.sensitivityErrorControl, *writer, vtk, *gradients);
+      summary = runWithSensitivities(*scene, *sensitivities, request.errorControl, *writer, vtk, *gradients);
     } else {
       summary = simulateKeepingFailures(scene->system, scene->solver, [&](const OutputSample& sample) {
         writer->write(sample);
@@ -411,7 +429,7 @@ int runCommand(const Options& o) {
                                                                                : "solver failure: " + summary.message;
   try {
     const nlohmann::json sensitivitySummary =
-        adjointSummary ? *adjointSummary : gradients ? gradients->toJson(o.sensitivityErrorControl) : nlohmann::json();
+        adjointSummary ? *adjointSummary : gradients ? gradients->toJson(request.errorControl) : nlohmann::json();
     writeSummary(outDir, summary, *scene, o.scenePath, adjointSummary || gradients ? &sensitivitySummary : nullptr);
   } catch (const std::exception& e) {
     printError((summary.ok ? std::string() : what + " (" + kept + "); ") + "cannot write the summary: " + e.what());

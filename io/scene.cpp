@@ -675,6 +675,39 @@ void checkSolverSettings(const SolverSettings& s) {
   }
 }
 
+namespace {
+
+/// A list of non-empty strings under `key` of `r` (absent: empty).
+std::vector<std::string> nonEmptyStrings(const ObjectReader& r, const std::string& key, const std::string& what) {
+  std::vector<std::string> out;
+  const json& a = r.array(key);
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (!a[k].is_string() || a[k].get<std::string>().empty()) {
+      r.fail("key \"" + key + "\": element [" + std::to_string(k) + "] must be " + what + ", got " + describe(a[k]));
+    }
+    out.push_back(a[k].get<std::string>());
+  }
+  return out;
+}
+
+/// The "sensitivity" object: the parameters (paths checked against the scene by
+/// buildSensitivityScenes), the adjoint outputs (checked by integralOutput), error control.
+SensitivityRequest parseSensitivityRequest(const json& j) {
+  ObjectReader r(j, "sensitivity");
+  r.allowOnly(scenekeys::kSensitivity);
+  SensitivityRequest s;
+  s.parameters = nonEmptyStrings(r, "parameters", "a dotted scene path (e.g. \"bodies[1].mass\")");
+  s.adjoint = nonEmptyStrings(r, "adjoint", "an adjoint output KIND:COLUMN (e.g. \"integral_square:mid.uy\")");
+  s.errorControl = r.boolean("error_control", true);
+  if (s.parameters.empty()) r.fail("key \"parameters\" must list at least one dotted scene path");
+  if (!s.adjoint.empty() && !s.errorControl) {
+    r.fail("key \"error_control\" is for the forward sensitivities: false is not allowed with \"adjoint\"");
+  }
+  return s;
+}
+
+}  // namespace
+
 Scene parseScene(const json& j, const std::string& baseDir) {
   ObjectReader top(j, "top level");
   top.allowOnly(scenekeys::kScene);
@@ -731,6 +764,7 @@ Scene parseScene(const json& j, const std::string& baseDir) {
 
   scene.solver = top.has("solver") ? parseSolver(top.object("solver")) : SolverSettings{};
   if (!top.has("solver")) checkSolverSettings(scene.solver);
+  if (top.has("sensitivity")) scene.sensitivity = parseSensitivityRequest(top.object("sensitivity"));
 
   located("scene", [&] { sys.finalize(); });
   return scene;

@@ -57,6 +57,15 @@ struct OutputRequest {
 /// A model ready to run, planar or spatial ("dimension": 3), as loadScene() reads it
 /// from a scene file: run it with simulate(scene.system, scene.solver, ...) and evaluate
 /// `outputs` at each OutputSample. System is move-only, so a Scene is too.
+/// The scene's "sensitivity" object (docs/scene-format.md, docs/sensitivities.md): what
+/// a run computes besides its results where the command line (or Python's run) names
+/// nothing itself.
+struct SensitivityRequest {
+  std::vector<std::string> parameters;  ///< dotted scene paths (forward or adjoint)
+  std::vector<std::string> adjoint;     ///< adjoint outputs KIND:COLUMN (need parameters)
+  bool errorControl = true;             ///< the forward sensitivities in the error test
+};
+
 struct Scene {
   std::string name;       ///< the scene's "name" (results' summary.json)
   System system;          ///< the model, finalized
@@ -64,6 +73,7 @@ struct Scene {
   std::vector<OutputRequest> outputs;  ///< the scene's "outputs", in order
   std::vector<BodyGeometry> geometry;  ///< the rigid bodies' "geometry" (viewing only)
   std::vector<FeBodyDrawing> feBodies;  ///< the fe_bodies' surfaces and stress shapes
+  SensitivityRequest sensitivity;       ///< the scene's "sensitivity" (none: empty lists)
 };
 
 /// Reads and parses a scene file. Error messages start with the file path.

@@ -17,7 +17,8 @@ using Keys = std::vector<std::string>;
 
 // ----- multibody scenes (flexmbd run) ------------------------------------------------
 inline const Keys kScene = {"name",   "dimension", "gravity", "bodies", "joints",
-                            "drivers", "forces",   "outputs", "solver"};
+                            "drivers", "forces",   "outputs", "solver", "sensitivity"};
+inline const Keys kSensitivity = {"parameters", "adjoint", "error_control"};
 inline const Keys kRigidBody = {"name",  "type",     "mass", "inertia", "com", "position",
                                 "angle", "velocity", "angular_velocity", "geometry"};
 inline const Keys kFlexibleBody = {"name",     "type",     "position",    "angle",
@@ -145,6 +146,7 @@ inline const Keys kMasslessCablesSolver = {"method", "t_start", "t_end",        
 inline const std::vector<std::pair<std::string, const Keys*>>& allObjects() {
   static const std::vector<std::pair<std::string, const Keys*>> objects = {
       {"scene", &kScene},
+      {"sensitivity", &kSensitivity},
       {"body.rigid", &kRigidBody},
       {"body.flexible", &kFlexibleBody},
       {"body.flexible_invariants", &kInvariantsBody},

@@ -400,7 +400,7 @@ TEST_F(Cli, AdjointBadInputExitsTwoNamingTheOutput) {
                         Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.x_ddot", "accelerations"},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint", "needs an integral output"},
                         Case{"--sensitivity 'bodies[2].mass' --adjoint integral:slider.x --no-sensitivity-error-control",
-                             "not with --adjoint"}}) {
+                             "not with adjoint outputs (--adjoint)"}}) {
     const CliResult r = runWith(c.options);
     EXPECT_EQ(r.status, 2) << c.options << ": " << r.err;
     EXPECT_TRUE(IsOneErrorLine(r.err)) << c.options;

@@ -320,6 +320,68 @@ TEST_F(Cli, SensitivityColumnsAndSummaryGradients) {
   EXPECT_NEAR(s.at("max_abs").at("slider.x").at("gradient").at("joints[2].points[0][0]").get<double>(), 1.0, 1e-7);
 }
 
+// The scene's "sensitivity" object: its parameters (and adjoint outputs) are what a run
+// computes where the command line names none; an option given replaces the scene's list.
+TEST_F(Cli, SceneSensitivityKeyIsTheDefaultOfTheOptions) {
+  json j = example();
+  j["solver"]["t_end"] = 1.0;
+  j["sensitivity"] = {{"parameters", {"bodies[2].mass", "joints[2].points[0][0]"}}};
+  const fs::path scene = writeScene("crank.json", j);
+  const auto runWith = [&](const std::string& options, const std::string& out) {
+    return run("run " + shellQuote(scene.string()) + " --out " + shellQuote((dir_ / out).string()) + " --quiet " +
+               options);
+  };
+  CliResult r = runWith("", "keyed");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::string csv = readFile(dir_ / "keyed" / "results.csv");
+  std::string header = csv.substr(0, csv.find('\n'));
+  EXPECT_NE(header.find(",dslider.x/dbodies[2].mass,"), std::string::npos);
+  EXPECT_NE(header.find(",dslider.x/djoints[2].points[0][0],"), std::string::npos);
+  const json summary = json::parse(readFile(dir_ / "keyed" / "summary.json"));
+  // the final slider position's gradient in the rod length: the closed form at theta = 1 rad
+  // (as SensitivityColumnsAndSummaryGradients)
+  const double th = 1.0, exact = 2.0 / std::sqrt(4.0 - std::sin(th) * std::sin(th));
+  EXPECT_NEAR(summary.at("sensitivities").at("final").at("slider.x").at("gradient").at("joints[2].points[0][0]").get<double>(),
+              exact, 1e-7);
+  // an option replaces the scene's list
+  r = runWith("--sensitivity 'bodies[1].mass'", "option");
+  ASSERT_EQ(r.status, 0) << r.err;
+  csv = readFile(dir_ / "option" / "results.csv");
+  header = csv.substr(0, csv.find('\n'));
+  EXPECT_NE(header.find(",dslider.x/dbodies[1].mass,"), std::string::npos);
+  EXPECT_EQ(header.find("dbodies[2].mass"), std::string::npos) << header;
+  // the scene's adjoint outputs with its parameters
+  j["sensitivity"]["adjoint"] = {"integral_square:slider.x"};
+  const fs::path adjointScene = writeScene("adjoint.json", j);
+  r = run("run " + shellQuote(adjointScene.string()) + " --out " + shellQuote((dir_ / "adjoint").string()) + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const json s = json::parse(readFile(dir_ / "adjoint" / "summary.json")).at("sensitivities");
+  EXPECT_EQ(s.at("method"), "adjoint");
+  EXPECT_TRUE(s.at("integrals").contains("integral_square:slider.x"));
+  // bad input: exit 2 naming the key
+  struct Case {
+    json key;
+    std::string options, expected;
+  };
+  for (const Case& c :
+       {Case{{{"parameters", json::array()}}, "", "sensitivity: key \"parameters\" must list at least one"},
+        Case{{{"paramters", {"bodies[2].mass"}}}, "", "sensitivity: unknown key \"paramters\""},
+        Case{{{"parameters", {"bodies[2].mass", 3}}}, "", "element [1] must be a dotted scene path"},
+        Case{{{"parameters", {"bodies[7].mass"}}}, "", "no element [7]"},
+        Case{{{"parameters", {"bodies[2].mass"}}, {"adjoint", {"integral:slider.x"}}, {"error_control", false}}, "",
+             "\"error_control\" is for the forward sensitivities"},
+        Case{{{"parameters", {"bodies[2].mass"}}, {"adjoint", {"integral:slider.x"}}}, "--no-sensitivity-error-control",
+             "option --no-sensitivity-error-control is for the forward sensitivities"}}) {
+    json bad = example();
+    bad["sensitivity"] = c.key;
+    r = run("run " + shellQuote(writeScene("bad.json", bad).string()) + " --out " + shellQuote((dir_ / "bad").string()) +
+            " --quiet " + c.options);
+    EXPECT_EQ(r.status, 2) << c.key.dump() << ": " << r.err;
+    EXPECT_TRUE(IsOneErrorLine(r.err)) << c.key.dump();
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << c.key.dump() << ": " << r.err;
+  }
+}
+
 TEST_F(Cli, SensitivityBadInputExitsTwoNamingTheParameter) {
   const fs::path scene = writeScene("crank.json", example());
   const auto runWith = [&](const std::string& options) {

@@ -223,13 +223,17 @@ class Scene:
         mode shape's entries; finalizes the system."""
         return self._native.velocity_names
 
-    def run(self, progress=False, raise_on_failure=True, sensitivities=None, sensitivity_error_control=True,
+    def run(self, progress=False, raise_on_failure=True, sensitivities=None, sensitivity_error_control=None,
             adjoint=None):
         """Runs the model (the GIL is released: runs in threads go on in parallel).
 
         Returns Results. A solver failure raises SolverFailure (its ``results`` hold the
         rows up to the failure) unless raise_on_failure is False; input and model errors
         raise InputError / ModelError (ValueError) with the engine's message.
+
+        ``sensitivities``, ``adjoint``, ``sensitivity_error_control``: None takes the
+        scene's "sensitivity" object (its "parameters", "adjoint", "error_control";
+        docs/scene-format.md), ``[]`` none.
 
         ``sensitivities``: dotted scene paths ("bodies[1].mass", ...) of parameters whose
         forward sensitivities IDAS integrates with the run (docs/sensitivities.md): the
@@ -245,6 +249,13 @@ class Scene:
         columns: one backward integration per output, whatever the number of parameters
         (``summary["sensitivities"]["integrals"][OUTPUT]`` holds "value" and "gradient";
         ``Results.gradient(OUTPUT)`` as a dict)."""
+        request = json.loads(self._text).get("sensitivity", {}) if self._text is not None else {}
+        if sensitivities is None:
+            sensitivities = request.get("parameters", [])
+        if adjoint is None:
+            adjoint = request.get("adjoint", [])
+        if sensitivity_error_control is None:
+            sensitivity_error_control = request.get("error_control", True)
         if adjoint:
             if not sensitivities:
                 raise InputError("adjoint outputs need the parameters of their gradients: sensitivities=[PATH, ...]")

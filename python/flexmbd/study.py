@@ -411,11 +411,12 @@ def run_point(index, scene, overrides, outputs, names, sensitivities=(), sensiti
             adjoint = point.run(raise_on_failure=False, sensitivities=list(sensitivities), adjoint=integrals)
         if sensitivities and (_needs_forward(outputs) or not integrals):
             results = point.run(raise_on_failure=False, sensitivities=list(sensitivities),
-                                sensitivity_error_control=sensitivity_error_control)
+                                sensitivity_error_control=sensitivity_error_control, adjoint=[])
         elif adjoint is not None:
             results = adjoint  # the table of a plain run, and the integrals
         else:
-            results = point.run(raise_on_failure=False)
+            # the study's own sensitivities only, not the scene's "sensitivity" key
+            results = point.run(raise_on_failure=False, sensitivities=[], adjoint=[])
         if adjoint is not None and not adjoint.ok:
             results = adjoint
         record["status"] = "ok" if results.ok else "failed"

@@ -116,3 +116,23 @@ def test_adjoint_errors():
     plain = flexmbd.load_scene(CRANK).run()
     with pytest.raises(KeyError, match="no adjoint output"):
         plain.gradient("integral:slider.x")
+
+
+def test_the_scenes_sensitivity_key_is_the_default_of_run():
+    # the scene's "sensitivity" object (docs/scene-format.md): run() with no arguments takes
+    # its parameters; the table and gradients equal the run naming them; [] runs without
+    with open(CRANK) as f:
+        scene = json.load(f)
+    scene["sensitivity"] = {"parameters": [SLIDER_MASS, ROD_LENGTH]}
+    keyed = flexmbd.scene_from_dict(scene).run()
+    named = flexmbd.load_scene(CRANK).run(sensitivities=[SLIDER_MASS, ROD_LENGTH])
+    assert keyed.columns == named.columns
+    assert np.array_equal(keyed.data, named.data)
+    assert keyed.summary["sensitivities"] == named.summary["sensitivities"]
+    plain = flexmbd.scene_from_dict(scene).run(sensitivities=[])
+    assert "sensitivities" not in plain.summary
+    assert not any(c.startswith("d") and "/d" in c for c in plain.columns)
+    # the adjoint outputs of the key, with its parameters
+    scene["sensitivity"]["adjoint"] = ["integral_square:slider.x"]
+    adjoint = flexmbd.scene_from_dict(scene).run()
+    assert set(adjoint.gradient("integral_square:slider.x")) == {SLIDER_MASS, ROD_LENGTH}
