@@ -489,7 +489,9 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
       // each gradient to rtol |G| / |p_i| (the change of G over a relative change of p_i of 1)
       for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
     }
-    const AdjointSolution backward = recording.integrateAdjoint(problem, t0);
+    ProgressReporter backwardProgress(settings.progress, t0, tEnd, "ida adjoint, backward", true);
+    const AdjointSolution backward = recording.integrateAdjoint(
+        problem, t0, [&](double t, long steps) { backwardProgress.update(t, steps); });
     // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);

@@ -492,7 +492,8 @@ VecX IdaSolver::integrals() const {
   return Eigen::Map<const VecX>(N_VGetArrayPointer(d.quad), d.outputs->count());
 }
 
-AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, double t0) {
+AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, double t0,
+                                            const std::function<void(double t, long steps)>& progress) {
   Impl& d = *impl_;
   if (!d.recording || problem.outputs != d.outputs) throw std::logic_error("IdaSolver: adjoint without its recording");
   const int n = d.dae->size();
@@ -582,8 +583,27 @@ AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, doubl
   }
   d.pending = nullptr;
   d.cacheValid = false;
-  const int flag = IDASolveB(d.mem, t0, IDA_NORMAL);
-  if (d.pending) std::rethrow_exception(std::exchange(d.pending, nullptr));
+  // the backward steps taken so far by every backward problem
+  const auto backwardSteps = [&] {
+    long total = 0;
+    for (const auto& b : d.backward) {
+      long steps = 0;
+      if (void* bmem = IDAGetAdjIDABmem(d.mem, b->which); bmem && IDAGetNumSteps(bmem, &steps) == IDA_SUCCESS) {
+        total += steps;
+      }
+    }
+    return total;
+  };
+  // to t0 through kAdjointProgressPoints times when progress is shown (IDA_NORMAL steps past
+  // each and interpolates: the same steps as one call to t0)
+  const int parts = progress ? kAdjointProgressPoints : 1;
+  int flag = IDA_SUCCESS;
+  for (int k = 1; k <= parts && flag >= 0; ++k) {
+    const double tout = k == parts ? t0 : tEnd - (tEnd - t0) * static_cast<double>(k) / parts;
+    flag = IDASolveB(d.mem, tout, IDA_NORMAL);
+    if (d.pending) std::rethrow_exception(std::exchange(d.pending, nullptr));
+    if (flag >= 0 && progress) progress(tout, backwardSteps());
+  }
   if (flag < 0) {
     realtype t = 0.0, h = 0.0;
     void* bmem = IDAGetAdjIDABmem(d.mem, d.backward.front()->which);
@@ -596,7 +616,7 @@ AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, doubl
     if (!d.lastIdaMessage.empty()) os << " (" << d.lastIdaMessage << ")";
     throw SolverError(os.str(), t, h);
   }
-  AdjointSolution out{MatX::Zero(n, count), MatX::Zero(n, count), MatX::Zero(np, count), 0};
+  AdjointSolution out{MatX::Zero(n, count), MatX::Zero(n, count), MatX::Zero(np, count), backwardSteps()};
   for (const auto& b : d.backward) {
     realtype t = 0.0;
     d.check(IDAGetB(d.mem, b->which, &t, b->y, b->yp), "IDAGetB");
@@ -605,8 +625,6 @@ AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, doubl
     out.lambdaRate0.col(b->k) = Eigen::Map<const VecX>(N_VGetArrayPointer(b->yp), n);
     // IDAS's backward quadrature runs from T to t0: q(t0) = -int_{t0}^{T} rhs dt
     out.integral.col(b->k) = -Eigen::Map<const VecX>(N_VGetArrayPointer(b->q), np);
-    long steps = 0;
-    if (void* bmem = IDAGetAdjIDABmem(d.mem, b->which); bmem && IDAGetNumSteps(bmem, &steps) == IDA_SUCCESS) out.steps += steps;
   }
   return out;
 }

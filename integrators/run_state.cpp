@@ -46,9 +46,9 @@ double OutputSchedule::time(long k) const { return k == count ? tEnd : std::min(
 /// kProgressInterval seconds: short runs stay silent, long ones do not flood the terminal.
 constexpr double kProgressDelay = 2.0, kProgressInterval = 0.5;
 
-ProgressReporter::ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator)
+ProgressReporter::ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator, bool backward)
     : enabled_(enabled && isatty(STDERR_FILENO)), t0_(t0), tEnd_(tEnd), integrator_(std::move(integrator)),
-      start_(std::chrono::steady_clock::now()), last_(start_) {}
+      backward_(backward), start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 void ProgressReporter::update(double t, long steps) {
   if (!enabled_) return;
@@ -57,8 +57,9 @@ void ProgressReporter::update(double t, long steps) {
   if (elapsed < kProgressDelay || std::chrono::duration<double>(now - last_).count() < kProgressInterval) return;
   last_ = now;
   shown_ = true;
-  std::fprintf(stderr, "\r  %s: t = %.6g / %.6g (%5.1f%%), %ld steps, %.0f steps/s   ", integrator_.c_str(), t, tEnd_,
-               100.0 * (t - t0_) / (tEnd_ - t0_), steps, steps / elapsed);
+  const double done = backward_ ? (tEnd_ - t) / (tEnd_ - t0_) : (t - t0_) / (tEnd_ - t0_);
+  std::fprintf(stderr, "\r  %s: t = %.6g / %.6g (%5.1f%%), %ld steps, %.0f steps/s   ", integrator_.c_str(), t,
+               backward_ ? t0_ : tEnd_, 100.0 * done, steps, steps / elapsed);
   std::fflush(stderr);
 }
 

@@ -39,8 +39,9 @@ struct OutputSchedule {
 /// Progress on stderr for runs longer than a few seconds, when stderr is a terminal.
 class ProgressReporter {
  public:
-  /// `integrator`: the integrator chosen, named in the progress line.
-  ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator);
+  /// `integrator`: the integrator chosen, named in the progress line. `backward`: t runs
+  /// from tEnd to t0 (an adjoint's backward integration).
+  ProgressReporter(bool enabled, double t0, double tEnd, std::string integrator, bool backward = false);
   ProgressReporter(const ProgressReporter&) = delete;
   ProgressReporter& operator=(const ProgressReporter&) = delete;
   /// Shows t and the steps taken, at most twice a second, after the first 2 s.
@@ -51,6 +52,7 @@ class ProgressReporter {
   bool enabled_;
   double t0_, tEnd_;
   std::string integrator_;
+  bool backward_;
   std::chrono::steady_clock::time_point start_, last_;
   bool shown_ = false;
 };
