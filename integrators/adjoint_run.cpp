@@ -491,7 +491,11 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     }
     ProgressReporter backwardProgress(settings.progress, t0, tEnd, "ida adjoint, backward", true);
     const AdjointSolution backward = recording.integrateAdjoint(
-        problem, t0, [&](double t, long steps) { backwardProgress.update(t, steps); });
+        problem, t0,
+        backwardProgress.enabled() ? std::function<void(double, long)>([&](double t, long steps) {
+          backwardProgress.update(t, steps);
+        })
+                                   : std::function<void(double, long)>());
     // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);

@@ -67,15 +67,12 @@ class IdaSolver final : public DaeIntegrator {
   /// problem per output, terminal values at T) back to t0, with the quadratures of the
   /// gradients (docs/sensitivities.md, "Adjoint sensitivities"). Each backward problem's
   /// Newton matrix is -J(-cj_B)^T (the term of dE/dt left out).
-  /// `progress` (if given) gets the backward time reached and the backward steps taken,
-  /// at kAdjointProgressPoints times of the pass (IDAS integrates past them and
-  /// interpolates: the steps do not depend on them).
+  /// `progress` (if given) gets the time of each backward residual evaluation and the
+  /// backward steps taken so far (it does not change the integration).
   /// @throws SolverError with IDAS's reason and the time; an exception of a callback as
   /// it was thrown; std::logic_error without recording.
   AdjointSolution integrateAdjoint(const AdjointProblem& problem, double t0,
                                    const std::function<void(double t, long steps)>& progress = {});
-  /// The times of the backward pass at which integrateAdjoint reports progress.
-  static constexpr int kAdjointProgressPoints = 100;
   bool usesKlu() const override { return usesKlu_; }
   bool solutionAtFailure(VecX& y) const override {
     if (failureState_.size() == 0) return false;

@@ -46,6 +46,8 @@ class ProgressReporter {
   ProgressReporter& operator=(const ProgressReporter&) = delete;
   /// Shows t and the steps taken, at most twice a second, after the first 2 s.
   void update(double t, long steps);
+  /// Whether it shows anything (asked for, and stderr a terminal).
+  bool enabled() const { return enabled_; }
   ~ProgressReporter();
 
  private:
