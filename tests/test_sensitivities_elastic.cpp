@@ -87,17 +87,22 @@ TEST(SensitivitiesElastic, NodalRodMatchesWholeRuns) {
   checkAgainstWholeRuns("nodal rod", scene, paths, checks, 1e-4);
 }
 
+/// The crank's speed of an elastic slider crank: the deflection and the slider against
+/// whole runs at p (1 +- 1e-4).
+void checkCrankSpeed(const std::string& label, const json& scene, double tolerance) {
+  const std::string speed = "drivers[0].law.speed";
+  checkAgainstWholeRuns(label, scene, {speed}, {{0, speed, "mid.uy", tolerance}, {0, speed, "slider.x", tolerance}},
+                        1e-4);
+}
+
 TEST(SensitivitiesElastic, NodalRodCrankSpeedAtTightTolerances) {
   // The crank's speed of the nodal rod (2 elements, 5 ms) at rtol 1e-9, atol 1e-11: with
   // the three-point dF/dp (h = eps^(1/3) p) the error test chased its round-off in the
   // driver's rows down to h = 5e-15 and the run failed at t = 3.5 ms; the five-point
   // difference at h = 1e-3 p runs to the end (docs/sensitivities.md, "dF/dp"). Tolerance
   // as NodalRodMatchesWholeRuns.
-  const json scene = elasticSliderCrank(2, 0, 0.005, 1e-9, 1e-11);
-  const std::string speed = "drivers[0].law.speed";
   const double kTolerance = 1e-4;
-  checkAgainstWholeRuns("nodal rod", scene, {speed},
-                        {{0, speed, "mid.uy", kTolerance}, {0, speed, "slider.x", kTolerance}}, 1e-4);
+  checkCrankSpeed("nodal rod", elasticSliderCrank(2, 0, 0.005, 1e-9, 1e-11), kTolerance);
 }
 
 TEST(SensitivitiesElastic, ModalRodMatchesWholeRuns) {
@@ -105,12 +110,9 @@ TEST(SensitivitiesElastic, ModalRodMatchesWholeRuns) {
   // 5 ms, rtol 1e-10: no axial stiffness left, so the runs are cheap and tight. The crank's
   // speed (the initial velocities and the driver): the deflection and the slider. (The
   // rod's Young's modulus and section height: ModalRodSectionMatchesWholeRuns.)
-  const json scene = elasticSliderCrank(8, 2, 0.005, 1e-10, 1e-12);
-  const std::string speed = "drivers[0].law.speed";
   // run noise ~1e-10 / 1e-4 = 1e-6 relative, x 2, plus truncation ~1e-8
   const double kTolerance = 1e-5;
-  checkAgainstWholeRuns("modal rod", scene, {speed},
-                        {{0, speed, "mid.uy", kTolerance}, {0, speed, "slider.x", kTolerance}}, 1e-4);
+  checkCrankSpeed("modal rod", elasticSliderCrank(8, 2, 0.005, 1e-10, 1e-12), kTolerance);
 }
 
 // The normal modes of a modal body are computed afresh in each perturbed scene; without a
