@@ -118,9 +118,7 @@ class SystemIntegrals final : public IntegralOutputs {
   }
   /// The step of entry j of y: eps^(1/3) max(|y_j|, 1) (three-point difference).
   static double stepOf(double value) {
-    const double h = kCentralDifferenceFraction * std::max(std::fabs(value), 1.0);
-    const volatile double shifted = value + h;  // the step actually taken (Press et al. 2007, sec. 5.7)
-    return shifted - value;
+    return stepTaken(value, kCentralDifferenceFraction * std::max(std::fabs(value), 1.0));
   }
   /// dg_k/dy_j by a central difference at the unpacked state (restored after).
   double difference(int k, double t, int j) {
@@ -490,12 +488,9 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
       for (Eigen::Index i = 0; i < np; ++i) problem.atolQ(i, k) = choice.options.rtol * g / perturbed.scales[i];
     }
     ProgressReporter backwardProgress(settings.progress, t0, tEnd, "ida adjoint, backward", true);
-    const AdjointSolution backward = recording.integrateAdjoint(
-        problem, t0,
-        backwardProgress.enabled() ? std::function<void(double, long)>([&](double t, long steps) {
-          backwardProgress.update(t, steps);
-        })
-                                   : std::function<void(double, long)>());
+    std::function<void(double, long)> report;  // none where nothing is shown
+    if (backwardProgress.enabled()) report = [&](double t, long steps) { backwardProgress.update(t, steps); };
+    const AdjointSolution backward = recording.integrateAdjoint(problem, t0, report);
     // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);

@@ -16,6 +16,13 @@ namespace flexmbd {
 /// error h^2 |f^(3)| / 6 against the round-off eps |f| / h (Nocedal & Wright 2006, sec. 8.1).
 inline const double kCentralDifferenceFraction = std::cbrt(2.220446049250313e-16);
 
+/// The step x + h - x actually taken from x (exact in floating point, so the difference
+/// quotient divides by the step its points are apart; Press et al. 2007, sec. 5.7).
+inline double stepTaken(double x, double h) {
+  const volatile double shifted = x + h;
+  return shifted - x;
+}
+
 /// The five-point central difference of the parameter derivatives (fourth order,
 /// Abramowitz & Stegun 1964, eq. 25.3.6): f'(p) = sum_j w_j f(p + o_j h) / h + h^4 f^(5) / 30,
 /// with round-off sqrt(2 (8^2 + 1)) / 12 eps |f| / h = 0.95 eps |f| / h. Its points o_j h:

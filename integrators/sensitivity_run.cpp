@@ -19,10 +19,7 @@
 namespace flexmbd {
 
 double parameterStep(double p, double typical) {
-  const double h = kParameterStepFraction * (p != 0.0 ? std::fabs(p) : typical);
-  // the step actually taken: (p + h) - p, exact in floating point (Press et al. 2007, sec. 5.7)
-  const volatile double shifted = p + h;
-  return shifted - p;
+  return stepTaken(p, kParameterStepFraction * (p != 0.0 ? std::fabs(p) : typical));
 }
 
 MatX sensitivityTolerances(const VecX& atol, double frameAtol, double modelSize, const VecX& scales) {
