@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "core/stop_request.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 namespace flexmbd::cli {
 
-// ----- exit status of every command (README, "Command line") ---------------------------
+// ----- exit status of every command (docs/command-line.md) ---------------------------
 constexpr int kExitOk = 0;
 /// The solver failed or a run stopped early (results up to there kept); a kinematic
 /// analysis stopped at a singular position; a page, plot or eigensolver failed.
@@ -82,7 +82,7 @@ struct UsageError : std::runtime_error {
 };
 
 /// Longest message printed or written to a summary. Messages quote names and values
-/// shortened (io/json_reader.hpp); this bounds what a model error built elsewhere from a
+/// shortened (scene/json_reader.hpp); this bounds what a model error built elsewhere from a
 /// huge name could still carry.
 constexpr std::size_t kMaxMessageLength = 1000;
 
@@ -111,7 +111,7 @@ inline double parseNumberOption(const std::string& option, const std::string& te
     throw UsageError("option " + option + " expects a number, got '" + text + "'");
   }
   if (!std::isfinite(x)) throw UsageError("option " + option + " expects a finite number, got '" + text + "'");
-  if (std::fabs(x) > 1e100) {  // the bound of scene numbers (io/json_reader.hpp, kMaxInputMagnitude)
+  if (std::fabs(x) > 1e100) {  // the bound of scene numbers (scene/json_reader.hpp, kMaxInputMagnitude)
     throw UsageError("option " + option + " must be at most 1e100 in magnitude, got '" + text + "'");
   }
   return x;

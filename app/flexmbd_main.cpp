@@ -35,14 +35,14 @@
 #include "app/view_command.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
-#include "integrators/simulation.hpp"
-#include "io/output_lock.hpp"
-#include "io/json_reader.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene.hpp"
-#include "io/adjoint_results.hpp"
-#include "io/sensitivity_results.hpp"
-#include "io/vtk_writer.hpp"
+#include "simulation/simulation.hpp"
+#include "results/output_lock.hpp"
+#include "scene/json_reader.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene.hpp"
+#include "results/adjoint_results.hpp"
+#include "results/sensitivity_results.hpp"
+#include "results/vtk_writer.hpp"
 
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "0.1.0"  // keep in step with project(VERSION) in CMakeLists.txt
@@ -321,7 +321,7 @@ int runCommand(const Options& o) {
     return runTensegrityCommand({o.scenePath, o.outDir, o.tEnd, o.rtol, o.atol, o.quiet, o.vtk});
   }
   const std::filesystem::path outDir(o.outDir);
-  // One run at a time in DIR, before anything is written there (io/output_lock.hpp).
+  // One run at a time in DIR, before anything is written there (results/output_lock.hpp).
   std::optional<OutputLock> lock;
   try {
     lock.emplace(outDir);
@@ -344,7 +344,7 @@ int runCommand(const Options& o) {
       }
       s.tEnd = *o.tEnd;
     }
-    overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (integrators/tolerances.hpp)
+    overrideTolerances(s, o.rtol, o.atol);  // every class scaled together (simulation/tolerances.hpp)
     s.progress = !o.quiet;
     checkSolverSettings(s);
     request = sensitivityRequest(o, scene->sensitivity);

@@ -14,8 +14,8 @@
 #include "app/command_line.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
-#include "io/output_lock.hpp"
-#include "io/results_writer.hpp"
+#include "results/output_lock.hpp"
+#include "results/results_writer.hpp"
 #include "linkage/kinematic_analysis.hpp"
 #include "linkage/kinematics_scene.hpp"
 
@@ -146,7 +146,7 @@ int runKinematicsCommand(const std::vector<std::string>& args) {
     return kExitInputError;
   }
   const fs::path outDir(o.outDir);
-  std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
+  std::optional<OutputLock> lock;  // one run at a time in DIR (results/output_lock.hpp)
   try {
     lock.emplace(outDir);
   } catch (const std::exception& e) {

@@ -21,15 +21,16 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
-#include "integrators/linearization.hpp"
-#include "integrators/modal_sensitivity.hpp"
-#include "integrators/sensitivity_run.hpp"
-#include "integrators/simulation.hpp"
-#include "io/json_reader.hpp"
-#include "io/output_lock.hpp"
-#include "io/scene.hpp"
-#include "io/sensitivity_results.hpp"
-#include "io/vtk_writer.hpp"
+#include "analysis/linearization.hpp"
+#include "sensitivity/modal_sensitivity.hpp"
+#include "sensitivity/sensitivity_run.hpp"
+#include "simulation/reference_by_run.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/json_reader.hpp"
+#include "results/output_lock.hpp"
+#include "scene/scene.hpp"
+#include "results/sensitivity_results.hpp"
+#include "results/vtk_writer.hpp"
 
 namespace flexmbd {
 namespace {
@@ -228,7 +229,7 @@ void writeModesCsv(const fs::path& file, const std::vector<Mode>& modes,
   if (!out) throw writeFailure(file);
 }
 
-/// The eigenvalue sensitivities (integrators/modal_sensitivity.hpp) of `modes` with respect
+/// The eigenvalue sensitivities (sensitivity/modal_sensitivity.hpp) of `modes` with respect
 /// to each parameter: each perturbed scene's reference state found as the base's
 /// (initialReference: its consistent state or equilibrium, or --steady), linearised.
 /// @throws InputError naming the parameter when its perturbed model has no such state.

@@ -46,7 +46,7 @@ using cli::kExitInputError;
 
 const char* const kScriptName = "plot_results.py";
 
-/// The header row of a CSV file (RFC 4180 quoting, as io/results_writer.cpp writes it).
+/// The header row of a CSV file (RFC 4180 quoting, as results/results_writer.cpp writes it).
 std::vector<std::string> readHeader(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw cli::UsageError("plot: cannot open " + path.string());

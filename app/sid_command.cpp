@@ -8,8 +8,8 @@
 #include "bodies/sid_data.hpp"
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
-#include "io/scene.hpp"
-#include "io/sid_file.hpp"
+#include "scene/scene.hpp"
+#include "fe_import/sid_file.hpp"
 
 namespace flexmbd {
 

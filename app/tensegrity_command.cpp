@@ -11,9 +11,9 @@
 
 #include "app/command_line.hpp"
 #include "core/errors.hpp"
-#include "io/output_lock.hpp"
-#include "io/results_writer.hpp"
-#include "io/vtk_writer.hpp"
+#include "results/output_lock.hpp"
+#include "results/results_writer.hpp"
+#include "results/vtk_writer.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
 
 namespace flexmbd {
@@ -134,7 +134,7 @@ bool isTensegrityScene(const std::string& scenePath) { return isTensegritySceneF
 
 int runTensegrityCommand(const TensegrityRunOptions& o) {
   const std::filesystem::path outDir(o.outDir);
-  std::optional<OutputLock> lock;  // one run at a time in DIR (io/output_lock.hpp)
+  std::optional<OutputLock> lock;  // one run at a time in DIR (results/output_lock.hpp)
   try {
     lock.emplace(outDir);
   } catch (const std::exception& e) {

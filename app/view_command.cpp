@@ -15,9 +15,9 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "core/errors.hpp"
-#include "io/html_viewer.hpp"
-#include "io/results_table.hpp"
-#include "io/scene.hpp"
+#include "viewer/html_viewer.hpp"
+#include "results/results_table.hpp"
+#include "scene/scene.hpp"
 
 namespace flexmbd {
 namespace {

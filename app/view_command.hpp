@@ -1,7 +1,7 @@
 /// @file
 /// flexmbd view DIR: one self-contained HTML page that animates a run (or the mode shapes
 /// of `flexmbd modes`) in the browser, with plots of chosen results columns
-/// (io/html_viewer.hpp; docs/viewer.md).
+/// (viewer/html_viewer.hpp; docs/viewer.md).
 #pragma once
 
 #include <string>

@@ -1,4 +1,4 @@
-// Benchmark (issue 29): the cost of adjoint sensitivities. CPU of a plain IDA run and of a
+// Benchmark: the cost of adjoint sensitivities. CPU of a plain IDA run and of a
 // run with the gradient of one integral output by the adjoint method (forward run, its
 // segments recorded again, one backward integration with a quadrature per parameter),
 // as a ratio to the plain run, for p = 1, 10 and all parameters, against the issue's target
@@ -24,10 +24,10 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
-#include "integrators/adjoint_run.hpp"
-#include "io/adjoint_results.hpp"
-#include "io/results_writer.hpp"
-#include "io/sensitivity_results.hpp"
+#include "sensitivity/adjoint_run.hpp"
+#include "results/adjoint_results.hpp"
+#include "results/results_writer.hpp"
+#include "results/sensitivity_results.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -8,7 +8,7 @@
 // Configurations: the engine's model of the mechanism (examples/bari_slider_crank.json,
 // the general engine with no per-problem tuning: rtol = atol = tol as in the classic
 // codes' runs, the elastic coordinates' atol in the scene's ratio to atol) under IDA (GGL, index 1) and Radau IIA, and the hand-coded equations of
-// the test set (benchmarks/problems/bari_crank.*) under the same integrators.
+// the test set (problems/bari_crank.*) under the same integrators.
 #include <time.h>
 
 #include <cmath>
@@ -16,10 +16,10 @@
 #include <map>
 
 #include "benchmarks/bench_common.hpp"
-#include "benchmarks/problems/bari_crank.hpp"
+#include "problems/bari_crank.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/radau_solver.hpp"
-#include "io/scene.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::bench;

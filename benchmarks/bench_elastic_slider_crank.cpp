@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "benchmarks/bench_common.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// Benchmark: cost of a chain of N flexible links against N (issue 24, item 1). A planar
+// Benchmark: cost of a chain of N flexible links against N. A planar
 // pendulum chain: N steel links (0.3 m, 8 x 8 mm, 4 beam elements each reduced to 4 normal
 // modes under pinned-pinned reference conditions) on revolute joints, the first to the
 // ground at the origin, released horizontal under gravity; integrated over --span (default
@@ -14,8 +14,8 @@
 #include "benchmarks/bench_common.hpp"
 #include "benchmarks/bench_scenes.hpp"
 #include "core/dae_system.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::bench;

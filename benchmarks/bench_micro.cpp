@@ -6,7 +6,7 @@
 //   crank<N>     the elastic slider-crank (GGL) with N nodal rod elements (--elements)
 //   bari_ggl     Simeon's crank of the Bari test set (examples/bari_slider_crank.json), GGL
 //   bari_index1  the same, index 1
-//   bari_hand    the test set's hand-coded equations (benchmarks/problems/bari_crank.hpp)
+//   bari_hand    the test set's hand-coded equations (problems/bari_crank.hpp)
 //   rigid_crank  the rigid slider-crank (examples/slider_crank_rigid.json), GGL
 // After the runs: the cost of a Jacobian and of a refactorisation in residual evaluations
 // (target: a Jacobian costs at most a few residuals).
@@ -28,7 +28,7 @@
 
 #include "benchmarks/bench_common.hpp"
 #include "benchmarks/bench_scenes.hpp"
-#include "benchmarks/problems/bari_crank.hpp"
+#include "problems/bari_crank.hpp"
 #include "integrators/initial_conditions.hpp"
 
 using namespace flexmbd;

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Python module and parameter studies: what they cost (issue 15).
+"""Python module and parameter studies: what they cost.
 
 1. The flagship (examples/slider_crank_elastic_demo_nodal.json and ..._modal.json) run
    from Python (flexmbd.load_scene(...).run()) and by the command line (flexmbd run,

@@ -14,9 +14,9 @@
 #include "benchmarks/bench_common.hpp"
 #include "core/dae_system.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 using flexmbd::bench::Clock;

@@ -1,4 +1,4 @@
-// The rotor benchmark of issue 27, as EXUDYN's performance test runs it: the rotor with a
+// The rotor benchmark as EXUDYN's performance test runs it: the rotor with a
 // disc of ../shared/data/exudyn-rotor (Abaqus export, 115 nodes) as an "fe_body" with 8
 // free-free modes and the stiffness scaled by 0.01, a 0.1 kg unbalance on the disc's rim
 // (node 10), spinning at 50 rev/s about its axis (z) on two spring-damper bearings (the
@@ -11,7 +11,7 @@
 // distance over the outputs (every 1 ms), relative to the largest displacement of the
 // reference.
 //
-// EXUDYN's figure (issue 27): 20,000 implicit steps of 1e-4 s, 2.74 s for the 2 s on its
+// EXUDYN's figure: 20,000 implicit steps of 1e-4 s, 2.74 s for the 2 s on its
 // developers' machine, 4.4 to 5.4 s CPU measured on a machine like ours, a numerical
 // Jacobian 41 % of it; target: at least 5 times faster per simulated second at matched
 // accuracy.
@@ -28,8 +28,8 @@
 
 #include "benchmarks/bench_common.hpp"
 #include "bodies/ffr_body_3d.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using flexmbd::bench::CsvWriter;
@@ -108,7 +108,7 @@ Run runOnce(const Scene& scene, double rtol) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bench::Options opt("bench_rotor", "EXUDYN's rotor performance test (issue 27): CPU, steps and error per tolerance", 3);
+  bench::Options opt("bench_rotor", "EXUDYN's rotor performance test: CPU, steps and error per tolerance", 3);
   std::vector<std::string> rtols;
   double tEnd = 2.0;
   opt.addList("--rtol", "relative tolerances (default 1e-4,1e-5,1e-6,1e-7)", &rtols);
@@ -167,7 +167,7 @@ int main(int argc, char** argv) {
     csv.row({t, fmt(c), fmt(c / tEnd), std::to_string(last.stats.steps), std::to_string(last.stats.residualEvals),
              std::to_string(last.stats.jacobianEvals), fmt(err)});
   }
-  std::printf("\nEXUDYN (issue 27): 20,000 steps of 1e-4 s, 4.4 to 5.4 s CPU for 2 s on a machine like this one, "
+  std::printf("\nEXUDYN: 20,000 steps of 1e-4 s, 4.4 to 5.4 s CPU for 2 s on a machine like this one, "
               "2.2 to 2.7 s per simulated second\n");
   return 0;
 }

@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
   bool fixed = false;
   double accuracy = 1e-4, accuracySpan = 2 * M_PI / 150.0 / 8, budget = 120.0;
   std::vector<std::string> integratorNames;
-  opt.flag("--fixed-accuracy", "time per simulated second at a fixed midpoint-deflection accuracy (issue 10)", &fixed);
+  opt.flag("--fixed-accuracy", "time per simulated second at a fixed midpoint-deflection accuracy", &fixed);
   opt.addDouble("--accuracy", "relative midpoint-deflection accuracy of --fixed-accuracy (default 1e-4)", &accuracy);
   opt.addDouble("--accuracy-span", "simulated time of --fixed-accuracy (default 1/8 revolution)", &accuracySpan);
   opt.addDouble("--budget", "CPU seconds per run above which larger meshes are skipped (default 120)", &budget);

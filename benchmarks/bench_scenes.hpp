@@ -28,11 +28,11 @@
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/klu_ordering.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/ffr_test_models.hpp"
 #include "benchmarks/bench_common.hpp"
-#include "tests/reference_solutions.hpp"
+#include "problems/reference_solutions.hpp"
 
 namespace flexmbd::bench {
 

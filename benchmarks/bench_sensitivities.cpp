@@ -1,4 +1,4 @@
-// Benchmark (issue 29): the cost of forward sensitivities. CPU of a plain IDA run and of
+// Benchmark: the cost of forward sensitivities. CPU of a plain IDA run and of
 // runs with p = 1, 2, 4 parameters (IDAS, staggered corrector, sensitivity error control
 // on; and p = 4 with it off), each as a ratio to the plain run, against the issue's target of about 1 + 0.5 p
 // runs. Models: the rigid slider crank (examples/slider_crank_rigid.json, 10 revolutions)
@@ -20,9 +20,9 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
-#include "integrators/sensitivity_run.hpp"
-#include "io/results_writer.hpp"
-#include "io/sensitivity_results.hpp"
+#include "sensitivity/sensitivity_run.hpp"
+#include "results/results_writer.hpp"
+#include "results/sensitivity_results.hpp"
 
 using namespace flexmbd;
 

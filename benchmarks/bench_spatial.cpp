@@ -1,4 +1,4 @@
-// Benchmark of the spatial models (issue 13).
+// Benchmark of the spatial models.
 //
 // (a) Work precision, rtol from --max-rtol (1e-4) to --min-rtol (1e-10) by decades,
 //     atol = rtol / 100, GGL, IDA, automatic linear solver; CPU time of simulate()
@@ -49,11 +49,11 @@
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
-#include "tests/reference_solutions.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 using flexmbd::bench::CsvWriter;

@@ -1,7 +1,7 @@
-// Benchmark of the spatial flexible body (issue 14): the elastic slider crank of
+// Benchmark of the spatial flexible body: the elastic slider crank of
 // examples/slider_crank_elastic.json (8 rod elements, nodal, and 2 modes) as the planar
 // model and rebuilt of spatial bodies in the x-y plane with an FfrBody3d rod
-// (tests/ffr3d_crank_models.hpp: revolute bearing, spherical crank pin, universal joint at
+// (problems/ffr3d_crank_models.hpp: revolute bearing, spherical crank pin, universal joint at
 // the slider, prismatic rail, angle driver; the rod's 3D section with the planar A and
 // in-plane I).
 //
@@ -32,9 +32,9 @@
 #include "benchmarks/bench_common.hpp"
 #include "core/dae_system.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
-#include "tests/ffr3d_crank_models.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "simulation/simulation.hpp"
+#include "problems/ffr3d_crank_models.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 using flexmbd::bench::CsvWriter;

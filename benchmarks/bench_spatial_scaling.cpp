@@ -1,4 +1,4 @@
-// Benchmark: cost of a spatial flexible body against its mesh (issue 24, item 1).
+// Benchmark: cost of a spatial flexible body against its mesh.
 // examples/spatial_slider_crank_elastic.json with its rod meshed by 8, 16, ..., N spatial
 // beam elements (nodal, or reduced to --modes modes), integrated from t = 0 over --span
 // (default 0.01 s as in the issue) at rtol 1e-6, atol 1e-8 (the scene's), GGL, KLU, by
@@ -16,8 +16,8 @@
 #include "benchmarks/bench_scenes.hpp"
 #include "core/dae_system.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::bench;

@@ -1,4 +1,4 @@
-// Issue 25, item 6: end error against the tolerance on the free A05 stiff flyball governor
+// End error against the tolerance on the free A05 stiff flyball governor
 // (docs/stability.md, section 7; tests/test_stiff_spatial_accuracy.cpp asserts the bound).
 // The governor of examples/flyball_governor.json without its motor, spun at 2 pi rad/s from
 // the 30 deg configuration, 2 s, outputs every 0.01 s; variants: "soft" (k and c / 100),
@@ -17,9 +17,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "integrators/simulation.hpp"
-#include "integrators/tolerances.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "simulation/tolerances.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -1,4 +1,4 @@
-// Benchmark: time per step of method 1 (inextensible cables, one LCP per step, issue 6)
+// Benchmark: time per step of method 1 (inextensible cables, one LCP per step)
 // against the number of cables, for the LCP solvers behind tensegrity/lcp_solver.hpp
 // (Siconos lexicographic Lemke and projected Gauss-Seidel).
 //

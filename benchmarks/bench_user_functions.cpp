@@ -1,4 +1,4 @@
-// User functions (issue 28, item 3): what a C++ callable costs per call against the
+// User functions: what a C++ callable costs per call against the
 // built-in law it replaces.
 //  1. A time law's value f(t) called directly, 10^7 times: the built-in harmonic law and
 //     the same law as a user law (std::function behind the TimeLaw interface, the call
@@ -22,7 +22,7 @@
 
 #include "builders/planar_builders.hpp"
 #include "core/user_function.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace flexmbd;
 

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""User functions from Python (issue 28, item 3): the overhead per call of a Python callable.
+"""User functions from Python: the overhead per call of a Python callable.
 
 A pendulum driven by a harmonic torque (50 s, outputs every 0.01 s) and a slider on a
 spring-damper, each run with the built-in law and with the same law as a Python

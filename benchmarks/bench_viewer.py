@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The browser viewer (issue 28, item 1): page size, the time `flexmbd view` takes to
+"""The browser viewer: page size, the time `flexmbd view` takes to
 write it, and the time headless Chromium takes to show its first frame, for the demo's
 3-revolution nodal run (examples/slider_crank_elastic_demo_nodal.json, 541 frames).
 

@@ -1,4 +1,4 @@
-// Diagnosis (issue 24, item 2): why a scene takes the steps it takes. Runs a scene with
+// Diagnosis: why a scene takes the steps it takes. Runs a scene with
 // SUNDIALS IDA one step at a time (dense LU, the engine's residual and Jacobian) and
 // records per step the size and order, and which unknown dominates the weighted local
 // error estimate (IDAGetEstLocalErrors x IDAGetErrWeights), grouped by coordinate class
@@ -21,9 +21,9 @@
 
 #include "core/dae_system.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/quasi_static_start.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "analysis/quasi_static_start.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 

@@ -1,6 +1,6 @@
 /// @file
 /// The data of a flexible body exported from a finite element code (Abaqus, Ansys: the
-/// readers in io/fe_abaqus.hpp and io/fe_ansys.hpp): nodes, elements, node sets, the
+/// readers in fe_import/fe_abaqus.hpp and fe_import/fe_ansys.hpp): nodes, elements, node sets, the
 /// degree-of-freedom map and the sparse mass and stiffness matrices. docs/fe-import.md.
 #pragma once
 

@@ -1,6 +1,6 @@
 /// @file
 /// A spatial floating-frame-of-reference body from a finite element mesh (FeBodyData from
-/// io/fe_abaqus.hpp, io/fe_ansys.hpp or io/fe_calculix.hpp): the inertia invariants
+/// fe_import/fe_abaqus.hpp, fe_import/fe_ansys.hpp or fe_import/fe_calculix.hpp): the inertia invariants
 /// (FfrInvariants3d) computed from the FE mass matrix and the nodal coordinates (solid
 /// elements, 3 DOF per node: exact; beams and shells, 6 DOF per node: exact for the rigid
 /// motions, the rest lumped at the nodes), reduced to free-free normal modes about mean

@@ -1,8 +1,8 @@
 /// @file
-/// Stresses of imported FE bodies (issue 27, item 4; docs/fe-import.md "Stresses"): the
+/// Stresses of imported FE bodies (docs/fe-import.md "Stresses"): the
 /// nodal stress fields an FE code computed for some displacement fields of the body (its
 /// modes, its static load cases: CalculiX .frd DISP and STRESS blocks, read by
-/// io/fe_calculix.hpp stressSamplesFromFrd) give, by linearity,
+/// fe_import/fe_calculix.hpp stressSamplesFromFrd) give, by linearity,
 /// the stress shape of each coordinate of the reduced body, sigma = S q_f; von Mises of it.
 #pragma once
 

@@ -76,7 +76,7 @@ void SpatialBeam::InertiaAssembly::add(const Element& el, const ElementRows& idx
     for (int b = 0; b < kElementDofs; ++b) {
       // S_kl keep their exact zeros out: an element along a body axis moves its
       // coordinates in one direction each (S_xx has only axial entries), and the body
-      // walks the stored entries at every evaluation (issue 24)
+      // walks the stored entries at every evaluation
       for (int kl = 0; kl < 9; ++kl) {
         if (skl[kl](a, b) != 0.0) tS_[kl].emplace_back(idx[a], idx[b], skl[kl](a, b));
         if (rkl[kl](a, b) != 0.0) tR_[kl].emplace_back(idx[a], idx[b], rkl[kl](a, b));

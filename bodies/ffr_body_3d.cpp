@@ -330,7 +330,7 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
   auto of = out.tail(nf_);
-  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated; issue 24): the
+  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated): the
   // quadratic part of J (for I aw), Y af = X0 af + (qf^T W_i af)_i and the rows f' part
   // Y^T aw = X0^T aw + sum_i aw_i W_i^T qf, W_i = sign (S_kl - S_kl^T) (skewPairOf)
   Mat3 quadratic = Mat3::Zero();
@@ -434,7 +434,7 @@ void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   const Vec3 sp = inv_.sBar * pf;
   Q.head<3>() -= A * (Om * s + 2.0 * ws * sp);
   auto Qf = Q.tail(nf_);
-  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated; issue 24): the
+  // One walk over the six stored S_kl (k <= l; S_lk = S_kl^T, validated): the
   // quadratic parts of J (qf^T S_kl qf) and G (qf'^T S_kl qf), and into Q_f -Om_kl S_kl qf
   // (with S_lk qf = S_kl^T qf; Om symmetric) and the Coriolis term 2 w_i W_i qf'.
   Mat3 quadratic = Mat3::Zero(), Gq = Mat3::Zero();

@@ -1,5 +1,5 @@
 /// @file
-/// Spatial flexible body in the floating frame of reference formulation (issue 14).
+/// Spatial flexible body in the floating frame of reference formulation.
 #pragma once
 
 #include <array>

@@ -5,7 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseLU>
 // GCC 12 warns -Wuse-after-free inside Spectra (Eigen temporaries freed and reallocated
-// by resize): a false positive of its inlining analysis (as integrators/linearization.cpp).
+// by resize): a false positive of its inlining analysis (as analysis/linearization.cpp).
 #if defined(__GNUC__) && !defined(__clang__) && __GNUC__ >= 12
 #pragma GCC diagnostic ignored "-Wuse-after-free"
 #endif
@@ -85,7 +85,7 @@ void largestOfPencil(const SpMat& A, const SpMat& C, int nev, const std::string&
   if (cop.info() != Spectra::CompInfo::Successful) throw InputError(owner + ": " + notDefinite);
   Spectra::SparseSymMatProd<double> mop(A);
   // an even Krylov subspace of 2 nev + 2 (at least 20): the odd 2 nev + 1 stalled the same
-  // Lanczos in the linearisation's modes (integrators/linearization.cpp) at 9 of 10 values
+  // Lanczos in the linearisation's modes (analysis/linearization.cpp) at 9 of 10 values
   const int ncv = std::min(n, std::max(2 * nev + 2, 20));
   Spectra::SymGEigsSolver<Spectra::SparseSymMatProd<double>, Spectra::SparseCholesky<double>,
                           Spectra::GEigsMode::Cholesky>

@@ -3,7 +3,7 @@
 /// flexible body modeling in multibody system codes, Part I", Mech. Struct. Mach. 22(3);
 /// Schwertassek & Wallrapp, Dynamik flexibler Mehrkoerpersysteme, 1999, ch. 6): the reduced
 /// body as Taylor objects in its elastic coordinates q, and its conversion to and from
-/// flexmbd's spatial invariants (FfrInvariants3d). The text file is io/sid_file.hpp; the
+/// flexmbd's spatial invariants (FfrInvariants3d). The text file is fe_import/sid_file.hpp; the
 /// blocks, their conventions and what is checked: docs/fe-import.md, "SID".
 #pragma once
 

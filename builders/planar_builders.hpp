@@ -2,7 +2,7 @@
 /// Convenience builders of planar models (the C++ API most users need): free functions
 /// that make a concrete body, joint, driver or force and add it to a System through its
 /// generic addBody / addConstraint / addForce. Kept out of core/ so that the core does not
-/// depend on the concrete bodies, joints and forces (issue 13).
+/// depend on the concrete bodies, joints and forces.
 #pragma once
 
 #include <string>

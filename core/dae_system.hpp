@@ -142,7 +142,7 @@ class DaeSystem final : public DaeProblem {
   /// Per body with T != I: the structural non-zeros of T (nq x nv) and T+ (nv x nq), each in
   /// a square pattern of size nq (empty for T = I). Built once: a body's T is sparse (the
   /// identity on elastic coordinates), and assembling it densely made the Jacobian pattern
-  /// of a spatial flexible body quadratic in its mesh (issue 24).
+  /// of a spatial flexible body quadratic in its mesh.
   std::vector<SparsePattern> ratePattern_, rateInversePattern_;
 };
 

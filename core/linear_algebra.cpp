@@ -35,7 +35,7 @@ std::vector<int> dependentRows(const MatX& A, double rankTolerance) {
   // Householder QR of A^T column by column in natural order (Eigen's SparseQR moves a column
   // whose remainder is below the pivot threshold to the end): with unit columns, a row is
   // dependent when its remainder after the earlier rows is below rankTolerance of its norm.
-  // Sparse: O(nnz) for a chain, where the dense Gram-Schmidt was O(m^2 n) (issue 26, D10).
+  // Sparse: O(nnz) for a chain, where the dense Gram-Schmidt was O(m^2 n).
   const SpMat At = unitRowsTransposed(A);
   Eigen::SparseQR<SpMat, Eigen::NaturalOrdering<int>> qr;
   qr.setPivotThreshold(rankTolerance);

@@ -1,8 +1,8 @@
 /// @file
 /// Input values that are positive but numerically meaningless next to the rest of the
-/// model (issue 26, D2): one bound for the smallest magnitude of any positive scene value
+/// model: one bound for the smallest magnitude of any positive scene value
 /// and one for the spread of the values of one kind (masses, inertias, stiffnesses, lengths);
-/// the same smallest magnitude for the length of an axis or direction (D22).
+/// the same smallest magnitude for the length of an axis or direction .
 #pragma once
 
 #include <string>
@@ -13,7 +13,7 @@
 namespace flexmbd {
 
 /// Smallest positive magnitude of a physical value: the inverse of the largest one read
-/// (1e100, io/json_reader.hpp), so that products and quotients of three values stay
+/// (1e100, scene/json_reader.hpp), so that products and quotients of three values stay
 /// normal doubles (1e-300 to 1e300); a subnormal mass (5e-324) gives 1/m = inf.
 constexpr double kMinPositiveMagnitude = 1e-100;
 

@@ -3,7 +3,7 @@
 /// decimal notation for magnitudes from 1e-4 to 1e6 ("-80", "0.001", "123456.5") and in
 /// exponent notation outside ("1e-08", "2.5e+20"). "%.1g" alone would print -80 as
 /// "-8e+01" (it reads back exactly, but no reader expects it). fmt() is the one number
-/// formatter of the engine's messages (issue 13): shortest by default, or a fixed number
+/// formatter of the engine's messages: shortest by default, or a fixed number
 /// of significant digits.
 #pragma once
 

@@ -1,13 +1,13 @@
 /// @file
 /// Stopping a run from outside (SIGINT/SIGTERM in the command line, Ctrl-C in Python)
-/// without waiting for the next output row (issue 26, item 8): the integrators' inner
+/// without waiting for the next output row: the integrators' inner
 /// loops (every residual of the model's DAE, every ALI3-P, CVODE, time-stepping and
 /// kinematics step) call pollStop(), which runs the check the thread's caller installed.
 #pragma once
 
 namespace flexmbd {
 
-/// A check that throws (RunInterrupted, integrators/simulation.hpp) to stop the run; `t` is
+/// A check that throws (RunInterrupted, simulation/simulation.hpp) to stop the run; `t` is
 /// the time being computed. It must be cheap: it runs at every residual evaluation.
 using StopPoll = void (*)(double t);
 

@@ -18,8 +18,8 @@ namespace flexmbd {
 /// spatial bodies in one model), constraints (joints and drivers) and force elements,
 /// with gravity. Build phase: add*; then finalize(); afterwards the model is immutable
 /// and add* throws InputError. Body 0 is the ground ("ground"). Movable, not copyable.
-/// Integrated by simulate() (integrators/simulation.hpp); read from a scene file by
-/// loadScene() (io/scene.hpp); built in code with the free functions of
+/// Integrated by simulate() (simulation/simulation.hpp); read from a scene file by
+/// loadScene() (scene/scene.hpp); built in code with the free functions of
 /// builders/planar_builders.hpp and builders/spatial_builders.hpp.
 class System {
  public:

@@ -137,16 +137,16 @@ class SpinUpLaw final : public TimeLaw {
     const double T = rampTime_;
     if (t <= 0.0) {
       // At rest before the ramp: theta, theta', theta'' all vanish at t = 0, so
-      // holding the initial value keeps the law C2 there (extension of issue 2).
+      // holding the initial value keeps the law C2 there.
       return {initial_, 0.0, 0.0};
     }
     if (t >= T) {
-      // theta = w (t - T/2) after the ramp (issue 2).
+      // theta = w (t - T/2) after the ramp.
       return {initial_ + w * (t - 0.5 * T), w, 0.0};
     }
     const double x = 2.0 * kPi * t / T;
     const double r = T / (2.0 * kPi);
-    // theta = (w/T)(t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)) (issue 2); the
+    // theta = (w/T)(t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1)); the
     // derivatives follow by differentiating it: theta' = (w/T)(t - (T/(2 pi)) sin),
     // theta'' = (w/T)(1 - cos). cos - 1 = -2 sin^2(x/2) avoids cancellation at small t.
     const double sh = std::sin(0.5 * x);

@@ -43,7 +43,7 @@ TimeLawPtr makePolynomialLaw(std::vector<double> coefficients);
 /// f(t) = offset + amplitude * sin(omega t + phase).
 TimeLawPtr makeHarmonicLaw(double amplitude, double omega, double phase = 0.0,
                            double offset = 0.0);
-/// Smooth spin-up to angular speed w over time T (issue 2):
+/// Smooth spin-up to angular speed w over time T:
 ///   theta(t) = (w/T) (t^2/2 + (T/(2 pi))^2 (cos(2 pi t/T) - 1))  for t < T,
 ///   theta(t) = w (t - T/2)                                        for t >= T;
 /// plus `initial`. Continuous up to the second derivative at t = T. For t <= 0 the

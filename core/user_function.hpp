@@ -1,5 +1,5 @@
 /// @file
-/// User functions (issue 28, item 3): time laws and spring-damper laws given as callables
+/// User functions: time laws and spring-damper laws given as callables
 /// (C++ std::function, or Python callables wrapped into one by the Python module), with
 /// their derivatives from the user or by central finite differences.
 #pragma once

@@ -10,8 +10,8 @@ namespace {
 
 // The planar element is the spatial BeamElement3d restricted to its x-y plane: its six
 // coordinates (u1, v1, psi1, u2, v2, psi2) are the spatial element's (u, v, tz) at both
-// nodes (psi = v' = tz), every integral and matrix the corresponding block (issue 25:
-// one element code for planar and spatial).
+// nodes (psi = v' = tz), every integral and matrix the corresponding block (one element
+// code for planar and spatial).
 constexpr int kInPlane[6] = {0, 1, 5, 6, 7, 11};
 
 BeamElement2d::Mat6 inPlane(const BeamElement3d::Mat12& A) {

@@ -19,7 +19,7 @@ namespace flexmbd {
 ///
 /// Everything constant is computed once, at construction, as the x-y restriction of the
 /// spatial BeamElement3d along the element's axis (its coordinates u, v, tz; one element
-/// code for planar and spatial, issue 25): 5-point Gauss-Legendre quadrature, exact for
+/// code for planar and spatial): 5-point Gauss-Legendre quadrature, exact for
 /// polynomials up to degree 9 (the integrands here reach 6). The strain energy is
 /// BeamStrainEnergy, shared with the spatial element.
 class BeamElement2d {
@@ -87,8 +87,8 @@ class BeamElement2d {
   /// eps = u' (linear model) or, with geometric stiffening, the element-averaged
   /// second-order strain eps_m = u' + (1/2l) int_0^l v'^2 dx = a e + e^T G e / (2l)
   /// (constant along the element). The pointwise u' + v'^2/2 cannot vanish in bending
-  /// with a linear u and a cubic v and locks coarse meshes (membrane locking, issue 11
-  /// item 8; docs/flexible-bodies.md); the averaged strain is the standard remedy.
+  /// with a linear u and a cubic v and locks coarse meshes (membrane locking;
+  /// docs/flexible-bodies.md); the averaged strain is the standard remedy.
   double strainEnergy(const Vec6& e, bool stiffening) const;
   /// dU/de and d2U/de2 (for the linear model: K e and K).
   Vec6 strainEnergyGradient(const Vec6& e, bool stiffening) const;

@@ -161,7 +161,7 @@ class BeamElement3d {
   /// R_zz = -rho Iy int tx^T tx dx, others zero,
   /// so the polar moment (J_yy + J_zz of a shaft along x) does not change by the twist
   /// and a section's second moments turn with it (Iz cos^2 + Iy sin^2). Without it a
-  /// spinning shaft loses torsional stiffness Omega^2 rho Ip per length (issue 25).
+  /// spinning shaft loses torsional stiffness Omega^2 rho Ip per length.
   /// The body adds it to int rho u u^T dV only (its rotational inertia); the first-order
   /// field S is unchanged. @throws std::out_of_range unless 0 <= k, l <= 2.
   const Mat12& sectionRotationMoment(int k, int l) const;

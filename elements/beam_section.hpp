@@ -7,7 +7,7 @@
 
 namespace flexmbd {
 
-/// The beam theory of an element (issue 25; docs/spatial-flexible.md):
+/// The beam theory of an element (docs/spatial-flexible.md):
 /// Euler-Bernoulli keeps the centre line's inertia and the sections' rotation by the
 /// twist; Rayleigh adds the rotary inertia of the sections turned by the bending slopes
 /// (rho I int v'^2 dx: the gyroscopic moments of a spinning shaft). Both keep the

@@ -9,7 +9,7 @@
 
 #include "bodies/ffr_body_2d.hpp"
 #include "builders/planar_builders.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 int main(int argc, char** argv) {
   using namespace flexmbd;

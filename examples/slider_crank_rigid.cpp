@@ -4,7 +4,7 @@
 #include <cstdio>
 
 #include "builders/planar_builders.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 int main() {
   using namespace flexmbd;

@@ -9,7 +9,7 @@
 /// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) stays regular where the
 /// constraint Jacobian G loses rank, so it carries a mechanism through the isolated
 /// singular positions (change points, dead centres) where the index-2 and index-3 DAE
-/// integrators stop: the engine uses it as a bridge across them (integrators/simulation.cpp)
+/// integrators stop: the engine uses it as a bridge across them (simulation/simulation.cpp)
 /// and as an integrator of its own ("ali3p").
 ///
 /// Models whose velocities are not coordinate rates (q' = T(q) v: spatial bodies with Euler

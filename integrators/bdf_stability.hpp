@@ -1,6 +1,6 @@
 /// @file
 /// The highest BDF order that is stable for the damped elastic modes of a model
-/// (issue 11, item 10; docs/formulations.md, "BDF order and damped elastic modes").
+/// (docs/formulations.md, "BDF order and damped elastic modes").
 #pragma once
 
 #include <string>

@@ -58,7 +58,7 @@ enum class IntegratorKind {
   /// Index-3 augmented Lagrangian with projections, trapezoidal rule (order 2), stays
   /// regular at singular positions (integrators/augmented_lagrangian_integrator.hpp)
   AugmentedLagrangian,
-  /// Chosen by the run from the model (integrators/integrator_choice.hpp): a setting, not
+  /// Chosen by the run from the model (simulation/integrator_choice.hpp): a setting, not
   /// an integrator (makeIntegrator refuses it).
   Automatic,
 };

@@ -22,7 +22,7 @@ namespace flexmbd {
 ///   - CAMD with the multipliers last (pivot threshold 1e-6);
 ///   - CAMD with the frame coordinates and the multipliers last (pivot threshold 1e-6).
 /// A large flexible body fills quadratically with KLU's own, a chain of flexible links
-/// quadratically with frames-and-multipliers-last (issue 24; the fills of every candidate:
+/// quadratically with frames-and-multipliers-last (the fills of every candidate:
 /// bench_spatial_scaling and bench_flexible_chain). Models without elastic coordinates (DaeProblem::eliminationGroups() without
 /// a group 0) keep KLU's own without trials.
 class KluOrdering {

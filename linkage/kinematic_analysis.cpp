@@ -269,13 +269,13 @@ SingularPosition KinematicAnalysis::locate(const KinematicState& regular, double
 namespace {
 
 /// Largest magnitude a result may have: the bound of scene numbers (kMaxInputMagnitude,
-/// io/json_reader.hpp). Inputs within it can still give results beyond it (an input
-/// acceleration of 1e100 rad/s^2 on a 30 cm crank: 3e101 m/s^2; issue 26).
+/// scene/json_reader.hpp). Inputs within it can still give results beyond it (an input
+/// acceleration of 1e100 rad/s^2 on a 30 cm crank: 3e101 m/s^2).
 constexpr double kMaxResultMagnitude = 1e100;
 
 /// The first quantity of a state that is non-finite or beyond kMaxResultMagnitude, with
 /// what is wrong ("" if none): a run never reports a position, transfer function,
-/// velocity or acceleration that is inf, NaN (issue 11) or absurdly large.
+/// velocity or acceleration that is inf, NaN or absurdly large.
 std::string firstOutOfRange(const KinematicState& s) {
   const std::pair<Eigen::ArrayXd, const char*> parts[] = {
       {s.x.array(), "positions"},

@@ -1,10 +1,10 @@
 // Strict reader of kinematics scene files (docs/kinematics.md). Same conventions as
-// io/scene.cpp: unknown keys first, then types and ranges; one-line errors
+// scene/scene.cpp: unknown keys first, then types and ranges; one-line errors
 // "<location>: <what is wrong>, got <what was found>".
 #include "linkage/kinematics_scene.hpp"
 
-#include "io/json_reader.hpp"
-#include "io/scene_keys.hpp"
+#include "scene/json_reader.hpp"
+#include "scene/scene_keys.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,13 +14,13 @@
 #include "core/errors.hpp"
 #include "core/stop_request.hpp"
 #include "core/system.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 namespace flexmbd::pybind {
 
 namespace py = pybind11;
 
-/// Ctrl-C during a run (issue 26, D7): while it lives, the run's stop check
+/// Ctrl-C during a run: while it lives, the run's stop check
 /// (core/stop_request.hpp) gives Python's signal handlers a turn every 0.1 s (the GIL taken
 /// for it); an exception one raises (KeyboardInterrupt) stops the run within its step, and
 /// raiseIfInterrupted() raises it in Python once the run has returned. Made on the thread

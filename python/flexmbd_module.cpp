@@ -21,14 +21,15 @@
 #include "builders/planar_builders.hpp"
 #include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
-#include "integrators/linearization.hpp"
-#include "integrators/simulation.hpp"
-#include "io/json_reader.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene.hpp"
-#include "io/scene_path.hpp"
-#include "io/adjoint_results.hpp"
-#include "io/sensitivity_results.hpp"
+#include "analysis/linearization.hpp"
+#include "simulation/reference_by_run.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/json_reader.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene.hpp"
+#include "scene/scene_path.hpp"
+#include "results/adjoint_results.hpp"
+#include "results/sensitivity_results.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tensegrity/tensegrity_scene.hpp"
 #include "bindings_support.hpp"
@@ -76,7 +77,7 @@ RunOutput runScene(Scene& scene, bool progress) {
 }
 
 /// The run of the scene `text` with forward sensitivities with respect to `paths`
-/// (io/sensitivity_results.hpp): the table holds the scene's columns, then the
+/// (results/sensitivity_results.hpp): the table holds the scene's columns, then the
 /// d<column>/d<path> columns, as results.csv of `flexmbd run --sensitivity`; the summary
 /// has the "sensitivities" gradients.
 RunOutput runSceneWithSensitivities(const std::string& text, const std::string& source,
@@ -108,7 +109,7 @@ RunOutput runSceneWithSensitivities(const std::string& text, const std::string& 
 }
 
 /// The run of the scene `text` with the gradients of the integral outputs `specs`
-/// ("KIND:COLUMN") with respect to `paths` by the adjoint method (io/adjoint_results.hpp):
+/// ("KIND:COLUMN") with respect to `paths` by the adjoint method (results/adjoint_results.hpp):
 /// the table of a plain run; the summary's "sensitivities" has the values and gradients, as
 /// `flexmbd run --adjoint`. A failed backward integration fails the run (rows kept).
 RunOutput runSceneWithAdjoint(const std::string& text, const std::string& source, const std::vector<std::string>& paths,
@@ -511,7 +512,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("body"), "index of the body's first coordinate in the system's coordinates (after finalize())");
   bindSpatial(m, systemClass);
 
-  // ----- solver settings (integrators/simulation.hpp) ------------------------------------
+  // ----- solver settings (simulation/simulation.hpp) ------------------------------------
   py::class_<SolverSettings>(m, "SolverSettings",
                               "How a run integrates: the scene's \"solver\" object (docs/scene-format.md, \"Solver\")")
       .def(py::init<>(), "The defaults of a scene that omits every solver key")
@@ -623,7 +624,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           py::arg("count") = 10, py::arg("steady") = false, py::arg("at") = py::none(),
           "Modes of the model linearised about its consistent initial state (static equilibrium if at rest, "
           "planar or spatial), steady=True about the steady motion at its initial velocities, or at=T about "
-          "the state a run reaches at time T (integrators/linearization.hpp): "
+          "the state a run reaches at time T (analysis/linearization.hpp): "
           "dicts of eigenvalue, omega (rad/s), frequency_hz, damping_ratio, shape (velocity space)")
       .def_property_readonly("velocity_names", [](Scene& s) {
         if (!s.system.isFinalized()) s.system.finalize();
@@ -824,5 +825,5 @@ PYBIND11_MODULE(_flexmbd, m) {
       },
       py::arg("path"),
       "The keys (str) and list indices (int) of a dotted scene path 'bodies[1].section.area', parsed by the "
-      "engine's one parser of the syntax (io/scene_path.hpp); InputError \"override '<path>': ...\" otherwise");
+      "engine's one parser of the syntax (scene/scene_path.hpp); InputError \"override '<path>': ...\" otherwise");
 }

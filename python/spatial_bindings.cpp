@@ -18,7 +18,7 @@
 #include "user_functions.hpp"
 #include "bodies/fe_body_model.hpp"
 #include "bodies/sid_data.hpp"
-#include "io/sid_file.hpp"
+#include "fe_import/sid_file.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
@@ -26,8 +26,8 @@
 #include "builders/spatial_builders.hpp"
 #include "core/magnitude_checks.hpp"
 #include "elements/beam_section.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/fe_ansys.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "fe_import/fe_ansys.hpp"
 #include "joints/world_frames.hpp"
 
 namespace flexmbd::pybind {
@@ -569,7 +569,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           },
           py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
 
-  // ----- the SID of a body (bodies/sid_data.hpp, io/sid_file.hpp) ----------------------------
+  // ----- the SID of a body (bodies/sid_data.hpp, fe_import/sid_file.hpp) ----------------------------
   m.def(
       "write_sid", [](const FfrInvariants3d& inv, const std::string& path) { writeSidFile(sidFromInvariants(inv), path); },
       py::arg("invariants"), py::arg("path"),
@@ -579,7 +579,7 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       py::arg("path"), py::arg("owner") = "SID body",
       "The invariants of a SID text file; InputError names the file and line, or the block and entry");
 
-  // ----- bodies from FE codes (bodies/fe_body_model.hpp, io/fe_abaqus.hpp, io/fe_ansys.hpp) ----
+  // ----- bodies from FE codes (bodies/fe_body_model.hpp, fe_import/fe_abaqus.hpp, fe_import/fe_ansys.hpp) ----
   py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
       .def_property_readonly("num_nodes", &FeBodyData::numNodes, "number of nodes")
       .def_property_readonly("num_dofs", &FeBodyData::numDofs, "number of degrees of freedom of M and K")

@@ -1,4 +1,4 @@
-// Python callables as the engine's user functions (core/user_function.hpp, issue 28 item 3):
+// Python callables as the engine's user functions (core/user_function.hpp):
 // a py::function wrapped into the std::function the C++ API takes. Runs release the GIL
 // (Scene._run); a wrapper takes it only while the callable runs, and turns a Python
 // exception into a C++ exception whose message is "<type>: <message>", which the engine

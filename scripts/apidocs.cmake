@@ -1,4 +1,4 @@
-# The API reference (issue 28, item 6): the C++ headers through Doxygen (docs/Doxyfile)
+# The API reference: the C++ headers through Doxygen (docs/Doxyfile)
 # into OUT/html, and the Python package's docstrings through pydoc into OUT/python.
 #
 #   cmake -DSOURCE_DIR=<root> -DOUT=<folder> [-DDOXYGEN=doxygen] [-DPYTHON=<python3>

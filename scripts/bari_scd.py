@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """scd of a `flexmbd run examples/bari_slider_crank.json` at t = 0.1: -log10 of the largest
 relative error of the positions phi2, x3, q1..q4 against the Bari test set's reference
-(benchmarks/problems/bari_crank.hpp, kReferencePositions; the test set's measure).
+(problems/bari_crank.hpp, kReferencePositions; the test set's measure).
 
 usage: scripts/bari_scd.py OUT_DIR [OUT_DIR ...]   (reads OUT_DIR/results.csv)
 """
@@ -9,7 +9,7 @@ import csv
 import math
 import sys
 
-REFERENCE = {  # t = 0.1: phi2, x3, q1..q4 (benchmarks/problems/bari_crank.hpp)
+REFERENCE = {  # t = 0.1: phi2, x3, q1..q4 (problems/bari_crank.hpp)
     "rod.theta": -0.3311734988256260,
     "slider.x": 0.1697373328427860,
     "rod.q1": 1.893192899613509e-4,

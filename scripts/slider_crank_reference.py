@@ -1,6 +1,6 @@
 """Closed form of the centred slider-crank with a rigid rod, shared by the scripts
 (print_table.py, demo_report.py, plot_kinematics.py); the C++ tests and benchmarks use
-the same formulas from tests/reference_solutions.hpp.
+the same formulas from problems/reference_solutions.hpp.
 
 Crank l1, rod l2, crank angle a (source document 000, eqs. 30-32, for a' = 1, a'' = 0):
   x      = l1 cos a + sqrt(l2^2 - l1^2 sin^2 a)

@@ -72,7 +72,7 @@ MasslessCableIntegrator::MasslessCableIntegrator(const TensegrityStructure& s, c
   }
   if (!(o.tEnd > o.tStart)) throw InputError("solver.t_end must be > t_start, got " + num(o.tEnd));
   if (!(o.outputStep > 0.0)) throw InputError("solver.output_step must be > 0, got " + num(o.outputStep));
-  if (!((o.tEnd - o.tStart) / o.outputStep <= 1e8)) {  // as `run` (integrators/simulation.cpp, kMaxOutputs)
+  if (!((o.tEnd - o.tStart) / o.outputStep <= 1e8)) {  // as `run` (simulation/simulation.cpp, kMaxOutputs)
     throw InputError("solver.output_step: at most 1e8 outputs over t_end - t_start expected, got " +
                      num((o.tEnd - o.tStart) / o.outputStep));
   }

@@ -1,10 +1,10 @@
-// Strict reader of tensegrity scenes (docs/tensegrity.md), in the manner of io/scene.cpp:
+// Strict reader of tensegrity scenes (docs/tensegrity.md), in the manner of scene/scene.cpp:
 // every object is checked for unknown keys first, every number for type and
 // finiteness, every node name against the nodes defined.
 #include "tensegrity/tensegrity_scene.hpp"
 
-#include "io/json_reader.hpp"
-#include "io/scene_keys.hpp"
+#include "scene/json_reader.hpp"
+#include "scene/scene_keys.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "tensegrity/self_equilibrium.hpp"
 
 namespace flexmbd {

@@ -1,5 +1,5 @@
 #include "tensegrity/tensegrity_time_stepper.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -43,7 +43,7 @@ std::vector<std::string> tensegrityColumns(const TensegrityStructure& s) {
 }
 
 void tensegrityRow(const TensegrityStructure& s, const TensegritySample& smp, std::vector<double>& values) {
-  // A row with a non-finite value is not written: the run stops there (issue 11).
+  // A row with a non-finite value is not written: the run stops there.
   const auto check = [&](bool finite, const std::string& what) {
     if (!finite) {
       std::ostringstream t;

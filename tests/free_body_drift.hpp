@@ -9,7 +9,7 @@
 
 #include "bodies/ffr_body_3d.hpp"
 #include "core/system.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 namespace flexmbd::testsupport {
 

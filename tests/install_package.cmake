@@ -22,14 +22,14 @@ foreach(item config library)
   endif()
 endforeach()
 foreach(file include/flexmbd/core/types.hpp include/flexmbd/builders/planar_builders.hpp
-             include/flexmbd/io/results_writer.hpp
-             include/flexmbd/integrators/simulation.hpp include/flexmbd/linkage/kinematic_analysis.hpp
+             include/flexmbd/results/results_writer.hpp
+             include/flexmbd/simulation/simulation.hpp include/flexmbd/linkage/kinematic_analysis.hpp
              include/flexmbd/tensegrity/tensegrity_structure.hpp bin/flexmbd)
   if(NOT EXISTS "${prefix}/${file}")
     message(FATAL_ERROR "install: ${prefix}/${file} missing")
   endif()
 endforeach()
-# Issue 13: every "folder/file.hpp" an installed header includes is installed too (a
+# Every "folder/file.hpp" an installed header includes is installed too (a
 # folder missing from the install rules would break only the outside projects), and the
 # subcommands of the command line (*_command.hpp, not in the library) are not.
 file(GLOB_RECURSE headers RELATIVE "${prefix}/include/flexmbd" "${prefix}/include/flexmbd/*.hpp")

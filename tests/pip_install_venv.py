@@ -1,4 +1,4 @@
-"""CTest python_pip_install (issue 28, item 2): `pip install` of the source tree into a
+"""CTest python_pip_install: `pip install` of the source tree into a
 fresh virtual environment, then the package and flexmbd-study used from there without
 PYTHONPATH and outside the source tree; then this interpreter's pip into a prefix (pip
 install --prefix), whose flexmbd-study must find its package by itself.

@@ -13,10 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "integrators/sensitivity_run.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene_path.hpp"
-#include "io/sensitivity_results.hpp"
+#include "sensitivity/sensitivity_run.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene_path.hpp"
+#include "results/sensitivity_results.hpp"
 
 namespace {
 

@@ -16,11 +16,11 @@
 #include "cli_fixture.hpp"
 #include "sensitivity_test_support.hpp"
 #include "core/errors.hpp"
-#include "integrators/adjoint_run.hpp"
-#include "io/adjoint_results.hpp"
-#include "io/results_table.hpp"
-#include "io/scene_path.hpp"
-#include "io/sensitivity_results.hpp"
+#include "sensitivity/adjoint_run.hpp"
+#include "results/adjoint_results.hpp"
+#include "results/results_table.hpp"
+#include "scene/scene_path.hpp"
+#include "results/sensitivity_results.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -25,14 +25,14 @@
 #include "core/time_law.hpp"
 #include "core/user_function.hpp"
 #include "ffr3d_test_models.hpp"
-#include "ffr_test_models.hpp"
-#include "io/scene.hpp"
+#include "problems/ffr_test_models.hpp"
+#include "scene/scene.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/radau_solver.hpp"
-#include "integrators/sensitivity_run.hpp"
-#include "io/json_reader.hpp"
-#include "io/sensitivity_results.hpp"
-#include "integrators/simulation.hpp"
+#include "sensitivity/sensitivity_run.hpp"
+#include "scene/json_reader.hpp"
+#include "results/sensitivity_results.hpp"
+#include "simulation/simulation.hpp"
 
 // AddressSanitizer replaces the allocation functions itself: under it (make sanitize)
 // the counting is off and the tests are skipped.
@@ -159,7 +159,7 @@ TEST(Allocations, RigidSliderCrank) {
   expectAllocationFree(s.system, "rigid slider crank");
 }
 
-// dF/dp of a sensitivity run (integrators/sensitivity_run.hpp): the perturbed systems'
+// dF/dp of a sensitivity run (sensitivity/sensitivity_run.hpp): the perturbed systems'
 // residuals with their own scratch, no allocation per call.
 TEST(Allocations, SensitivityResidualDerivative) {
   if (!FLEXMBD_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";

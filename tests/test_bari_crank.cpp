@@ -1,14 +1,14 @@
 // Simeon's flexible slider crank (Bari IVP test set "crank"): the engine's model of it
 // (examples/bari_slider_crank.json, a rod given by its invariants) reproduces the test
-// set's equations (benchmarks/problems/bari_crank.*) and its published reference.
+// set's equations (problems/bari_crank.*) and its published reference.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <optional>
 
-#include "benchmarks/problems/bari_crank.hpp"
+#include "problems/bari_crank.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "io/scene.hpp"
+#include "scene/scene.hpp"
 #include "tests/test_support.hpp"
 
 using namespace flexmbd;
@@ -143,7 +143,7 @@ TEST(BariCrank, GglReachesEightDigitsAtTightTolerances) {
   // (docs/formulations.md) it reaches 8 digits: measured 8.49 at rtol 1e-12, atol 1e-14
   // (elastic 1e-17, raised to its floor 1e-15 s_e; elastic rates at their floor 1e-15 V0
   // = 6.8e-14 m/s, docs/formulations.md). At rtol = atol = 1e-11 it reached 8.6 with
-  // elastic rates at 1e-14 m/s, below that floor: 7.92 since issue 24.
+  // elastic rates at 1e-14 m/s, below that floor: 7.92.
   constexpr double kTightDigits = 8.0;
   const double scd = engineDigits(Formulation::Ggl, IntegratorKind::Ida, 1e-12, 1e-14);
   std::printf("[ measured ] engine ggl IDA rtol 1e-12, atol 1e-14: scd %.2f\n", scd);

@@ -465,7 +465,7 @@ TEST(BeamElement2d, SectionForcesOfStretchAndConstantCurvature) {
       EXPECT_NEAR(lin.x(), 0.0, 1e-12 * EA * kappa * l) << "xi " << xi;
       if (ee == bend) {
         // with stiffening the membrane strain is the element average of v'^2/2 =
-        // (kappa x)^2 / 2: kappa^2 l^2 / 6, the same at every section (issue 11, item 8)
+        // (kappa x)^2 / 2: kappa^2 l^2 / 6, the same at every section
         EXPECT_NEAR(nl.x(), EA * kappa * kappa * l * l / 6.0, 1e-12 * EA * kappa * kappa * l * l) << "xi " << xi;
       }
     }

@@ -1,4 +1,4 @@
-// CalculiX import (docs/fe-import.md, "CalculiX"): the readers of io/fe_calculix.hpp and
+// CalculiX import (docs/fe-import.md, "CalculiX"): the readers of fe_import/fe_calculix.hpp and
 // the clamped modes of bodies/modal_reduction.hpp against ccx itself. The test meshes a
 // steel bar (1 x 0.1 x 0.1 m, 10 x 2 x 2 C3D20R bricks, 321 nodes) and runs `ccx` three
 // times in a temporary folder (skipped without ccx on PATH):
@@ -33,11 +33,11 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/fe_calculix.hpp"
-#include "io/scene.hpp"
-#include "io/vtk_writer.hpp"
+#include "simulation/simulation.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "fe_import/fe_calculix.hpp"
+#include "scene/scene.hpp"
+#include "results/vtk_writer.hpp"
 #include "fe_test_support.hpp"
 #include "test_support.hpp"
 
@@ -315,7 +315,7 @@ TEST_F(CalculixBar, MatricesAreReadAndHoldTheBarsMass) {
   EXPECT_NEAR(m, rhoV, printed + 1e-15 * rhoV);
   const FeBodyModel model(d, FeBodyOptions{}, "bar");
   EXPECT_NEAR(model.invariants().mass, rhoV, printed + 1e-15 * rhoV);
-  // the finding of issue 27: the stored C3D20R mass is indefinite. Its LDL^T (a congruence,
+  // a finding: the stored C3D20R mass is indefinite. Its LDL^T (a congruence,
   // Sylvester's law of inertia) counts the negative eigenvalues; a Cholesky factor fails.
   const Eigen::SimplicialLDLT<SpMat> ldlt(d.mass);
   ASSERT_EQ(ldlt.info(), Eigen::Success);

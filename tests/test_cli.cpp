@@ -35,7 +35,7 @@ TEST_F(Cli, HelpAndVersion) {
   EXPECT_EQ(r.out.rfind("flexmbd ", 0), 0u) << r.out;
 }
 
-// Issue 28: `run` simulates planar and spatial multibody models and tensegrity
+// `run` simulates planar and spatial multibody models and tensegrity
 // structures; its paragraph of the help (also `run --help`) must say so, not "planar".
 TEST_F(Cli, HelpDescribesRunAsPlanarAndSpatial) {
   for (const std::string& command : {"--help", "run --help"}) {
@@ -136,7 +136,7 @@ TEST_F(Cli, ValidRunOfTheExample) {
 
 TEST_F(Cli, SpatialSceneRunsWithTheAugmentedLagrangianIntegrator) {
   // examples/spatial_four_bar.json (Euler parameters, three redundant equations released)
-  // with "integrator": "ali3p": refused as planar-only before issue 25; now it runs to the
+  // with "integrator": "ali3p": once refused as planar-only; it runs to the
   // end (exit 0) and conserves the energy of the undriven swing to the order-2 method's
   // global error (kSecondOrderPerRtol = 1e4 rtol, tests/test_spatial_ali3p.cpp).
   nlohmann::json j = nlohmann::json::parse(readFile(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_four_bar.json"));
@@ -243,7 +243,7 @@ TEST_F(Cli, MechanismThatCannotBeAssembledExitsWith2NamingJoints) {
   EXPECT_FALSE(fs::exists(out / "results.csv"));
 }
 
-// ----- issue 12: findings to fix ------------------------------------------------------------
+// ----- findings to fix ---------------------------------------------------------------------
 
 namespace {
 
@@ -469,7 +469,7 @@ TEST_F(Cli, VtkSaysOnStderrWhichBodyItCannotDraw) {
   EXPECT_NE(vtu.find("<!-- body_names: crank, rod, slider -->"), std::string::npos) << vtu.substr(0, 200);
 }
 
-// ----- issue 12: --format hdf5 ------------------------------------------------------------
+// ----- --format hdf5 ---------------------------------------------------------------------
 
 namespace {
 
@@ -619,7 +619,7 @@ TEST_F(Cli, Hdf5ResultsOfAFullDiskAreReadableWholeRows) {
   for (std::size_t r = 1; r < h5.rows.size(); ++r) ASSERT_GT(h5.rows[r][0], h5.rows[r - 1][0]) << "row " << r;
   const auto summary = nlohmann::json::parse(readFile(out / "summary.json"));
   EXPECT_EQ(summary.at("status"), "failed");
-  // The time of the last row written (issue 26, D14: was the output whose row failed).
+  // The time of the last row written (D14: was the output whose row failed).
   EXPECT_NEAR(summary.at("t_reached").get<double>(), h5.rows.back()[0], 1e-9);
 }
 

@@ -1,4 +1,4 @@
-// Craig-Bampton reduction of the planar and spatial beam models (issue 14,
+// Craig-Bampton reduction of the planar and spatial beam models (
 // bodies/modal_reduction.hpp): the basis holds exactly the static response of the nodal
 // model to loads at the interface nodes (so its section forces are the nodal model's),
 // its fixed-interface frequencies are those of the nodal model with the interface held,

@@ -1,4 +1,4 @@
-// Damped elastic slider-crank under IDA (issue 11, item 10): stiffness-proportional
+// Damped elastic slider-crank under IDA: stiffness-proportional
 // damping of the rod must not make IDA reject almost every step.
 #include <gtest/gtest.h>
 
@@ -6,8 +6,8 @@
 #include <cstdio>
 
 #include "integrators/bdf_stability.hpp"
-#include "integrators/simulation.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "simulation/simulation.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 

@@ -1,5 +1,5 @@
 // Failure messages state what was measured and name a cause only when the measurement
-// supports it (issue 11, item 11): an undriven mechanism is not told that its drivers do
+// supports it: an undriven mechanism is not told that its drivers do
 // not determine its motion; a well-conditioned Jacobian near a singular position is not
 // called "not near a singular configuration"; a diverged solution is called diverged, not
 // a model with redundant constraints or a massless body.
@@ -13,8 +13,8 @@
 #include "builders/planar_builders.hpp"
 #include "core/force.hpp"
 #include "core/system.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 

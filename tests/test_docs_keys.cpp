@@ -1,6 +1,6 @@
 // Every key the scene readers accept is documented in docs/scene-format.md, and every
-// key documented there is accepted (issue 12). The readers take their allowed keys
-// from io/scene_keys.hpp; the docs tag each key table with the objects it documents
+// key documented there is accepted. The readers take their allowed keys
+// from scene/scene_keys.hpp; the docs tag each key table with the objects it documents
 // (`<!-- keys: body.rigid body.flexible -->` above the table, one key per row in the
 // first column). Both are compared object by object.
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include <sstream>
 #include <string>
 
-#include "io/scene_keys.hpp"
+#include "scene/scene_keys.hpp"
 
 namespace {
 
@@ -141,8 +141,8 @@ TEST(DocsKeys, TheComparisonCatchesAKeyMissingFromTheDocsAndAKeyNoReaderAccepts)
 }
 
 TEST(DocsKeys, ReadersTakeTheirAllowedKeysFromTheTable) {
-  // A literal list passed to allowOnly would bypass io/scene_keys.hpp (and this test).
-  for (const char* file : {"io/scene.cpp", "io/json_reader.cpp", "linkage/kinematics_scene.cpp",
+  // A literal list passed to allowOnly would bypass scene/scene_keys.hpp (and this test).
+  for (const char* file : {"scene/scene.cpp", "scene/json_reader.cpp", "linkage/kinematics_scene.cpp",
                            "tensegrity/tensegrity_scene.cpp"}) {
     const std::string src = readText(std::string(FLEXMBD_SOURCE_DIR) + "/" + file);
     ASSERT_FALSE(src.empty()) << file;

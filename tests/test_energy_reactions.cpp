@@ -7,7 +7,7 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace flexmbd;
 

@@ -1,8 +1,8 @@
-// Issue 13 ("layering"): an exception thrown by a model's residual, Jacobian or
+// An exception thrown by a model's residual, Jacobian or
 // right-hand side that is not a solver failure (InputError, ModelError, std::logic_error)
 // crosses the integrator with its type and message, so that the caller can report it as
 // what it is (the command line: exit 2 for input and model errors) and not as a solver
-// failure (SolverError, exit 1). Before issue 13 each came back as a SolverError. A
+// failure (SolverError, exit 1). Each once came back as a SolverError. A
 // non-finite residual stays a recoverable solver event: the
 // integrator retries with a smaller step, and gives up with a SolverError only if the
 // residual stays non-finite. Through IDA (dense and KLU), Radau IIA (dense and KLU), both
@@ -29,7 +29,7 @@
 #include "builders/planar_builders.hpp"
 #include "core/force.hpp"
 #include "core/system.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace flexmbd;
 

@@ -31,9 +31,9 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "fe_test_support.hpp"
 #include "free_body_drift.hpp"
-#include "integrators/simulation.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 namespace fs = std::filesystem;

@@ -1,5 +1,5 @@
 // Flexible bodies from finite element codes (docs/fe-import.md): the Abaqus and Ansys
-// readers (io/fe_abaqus.hpp, io/fe_ansys.hpp) and the FFR body of a solid mesh
+// readers (fe_import/fe_abaqus.hpp, fe_import/fe_ansys.hpp) and the FFR body of a solid mesh
 // (bodies/fe_body_model.hpp), on the rotor with a disc that EXUDYN's test models use
 // (../shared/data/exudyn-rotor, read in place; the tests that need it skip without it):
 //  - the first elastic free-free eigenfrequency of both exports against EXUDYN's
@@ -27,9 +27,9 @@
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/system.hpp"
-#include "integrators/simulation.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/fe_ansys.hpp"
+#include "simulation/simulation.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "fe_import/fe_ansys.hpp"
 #include "free_body_drift.hpp"
 #include "fe_test_support.hpp"
 #include "test_support.hpp"
@@ -517,7 +517,7 @@ TEST_F(AnsysFiles, MalformedTables) {
 }
 
 TEST(FeImport, FreeFreeModesWithAnIndefiniteMass) {
-  // Stored solid masses need not be positive definite (CalculiX's C3D20R: issue 27). A
+  // Stored solid masses need not be positive definite (CalculiX's C3D20R). A
   // pencil built from its modes: V invertible, K = V^-T diag(kappa) V^-1, M = V^-T diag(mu)
   // V^-1, so K v_i = lambda_i M v_i with lambda_i = kappa_i / mu_i. Six rigid modes
   // (kappa = 0, mu > 0), elastic ones with mu > 0, and three with mu < 0 and large kappa

@@ -26,9 +26,9 @@
 #include "bodies/modal_reduction.hpp"
 #include "core/errors.hpp"
 #include "core/rotation_3d.hpp"
-#include "integrators/simulation.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "scene/scene.hpp"
 #include "fe_test_support.hpp"
 #include "test_support.hpp"
 

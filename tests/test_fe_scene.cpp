@@ -1,5 +1,5 @@
 // The scene body of an FE export ("type": "fe_body", docs/scene-format.md "FE bodies";
-// io/fe_body_reader.hpp): the rotor of ../shared/data/exudyn-rotor read from a scene with
+// scene/fe_body_reader.hpp): the rotor of ../shared/data/exudyn-rotor read from a scene with
 // paths relative to the scene file, against the FeBodyModel built directly; a point mass
 // against the closed-form change of mass, first and second moment; modal damping against
 // the decay of a free vibration, exp(-zeta omega t); the key errors.
@@ -15,9 +15,9 @@
 #include "bodies/fe_body_model.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
-#include "io/fe_abaqus.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "fe_import/fe_abaqus.hpp"
+#include "scene/scene.hpp"
 #include "fe_test_support.hpp"
 #include "test_support.hpp"
 

@@ -28,7 +28,7 @@
 #include "bodies/ffr_beam_model.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_2d.hpp"
-#include "ffr_test_models.hpp"
+#include "problems/ffr_test_models.hpp"
 #include "bodies/ffr_invariants.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
@@ -943,7 +943,7 @@ TEST(FfrBody2d, AttachmentOnlyAtNodes) {
   expectMatrixNear(model->materialPoint(2, 0.5).position, Vec2(0.3, 0.05), 1e-15, "material point", 1.0);
 }
 
-// Attachment points are resolved once, at finalize, into the bodies' identifiers (issue 13):
+// Attachment points are resolved once, at finalize, into the bodies' identifiers:
 // the joints of the elastic slider crank find the rod's nodes by index, and each index is
 // the node at the joint's point, with the same kinematics as the search by coordinates.
 TEST(FfrBody2d, AttachmentPointsResolvedAtFinalize) {
@@ -978,7 +978,7 @@ TEST(FfrBody2d, AttachmentPointsResolvedAtFinalize) {
 }
 
 // The outputs' augmented matrix [M G^T; G 0] is assembled sparsely through the bodies'
-// sinks (issue 13): equal to the dense blocks to round-off of the sums (1e-14 relative:
+// sinks: equal to the dense blocks to round-off of the sums (1e-14 relative:
 // the same products, summed in another order), with only the structural non-zeros stored.
 TEST(FfrBody2d, SparseAugmentedMatrixEqualsTheDenseBlocks) {
   const Scene scene = testmodels::elasticSliderCrank(16, 1.0, 0, 0.1, 1e-6, 1e-6);

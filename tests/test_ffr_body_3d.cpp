@@ -25,7 +25,7 @@
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "core/system.hpp"
 #include "ffr3d_test_models.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "joints/spatial_joint.hpp"
 #include "free_body_drift.hpp"
 #include "test_support.hpp"

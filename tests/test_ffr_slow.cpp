@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "tests/ffr_test_models.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// Validation of spatial flexible bodies (issue 14, C++ API): FfrBody3d from FfrBeamModel3d
+// Validation of spatial flexible bodies (C++ API): FfrBody3d from FfrBeamModel3d
 // in mechanisms.
 //  1. The planar elastic slider crank (examples/slider_crank_elastic.json: nodal 8
 //     elements and 2 modes) rebuilt in space in the x-y plane against the planar engine:
@@ -32,11 +32,11 @@
 #include "bodies/rigid_body_3d.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
-#include "tests/ffr3d_crank_models.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "problems/ffr3d_crank_models.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 using namespace flexmbd::test3d;
@@ -462,7 +462,7 @@ struct WorkRun {
   SimulationSummary summary;
 };
 
-/// The crank spun up from rest to 100 rad/s over 0.05 s (the smooth law of issue 2), then
+/// The crank spun up from rest to 100 rad/s over 0.05 s (the smooth spin-up law), then
 /// held, to 0.1 s; gravity, no damping. The driver's power is -lambda theta'(t) (lambda
 /// its multiplier: the torque it applies is -lambda), its work by Simpson's rule over
 /// outputs every h; compared with the change of the total energy at every other output.

@@ -1,4 +1,4 @@
-// Validation of floating-frame-of-reference flexible bodies (issue 4): static cantilever,
+// Validation of floating-frame-of-reference flexible bodies: static cantilever,
 // rigid limit of the elastic slider-crank, free-floating beam invariants, geometric
 // stiffening of a rotating cantilever, mesh convergence and modal reduction.
 #include <gtest/gtest.h>
@@ -9,10 +9,10 @@
 #include "bodies/ffr_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "integrators/static_equilibrium.hpp"
-#include "tests/ffr_test_models.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "analysis/static_equilibrium.hpp"
+#include "problems/ffr_test_models.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 
@@ -71,15 +71,14 @@ TEST(FfrStatic, CantileverUnderOwnWeightMatchesRhoAgL4Over8EI) {
 TEST(FfrRigidLimit, StiffRodFollowsRigidClosedFormAndDeflectionScalesAsOneOverE) {
   // E scaled by 1e3 and 1e4, 2 bending modes, tight tolerances so that deflections of
   // 1e-6 and 1e-7 m are resolved. (E x 1e6 runs too, but resolving its 1e-9 m
-  // vibrations at 1.3e6 rad/s takes 0.46 M steps: a hard case of issue 5, measured in
-  // the note of issue 4.) The slider follows the rigid closed form; the deflection
+  // vibrations at 1.3e6 rad/s takes 0.46 M steps: a hard case of the stability tests.) The slider follows the rigid closed form; the deflection
   // scales as 1/E up to the dynamic amplification 1/(1 - (w/omega_1)^2), which is
   // 2e-3 at E x 1e3 for the crank's harmonics.
   Scene s3 = testmodels::elasticSliderCrank(4, 1e3, 2, 1.0, 1e-8, 1e-12);
   Scene s4 = testmodels::elasticSliderCrank(4, 1e4, 2, 1.0, 1e-8, 1e-12);
   const CrankRun r3 = runCrank(s3), r4 = runCrank(s4);
   ASSERT_TRUE(r3.summary.ok && r4.summary.ok) << r3.summary.message << r4.summary.message;
-  constexpr double kRigidLimitTolerance = 1e-6;  // issue 4
+  constexpr double kRigidLimitTolerance = 1e-6;
   EXPECT_LT(r3.sliderError, kRigidLimitTolerance);
   EXPECT_LT(r4.sliderError, kRigidLimitTolerance);
   constexpr double kScalingTolerance = 5e-3;  // > the amplification difference 2e-3
@@ -226,7 +225,7 @@ TEST(FfrGeometricStiffening, RotatingCantileverFrequencyRisesSouthwellStyle) {
 
 TEST(FfrGeometricStiffening, SpinUpPastFirstFrequencyStaysBoundedOnlyWithStiffening) {
   // The cantilever above spun up from rest to Omega = 1.5 omega_1 with the smooth law of
-  // issue 2 over 15 s, then held: the linear model becomes unstable (omega^2 < 0).
+  // smooth spin-up over 15 s, then held: the linear model becomes unstable (omega^2 < 0).
   BeamSection s;
   s.area = 1.0;
   s.inertia = 1e-4;

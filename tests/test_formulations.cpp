@@ -3,9 +3,9 @@
 
 #include <cmath>
 
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

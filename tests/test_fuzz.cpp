@@ -1,4 +1,4 @@
-// Fuzz test of the command line (issue 11, "Kept fixed"; issue 26, item 6): a seeded
+// Fuzz test of the command line ("Kept fixed"): a seeded
 // generator damages every example scene (planar, spatial rigid and flexible, tensegrity,
 // kinematics) and variants of them that use the keys the examples leave out (Craig-Bampton
 // and modes keys, beam theories, arrays of placed shapes, geometry, bushings placed in the
@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "cli_fixture.hpp"
-#include "io/scene_keys.hpp"
+#include "scene/scene_keys.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -47,7 +47,7 @@ constexpr int kSummaryEvery = 4;  // one case in 4 also runs flexmbd summary on 
 constexpr int kPlotEvery = 25;    // one case in 25 also plots it (a Python start)
 constexpr int kStudyShare = 25;  // 400 scenes: 16 study files
 
-// Time limit of a process (issue 26, D23): kMinSeconds, times FLEXMBD_FUZZ_TIME_SCALE if
+// Time limit of a process: kMinSeconds, times FLEXMBD_FUZZ_TIME_SCALE if
 // set (a sanitizer build, a slow machine). A damaged scene may legitimately run much longer
 // (t_end, output_step or tolerances mutated): at its limit a process gets SIGTERM and
 // counts as "stopped at its limit", not a failure, as long as it then ends within
@@ -137,7 +137,7 @@ void collectPointers(const json& j, const json::json_pointer& at, std::vector<js
   }
 }
 
-/// Every key some scene reader accepts (io/scene_keys.hpp): inserted into random objects.
+/// Every key some scene reader accepts (scene/scene_keys.hpp): inserted into random objects.
 std::vector<std::string> sceneKeys() {
   std::vector<std::string> keys;
   for (const auto& [id, list] : flexmbd::scenekeys::allObjects()) keys.insert(keys.end(), list->begin(), list->end());

@@ -1,4 +1,4 @@
-// Issue 11 ("Crashes, silent wrong results, lost data"): each defect found by fuzzing and
+// Crashes, silent wrong results, lost data: each defect found by fuzzing and
 // by trying the engine as a new user, reproduced through the command line. Every test
 // here failed before its fix.
 #include <gtest/gtest.h>
@@ -9,8 +9,8 @@
 #include <string>
 
 #include "cli_fixture.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene.hpp"
 #include "linkage/kinematic_analysis.hpp"
 #include "linkage/kinematics_scene.hpp"
 
@@ -43,7 +43,7 @@ class Hardening : public Cli {
 // message quotes shortened values (60 characters) and is cut at 1,000 characters.
 constexpr std::size_t kMaxErrorLine = 1100;
 
-// ----- item 1: deep nesting, huge values in messages ---------------------------------
+// ----- deep nesting, huge values in messages ---------------------------------
 
 TEST_F(Hardening, DeeplyNestedJsonIsAnInputErrorForEverySubcommand) {
   const std::string deep = std::string(100000, '[') + std::string(100000, ']');
@@ -69,7 +69,7 @@ TEST_F(Hardening, HugeNamesAndValuesAreShortenedInErrors) {
   CliResult r = runScene("run", writeScene("long_name.json", j), dir_ / "out");
   EXPECT_EQ(r.status, 2);
   EXPECT_TRUE(IsOneErrorLine(r.err));
-  // the name rule (issue 26) refuses the name itself, before its keys are read
+  // the name rule refuses the name itself, before its keys are read
   EXPECT_NE(r.err.find("is 100000 characters long"), std::string::npos) << r.err.substr(0, 300);
   EXPECT_LT(r.err.size(), kMaxErrorLine);
 
@@ -90,7 +90,7 @@ TEST_F(Hardening, HugeNamesAndValuesAreShortenedInErrors) {
   EXPECT_LT(r.err.size(), kMaxErrorLine);
 }
 
-// ----- item 2: no `ok` with inf or NaN in the results -------------------------------
+// ----- no `ok` with inf or NaN in the results -------------------------------
 
 TEST_F(Hardening, OverflowingInputValuesAreRefused) {
   nlohmann::json k = exampleScene("kinematics_slider_crank.json");
@@ -121,7 +121,7 @@ TEST(HardeningLibrary, KinematicsStopsAtTheFirstNonFiniteState) {
   EXPECT_NE(summary.message.find("non-finite accelerations"), std::string::npos) << summary.message;
 }
 
-// Issue 26 (fuzz case 3654): inputs within the bound of scene numbers gave results beyond
+// Fuzz case 3654: inputs within the bound of scene numbers gave results beyond
 // it with status ok (an input acceleration of 1e100 rad/s^2: 3e101 m/s^2 at the joints).
 TEST(HardeningLibrary, KinematicsStopsAtResultsBeyondTheBoundOfSceneNumbers) {
   flexmbd::KinematicsScene scene = flexmbd::loadKinematicsScene(kSourceDir + "/examples/kinematics_four_bar.json");
@@ -161,7 +161,7 @@ TEST(HardeningLibrary, ResultsWriterRefusesANonFiniteRowAndKeepsTheRowsBefore) {
   fs::remove_all(dir);
 }
 
-// ----- item 3: tolerances that cannot give a result; constraint violation warnings ------
+// ----- tolerances that cannot give a result; constraint violation warnings ------
 
 TEST_F(Hardening, MeaninglessTolerancesAreRefused) {
   nlohmann::json j = exampleScene("slider_crank_elastic.json");
@@ -199,7 +199,7 @@ TEST_F(Hardening, LargeConstraintViolationIsWarned) {
   EXPECT_NE(summary.at("warnings")[0].get<std::string>().find("model size"), std::string::npos);
 }
 
-// ----- item 4: large moves of the consistent initialisation ----------------------------
+// ----- large moves of the consistent initialisation ----------------------------
 
 TEST_F(Hardening, LargeInitialCorrectionIsRecordedAndWarned) {
   const fs::path out = dir_ / "out";
@@ -258,7 +258,7 @@ TEST_F(Hardening, InitialVelocitiesThatViolateTheJointsAreWarned) {
   EXPECT_EQ(r.err.find("initial velocity of body 'rod'"), std::string::npos) << r.err;
 }
 
-// ----- item 6: output failures, signals, stale frames ---------------------------------
+// ----- output failures, signals, stale frames ---------------------------------
 
 /// Every line of a CSV file is complete: ends in a newline, as many fields as the header.
 ::testing::AssertionResult WholeRows(const std::string& csv) {
@@ -349,7 +349,7 @@ TEST_F(Hardening, RerunIntoAnOldOutputFolderLeavesNoFramesOfTheOldModel) {
   EXPECT_FALSE(fs::exists(out / "vtk" / "bodies.pvd"));
 }
 
-// ----- item 7: time spans the integrator cannot use are input errors, long runs run -----
+// ----- time spans the integrator cannot use are input errors, long runs run -----
 
 TEST_F(Hardening, UnresolvableTimeSpanIsAnInputError) {
   nlohmann::json j = example();

@@ -1,4 +1,4 @@
-// "integrator": "auto" and the quasi-static elastic start (issue 24, item 2;
+// "integrator": "auto" and the quasi-static elastic start (
 // docs/formulations.md, "Why a nodal rod takes so many steps").
 #include <gtest/gtest.h>
 
@@ -7,10 +7,10 @@
 #include <cstdio>
 
 #include "bodies/ffr_body_2d.hpp"
-#include "integrators/elastic_modes.hpp"
-#include "integrators/integrator_choice.hpp"
-#include "integrators/quasi_static_start.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "analysis/elastic_modes.hpp"
+#include "simulation/integrator_choice.hpp"
+#include "analysis/quasi_static_start.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 
@@ -161,9 +161,9 @@ TEST(IntegratorChoice, DemoNodalRodUnderAutoAgreesWithATightReference) {
   // Measured (one revolution): auto 1,531 steps against IDA's 67,184, peak 3.8e-5 relative
   // from rtol 1e-10, slider 2.9e-7 m.
   constexpr double kRevolutions = 0.5;
-  constexpr double kPeakTolerance = 1e-4;  // issue 24's target for the demo: 1e-4 of the peak
+  constexpr double kPeakTolerance = 1e-4;  // the demo's target: 1e-4 of the peak
   constexpr double kSliderTolerance = 1e-6;  // m: about 2 rtol x the model size (0.45 m)
-  constexpr double kStepRatio = 10.0;  // issue 24's target: at least 10 times fewer steps than IDA at the same settings
+  constexpr double kStepRatio = 10.0;  // the target: at least 10 times fewer steps than IDA at the same settings
   Scene s = demoNodal(kRevolutions);
   const DemoRun run = runDemo(s);
   ASSERT_TRUE(run.summary.ok) << run.summary.message;

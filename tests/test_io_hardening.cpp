@@ -1,4 +1,4 @@
-// Issue 26 ("Hardening, round two"), the input/output items: names that would break the
+// Hardening, the input/output items: names that would break the
 // result files, scene paths that are endless or special files, two runs into one output
 // folder, signals in every subcommand, and the small message and status defects D12-D22 of
 // ../shared/findings/reliability.md. Through the command line; exit codes and the words
@@ -182,7 +182,7 @@ TEST_F(IoHardening, AStaleLockOfAKilledRunIsTakenOver) {
   EXPECT_FALSE(fs::exists(out / ".flexmbd.lock"));
 }
 
-// ----- D5, D6, item 8: signals in every subcommand, not waiting for the next row -------
+// ----- signals in every subcommand, not waiting for the next row -------
 
 TEST_F(IoHardening, SigintStopsARunWithinItsStepNotAtTheNextOutput) {
   nlohmann::json j = example();
@@ -335,7 +335,7 @@ TEST_F(IoHardening, ModesIntoAReadOnlyFolderIsAnInputErrorWithTheReason) {
 // ----- the reproducers of the findings, when ../shared is there ---------------------------
 
 TEST_F(IoHardening, FindingsReproducersOfNames) {
-  if (!fs::exists(kFindings)) GTEST_SKIP() << "no " << kFindings.string() << " (the findings of issue 26)";
+  if (!fs::exists(kFindings)) GTEST_SKIP() << "no " << kFindings.string() << " (the findings of the second hardening round)";
   for (const auto& [file, command] : {std::pair<std::string, std::string>{"R01_tensegrity_name_with_comma.json", "run"},
                                       {"R02_kinematics_name_with_newline.json", "kinematics"}}) {
     const CliResult r = runScene(command, kFindings / file, dir_ / "out");

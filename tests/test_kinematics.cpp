@@ -11,11 +11,11 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "linkage/kinematic_analysis.hpp"
 #include "linkage/kinematics_scene.hpp"
 #include "tests/four_bar_reference.hpp"
-#include "tests/reference_solutions.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// Linearisation and modal analysis (integrators/linearization.hpp, docs/modes.md):
+// Linearisation and modal analysis (analysis/linearization.hpp, docs/modes.md):
 // small oscillations and gyroscopic stability against closed forms, planar and spatial.
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include "bodies/ffr_body_2d.hpp"
 #include "bodies/ffr_body_3d.hpp"
 #include "core/errors.hpp"
-#include "integrators/linearization.hpp"
-#include "io/scene.hpp"
+#include "analysis/linearization.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;
@@ -270,7 +270,7 @@ TEST(Linearization, RejectsAStateOfTheWrongSize) {
   EXPECT_THROW(linearize(s.system, r), InputError);
 }
 
-// Issue 28: a sparse eigensolver that cannot do its work is a SolverError (the command
+// A sparse eigensolver that cannot do its work is a SolverError (the command
 // line's exit 1), not an InputError or ModelError (exit 2, bad input): the model is well
 // formed and the dense solver finds its modes. Forced by a shift at an eigenvalue: four
 // free planar bodies have only s = 0, and a shift of 0 makes the shifted pencil singular.

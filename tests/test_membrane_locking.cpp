@@ -1,4 +1,4 @@
-// Membrane locking of the geometric-stiffening beam (issue 11, item 8). With linear
+// Membrane locking of the geometric-stiffening beam. With linear
 // axial and cubic transverse shapes, a pointwise second-order strain u' + v'^2/2 cannot
 // vanish in bending (u' is constant per element, v'^2/2 is quartic), so inextensional
 // bending stores spurious membrane energy and coarse meshes lock (Stolarski & Belytschko
@@ -20,8 +20,8 @@
 #include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
 #include "elements/beam_element_2d.hpp"
-#include "integrators/simulation.hpp"
-#include "integrators/static_equilibrium.hpp"
+#include "simulation/simulation.hpp"
+#include "analysis/static_equilibrium.hpp"
 #include "tests/test_support.hpp"
 
 namespace flexmbd {
@@ -361,7 +361,7 @@ TEST(MembraneLocking, SpinningFrequencyShiftsWithAmplitudeOnlyAtSecondOrderAndMe
 }
 
 TEST(MembraneLocking, SpinUpResponseConvergesFromFourElements) {
-  // The blade spun up from rest to Omega = omega_1 with the smooth law of issue 2 over
+  // The blade spun up from rest to Omega = omega_1 with the smooth spin-up law over
   // 6 s, then held to 8 s (hub = revolute joint driven in theta). The tip deflection lags
   // by the angular acceleration (quasi-static level alpha rho A L^4 / (8 EI) ~ 0.06 m)
   // and vibrates about the centrifugally stiffened state. Compared with 16 elements:

@@ -233,7 +233,7 @@ std::vector<double> dampingRatios(const fs::path& csv) {
 
 }  // namespace
 
-// Issue 28: an eigensolver that does not converge is a solver failure (exit 1, as a run
+// An eigensolver that does not converge is a solver failure (exit 1, as a run
 // whose integrator fails), not bad input (exit 2): the scene is well formed and the dense
 // solver finds the modes. Forced by an eigenvalue at the shift (the operator
 // (A - sigma E)^-1 E is then singular to rounding: 4e21 against the other eigenvalues' 1e3).
@@ -266,9 +266,9 @@ TEST_F(Cli, ModesEigensolverFailureExitsWith1AndTheDenseSolverFindsTheModes) {
   EXPECT_EQ(damped, 4);
 }
 
-// Issue 28: the sparse solver's Krylov subspace for 4 modes of the spatial elastic slider
+// The sparse solver's Krylov subspace for 4 modes of the spatial elastic slider
 // crank (48 independent coordinates) held 21 vectors and did not converge (exit 2 then);
-// with 22 (an even basis, integrators/linearization.cpp) it converges, to the dense
+// with 22 (an even basis, analysis/linearization.cpp) it converges, to the dense
 // solver's eigenvalues.
 TEST_F(Cli, ModesSparseSolverConvergesOnTheSpatialElasticSliderCrank) {
   const std::string scene = shellQuote(std::string(FLEXMBD_SOURCE_DIR) + "/examples/spatial_slider_crank_elastic.json");
@@ -288,7 +288,7 @@ TEST_F(Cli, ModesSparseSolverConvergesOnTheSpatialElasticSliderCrank) {
   for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(ws[k] / wd[k], 1.0, kSolverAgreement) << k;
 }
 
-// Issue 26/28: a section damping beta of 1e6 s made every mode overdamped by far: the slow
+// A section damping beta of 1e6 s made every mode overdamped by far: the slow
 // eigenvalues (~ -1/beta) fell below the zero threshold and were printed as 0 Hz modes
 // (exit 0; before that, "the reduced mass matrix is not positive definite"). Now the run
 // says the damping dominates, by how much, and what to do; exit 1 (a solver limit).

@@ -1,5 +1,5 @@
 // Eigenvalue sensitivities of `flexmbd modes --sensitivity PATH` (docs/modes.md,
-// "Sensitivities of the modes"; issue 29): a cantilever's bending frequencies against the
+// "Sensitivities of the modes"): a cantilever's bending frequencies against the
 // closed forms df/dE = f / (2 E) and df/dh = f / h, the elastic slider crank's complex modes
 // about its moving state against central differences of two `modes` runs, and bad input.
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_fixture.hpp"
-#include "io/scene_path.hpp"
+#include "scene/scene_path.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Issue 26 (hardening round two), items 2, 3, 5 and 7: values that are positive but
+// Hardening: values that are positive but
 // numerically meaningless, messages that say what was measured, runs bounded instead of
 // grinding, the start-up rank test of large models.
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@
 #include "core/errors.hpp"
 #include "core/linear_algebra.hpp"
 #include "core/magnitude_checks.hpp"
-#include "integrators/run_stages.hpp"
+#include "simulation/run_stages.hpp"
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "joints/world_frames.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
@@ -287,7 +287,7 @@ TEST_F(NumericLimits, ModelAboveTheMemoryAvailableIsRefusedWithItsEstimate) {
       {"body 'rod': 1001 elements, more than the 1000 a beam body may have"});
 }
 
-// Item 5: a run's steps are bounded (max_total_steps): a max_step that needs more steps than
+// A run's steps are bounded (max_total_steps): a max_step that needs more steps than
 // that over t_end - t_start is refused at input (exit 2, the count named); a run past the
 // budget ends as failed with its rows, the mean step and its fraction of the output step.
 TEST_F(NumericLimits, StepBudgetEndsARunAndRefusesATinyMaxStep) {
@@ -316,7 +316,7 @@ TEST_F(NumericLimits, StepBudgetEndsARunAndRefusesATinyMaxStep) {
   EXPECT_LT(summary.at("t_reached").get<double>(), scene["solver"]["t_end"].get<double>());
 }
 
-// D11 / item 8: modes at rest of a model beyond the dense static solve (more than 3,000
+// Modes at rest of a model beyond the dense static solve (more than 3,000
 // unknowns: the 600-element spatial beam has 3,612) are refused at once with the way out,
 // not after minutes and GBs (the 1,000-element beam: 293 s, 2.3 GB, then "singular").
 TEST_F(NumericLimits, ModesAtRestOfAHugeModelAreRefusedWithTheWayOut) {

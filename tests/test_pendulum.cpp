@@ -7,8 +7,8 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

@@ -12,9 +12,9 @@
 #include "benchmarks/bench_scenes.hpp"
 #include "core/errors.hpp"
 #include "integrators/radau_solver.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// Redundant constraints (issue 25, item 1): a mechanism whose joints are dependent runs
+// Redundant constraints: a mechanism whose joints are dependent runs
 // with "redundant_constraints": "resolve" (the dependent equations released at the
 // assembled position, docs/formulations.md) and gives the motion of the same mechanism
 // without the redundant joint; "refuse" stops with the message naming the equation; the
@@ -19,8 +19,8 @@
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 #include "joints/spatial_joint.hpp"
 
 using namespace flexmbd;

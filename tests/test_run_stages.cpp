@@ -1,4 +1,4 @@
-// The stages of a run (integrators/run_stages.hpp, output_recorder.hpp,
+// The stages of a run (simulation/run_stages.hpp, output_recorder.hpp,
 // singular_crossing.hpp), each on its own: the hand-over decision, the output recorder,
 // the failure diagnosis, the choice of the integrator options, the crossing decision and
 // the summary's warnings.
@@ -15,10 +15,10 @@
 #include "core/system.hpp"
 #include "integrators/bdf_stability.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/output_recorder.hpp"
-#include "integrators/run_stages.hpp"
-#include "integrators/singular_crossing.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "simulation/output_recorder.hpp"
+#include "simulation/run_stages.hpp"
+#include "simulation/singular_crossing.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 

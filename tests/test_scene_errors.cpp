@@ -1,4 +1,4 @@
-// Unit tests of the scene reader (io/scene.hpp): every kind of bad input gives an
+// Unit tests of the scene reader (scene/scene.hpp): every kind of bad input gives an
 // InputError whose one-line message names the offending key, object or value; the
 // example scene and a scene using every feature parse into the expected model.
 #include <gtest/gtest.h>
@@ -12,7 +12,7 @@
 #include "core/errors.hpp"
 #include "core/number_text.hpp"
 #include "core/system_evaluation.hpp"
-#include "io/scene.hpp"
+#include "scene/scene.hpp"
 #include "linkage/kinematics_scene.hpp"
 
 namespace flexmbd {
@@ -113,7 +113,7 @@ TEST(SceneErrors, ASpatialInertiaOfTwoNumbersSaysWhatItMustBe) {
 }
 
 TEST(SceneErrors, AnOutputPointFarBeyondTheModelIsATypo) {
-  // issue 26: a point output at z = -1e100 ran and exited 0 with coordinates of 1e100;
+  // A point output at z = -1e100 ran and exited 0 with coordinates of 1e100;
   // beyond kMaxMagnitudeRatio (1e12) times the model's size it is refused, planar and spatial
   json j = baseScene();
   j["outputs"] = json::array({{{"type", "point"}, {"name", "far"}, {"body", "rod"}, {"point", {1e100, 0.0}}}});
@@ -658,7 +658,7 @@ TEST(SceneParse, ToleranceClassesAndIntegrator) {
 }
 
 }  // namespace
-// ----- issue 12 ---------------------------------------------------------------------------
+// ----- scene errors -----------------------------------------------------------------------
 
 TEST(NumberText, PlainDecimalsNearOneExponentsFarFromIt) {
   EXPECT_EQ(shortestNumberText(-80), "-80");  // was "-8e+01"

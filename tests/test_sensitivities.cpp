@@ -19,10 +19,10 @@
 #include "sensitivity_test_support.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/sensitivity_run.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene_path.hpp"
-#include "io/sensitivity_results.hpp"
+#include "sensitivity/sensitivity_run.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene_path.hpp"
+#include "results/sensitivity_results.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -1,5 +1,5 @@
 // Forward sensitivities of the elastic and spatial models against central differences of
-// whole runs (issue 29, "Validation"; docs/sensitivities.md, "Accuracy"): the elastic
+// whole runs ("Validation"; docs/sensitivities.md, "Accuracy"): the elastic
 // slider crank with a nodal rod (the rod's Young's modulus and section height, the slider's
 // mass) and with a modal rod (the crank's speed), outputs the rod's midpoint deflection and
 // the slider's position; the spatial slider crank (the slider's mass, the rod's attachment

@@ -1,5 +1,5 @@
 // The Standard Input Data (SID, Wallrapp 1994) of flexible bodies: bodies/sid_data.hpp and
-// io/sid_file.hpp (docs/fe-import.md, "SID").
+// fe_import/sid_file.hpp (docs/fe-import.md, "SID").
 //  - a beam model's SID, written and read back, gives its invariants to round-off (modal
 //    with the section-rotation terms R_kl and H_i, and nodal);
 //  - the blocks mean what the SID defines: J is the inertia tensor of a uniform beam about
@@ -24,9 +24,9 @@
 #include "bodies/sid_data.hpp"
 #include "core/system.hpp"
 #include "fe_test_support.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "io/sid_file.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "fe_import/sid_file.hpp"
 #include <nlohmann/json.hpp>
 
 using namespace flexmbd;

@@ -1,4 +1,4 @@
-// Undriven mechanisms through singular positions (issue 11, item 9): parallelogram
+// Undriven mechanisms through singular positions: parallelogram
 // linkages swinging under gravity pass through positions where all links are collinear and
 // the constraint Jacobian G loses rank for an instant. The engine carries them through
 // (IDA, and the augmented Lagrangian integrator ALI3-P across the singular positions) and
@@ -23,8 +23,8 @@
 #include "builders/planar_builders.hpp"
 #include "core/system.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 

@@ -6,9 +6,9 @@
 
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

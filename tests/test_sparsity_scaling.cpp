@@ -1,4 +1,4 @@
-// Structure that keeps the cost of large models linear (issue 24): the kinematic matrix
+// Structure that keeps the cost of large models linear: the kinematic matrix
 // T(q) of a spatial flexible body written through its structural non-zeros only, a
 // Jacobian pattern and factors that grow linearly with the mesh and with a chain of
 // flexible links, and the KLU ordering chosen per model by trial factorisations. These
@@ -12,8 +12,8 @@
 #include "core/dae_system.hpp"
 #include "integrators/initial_conditions.hpp"
 #include "integrators/klu_ordering.hpp"
-#include "io/scene.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "scene/scene.hpp"
+#include "problems/ffr_test_models.hpp"
 
 using namespace flexmbd;
 

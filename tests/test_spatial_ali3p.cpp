@@ -1,4 +1,4 @@
-// The augmented Lagrangian integrator ALI3-P on spatial models (issue 25, item 2): q' = T(q) v
+// The augmented Lagrangian integrator ALI3-P on spatial models: q' = T(q) v
 // with Euler parameters, integrated in velocity space (the step's displacement d, q_{n+1} =
 // q_n (+) d; docs/formulations.md, "Singular positions: the augmented Lagrangian
 // integrator"). A heavy top checks the method (energy to its order, constraints at round-off
@@ -19,9 +19,9 @@
 #include "core/system_evaluation.hpp"
 #include "integrators/augmented_lagrangian_integrator.hpp"
 #include "integrators/initial_conditions.hpp"
-#include "integrators/simulation.hpp"
-#include "integrators/singular_crossing.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "simulation/singular_crossing.hpp"
+#include "scene/scene.hpp"
 #include "joints/spatial_joint.hpp"
 
 using namespace flexmbd;

@@ -11,8 +11,8 @@
 #include "builders/planar_builders.hpp"
 #include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;

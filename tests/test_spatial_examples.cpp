@@ -1,4 +1,4 @@
-// Issue 25, item 5: the spatial example scenes of examples/ run here, each against a
+// The spatial example scenes of examples/ run here, each against a
 // physical fact of it (docs/spatial.md, "Spatial examples"):
 //  - examples/heavy_top.json: energy and the top's two angular momenta conserved, the
 //    steady precession of Goldstein eq. 5.74 kept;
@@ -23,7 +23,7 @@
 #include "bodies/rigid_body_3d.hpp"
 #include "cli_fixture.hpp"
 #include "core/rotation_3d.hpp"
-#include "io/scene.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -10,8 +10,8 @@
 
 #include "bodies/ffr_beam_model_3d.hpp"
 #include "bodies/ffr_body_3d.hpp"
-#include "integrators/linearization.hpp"
-#include "io/scene.hpp"
+#include "analysis/linearization.hpp"
+#include "scene/scene.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/scene.hpp"
+#include "scene/scene.hpp"
 #include "test_support.hpp"
 
 using namespace flexmbd;

@@ -1,5 +1,5 @@
-// Static equilibrium and modes at rest of spatial models (issue 25, item 2): Newton in
-// velocity space with Euler-parameter increments (integrators/static_equilibrium.hpp)
+// Static equilibrium and modes at rest of spatial models: Newton in
+// velocity space with Euler-parameter increments (analysis/static_equilibrium.hpp)
 // against closed forms: a flexible L-frame under its weight, a rigid pendulum hanging
 // from a revolute joint, and a clamped beam's bending frequencies about its sagged state.
 #include <gtest/gtest.h>
@@ -13,9 +13,9 @@
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
 #include "elements/beam_section.hpp"
-#include "integrators/linearization.hpp"
-#include "integrators/static_equilibrium.hpp"
-#include "io/scene.hpp"
+#include "analysis/linearization.hpp"
+#include "analysis/static_equilibrium.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -1,4 +1,4 @@
-// Issue 25, item 4: spatial scenes modelled in the world. Joints placed by a world point
+// Spatial scenes modelled in the world. Joints placed by a world point
 // and axes (key "world", joints/world_frames.hpp), rigid bodies from shapes (key "shape",
 // bodies/shape_inertia.hpp), the joint output columns of results.csv
 // (joints/joint_outputs.hpp), the example examples/spatial_four_bar.json, and the exit
@@ -17,8 +17,8 @@
 #include "cli_fixture.hpp"
 #include "core/rotation_3d.hpp"
 #include "core/system_evaluation.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene.hpp"
 #include "joints/joint_outputs.hpp"
 #include "joints/world_frames.hpp"
 #include "test_support.hpp"

@@ -1,4 +1,4 @@
-// Spinning spatial beams (issue 25, item 3): the cross-sections' second-order rotation in
+// Spinning spatial beams: the cross-sections' second-order rotation in
 // the FFR kinetic energy (BeamElement3d::sectionRotationMoment, sectionRotationCoupling)
 // and the Rayleigh beam's rotary inertia.
 //  1. A twisted beam's inertia tensor against the exact one of rigidly turned sections:
@@ -27,7 +27,7 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "core/system.hpp"
 #include "core/time_law.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 

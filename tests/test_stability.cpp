@@ -1,4 +1,4 @@
-// Hard cases of issue 5 (fast part, CTest label "stability"): stiff elastic rods, crank
+// Hard cases (fast part, CTest label "stability"): stiff elastic rods, crank
 // speeds around the rod's first bending frequency, singular configurations, large mass
 // and stiffness ratios, tiny and huge units, inconsistent initial values. Each test
 // asserts what must hold; the figures it measures are printed as "[ measured ]" lines
@@ -20,11 +20,11 @@
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/ffr_test_models.hpp"
 #include "tests/four_bar_reference.hpp"
-#include "tests/reference_solutions.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

@@ -1,4 +1,4 @@
-// Hard cases of issue 5, long runs (CTest labels "stability" and "slow", so not in the
+// Hard cases, long runs (CTest labels "stability" and "slow", so not in the
 // default `ctest -LE slow`): 1000 crank revolutions of the rigid and of the elastic
 // slider-crank. Constraint drift must stay bounded (and not grow from the first to the
 // last revolutions) and the driver's work must equal the change of kinetic + potential
@@ -11,10 +11,10 @@
 #include <cmath>
 
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "io/scene.hpp"
-#include "tests/ffr_test_models.hpp"
-#include "tests/reference_solutions.hpp"
+#include "simulation/simulation.hpp"
+#include "scene/scene.hpp"
+#include "problems/ffr_test_models.hpp"
+#include "problems/reference_solutions.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// Static equilibrium with automatic load stepping (issue 11, item 12): a cantilever with
+// Static equilibrium with automatic load stepping: a cantilever with
 // geometric stiffening under a transverse tip load.
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include "builders/planar_builders.hpp"
 #include "core/errors.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/static_equilibrium.hpp"
+#include "analysis/static_equilibrium.hpp"
 
 using namespace flexmbd;
 
@@ -72,7 +72,7 @@ TEST(StaticEquilibrium, StiffenedCantileverAtFivePercentAndMoreConvergesByLoadSt
     EXPECT_LT(g.lpNorm<Eigen::Infinity>(), 1e-12) << fraction;
     // The root carries the load: vertical reaction on the beam = P (statics).
     EXPECT_NEAR(eq.lambda[1], -P, kEquilibriumTolerance * P) << fraction;
-    // Deflection: the element's averaged membrane strain (issue 11, item 8) and the free
+    // Deflection: the element's averaged membrane strain and the free
     // axial end make the membrane force zero in every element (axial equilibrium of the
     // nodes), so this moderate-rotation model's exact answer is the linear one,
     // delta = P L^3 / (3 E I), to which Hermite elements are nodally exact. (The

@@ -1,4 +1,4 @@
-// Issue 25, item 6: accuracy against the tolerance on a stiff spatial benchmark, the
+// Accuracy against the tolerance on a stiff spatial benchmark, the
 // IFToMM A05 stiff flyball governor (docs/stability.md, "Stiff force elements: the free
 // A05 governor"). The governor of examples/flyball_governor.json (the A05 parameters:
 // springs k = 8e5 N/m, c = 4e4 N s/m) with the motor removed and the whole model spun at
@@ -19,10 +19,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "integrators/integrator_choice.hpp"
-#include "integrators/simulation.hpp"
-#include "integrators/tolerances.hpp"
-#include "io/scene.hpp"
+#include "simulation/integrator_choice.hpp"
+#include "simulation/simulation.hpp"
+#include "simulation/tolerances.hpp"
+#include "scene/scene.hpp"
 
 using namespace flexmbd;
 using nlohmann::json;

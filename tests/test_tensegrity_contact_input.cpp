@@ -1,5 +1,5 @@
 // Contact detection between members (analytic sweep, shared-node rule) and the bad-input
-// rules of tensegrity models and scenes (issue 6), including a reported LCP failure and
+// rules of tensegrity models and scenes, including a reported LCP failure and
 // the command line.
 #include <gtest/gtest.h>
 

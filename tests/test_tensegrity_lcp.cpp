@@ -72,7 +72,7 @@ void netLcp(int k, unsigned seed, MatX& W, VecX& q) {
 #endif
 #endif
 
-// Issue 11, item 5: every solve created Siconos SolverOptions and freed only their
+// Every solve created Siconos SolverOptions and freed only their
 // contents (120 bytes lost per solve: 1.2 MB over 10,000 solves). The heap in use
 // (glibc mallinfo2) must not grow with the number of solves or of solvers. Bound: 64 KB,
 // room for allocator bookkeeping, 1/19 of what the leak lost here.

@@ -1,4 +1,4 @@
-// The regular 3-strut tensegrity prism (issue 6): self-stress from the equilibrium
+// The regular 3-strut tensegrity prism: self-stress from the equilibrium
 // matrix against the analytic force densities, rest under prestress (both methods), and
 // the release after shortening one cable (slack and taut events, energy history).
 #include <gtest/gtest.h>

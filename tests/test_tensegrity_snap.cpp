@@ -1,4 +1,4 @@
-// Cable snaps of tensegrity models (issue 6, source document 001): the two-mass cable
+// Cable snaps of tensegrity models (source document 001): the two-mass cable
 // snap against its analytic impact solution (method 1), the massless-cable limit
 // (method 2), momentum conservation through snaps and the energy balance of both methods.
 #include <gtest/gtest.h>
@@ -54,7 +54,7 @@ TEST(TensegritySnap, TwoMassInextensibleCableMatchesAnalyticImpact) {
   Recorder rec;
   const TensegrityRunSummary sum = TensegrityTimeStepper(s, set).run(rec.observer());
   ASSERT_TRUE(sum.ok) << sum.message;
-  // Tolerance 1e-9 (issue 6): the LCP of a single cable is solved exactly by Lemke; the
+  // Tolerance 1e-9: the LCP of a single cable is solved exactly by Lemke; the
   // remaining error is round-off.
   constexpr double kTol = 1e-9;
   ASSERT_EQ(sum.snaps, 1);

@@ -1,4 +1,4 @@
-// Planar T-bar tensegrity (issue 6): two crossed struts (they pass over each other out
+// Planar T-bar tensegrity: two crossed struts (they pass over each other out
 // of plane: no contact is checked), four perimeter cables, left node pinned, right node
 // on a vertical roller, a horizontal load ramped at the top node. Method 1 (inextensible
 // cables) against method 2 (massless elastic cables, stiffness growing).

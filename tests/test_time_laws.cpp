@@ -172,7 +172,7 @@ TEST(TimeLawValues, HarmonicAtAPoint) {
   EXPECT_NEAR(zero.ddf, 0.0, kRoundoffTol);
 }
 
-// theta = (w/T)(t^2/2 + (T/(2pi))^2 (cos(2 pi t/T) - 1)), t < T (issue 2), so
+// theta = (w/T)(t^2/2 + (T/(2pi))^2 (cos(2 pi t/T) - 1)), t < T, so
 //   theta'  = (w/T)(t - (T/(2pi)) sin(2 pi t/T)),   theta'' = (w/T)(1 - cos(2 pi t/T)).
 // t = 0:   theta = 0, theta' = 0, theta'' = 0.
 // t = T/2: theta = wT/8 - wT/(2 pi^2), theta' = w/2, theta'' = 2w/T (peak).

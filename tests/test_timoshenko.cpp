@@ -1,4 +1,4 @@
-// The Timoshenko beam element (issue 25 item 3): shear deformation with the
+// The Timoshenko beam element: shear deformation with the
 // interdependent interpolation (elements/beam_element_3d; Przemieniecki, Theory of
 // Matrix Structural Analysis, sec. 5.6), validated against
 //  1. its own energy: K = int (EI psi'^2 + kappa G A gamma^2 + EA u'^2 + GJ tx'^2) dx over

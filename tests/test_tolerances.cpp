@@ -1,4 +1,4 @@
-// Tolerance semantics (issue 24, integrators/tolerances.hpp): the default class
+// Tolerance semantics (simulation/tolerances.hpp): the default class
 // tolerances relative to the model's sizes, the override of rtol/atol that scales every
 // class together (command line and API alike), the round-off floors, and what they buy:
 // tightening the tolerances tightens the elastic coordinates too, and Simeon's crank
@@ -12,11 +12,11 @@
 #include <map>
 #include <sstream>
 
-#include "benchmarks/problems/bari_crank.hpp"
+#include "problems/bari_crank.hpp"
 #include "core/errors.hpp"
-#include "integrators/simulation.hpp"
-#include "integrators/tolerances.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "simulation/tolerances.hpp"
+#include "scene/scene.hpp"
 #include "tests/cli_fixture.hpp"
 
 using namespace flexmbd;

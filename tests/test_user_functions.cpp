@@ -1,4 +1,4 @@
-// User functions (issue 28, item 3; core/user_function.hpp): C++ callables as time laws
+// User functions (core/user_function.hpp): C++ callables as time laws
 // and spring-damper laws, their finite-difference derivatives against the exact ones, a
 // user law run against the same law built in and against a closed form, and an exception
 // in a callable ending the run with its message and the results so far.
@@ -12,7 +12,7 @@
 #include "builders/spatial_builders.hpp"
 #include "core/errors.hpp"
 #include "core/user_function.hpp"
-#include "integrators/simulation.hpp"
+#include "simulation/simulation.hpp"
 
 using namespace flexmbd;
 

@@ -1,4 +1,4 @@
-// flexmbd view (app/view_command.cpp, io/html_viewer.cpp, viewer/viewer.js): the page's
+// flexmbd view (app/view_command.cpp, viewer/html_viewer.cpp, viewer/viewer.js): the page's
 // data against closed forms and the run's own outputs, its errors, and the page opened in
 // a real browser (headless Chromium): it renders (the canvas not blank), without console
 // errors, with the frames and bodies of the run. Screenshots are kept in

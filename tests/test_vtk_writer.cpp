@@ -18,10 +18,10 @@
 #include "bodies/ffr_body_3d.hpp"
 #include "bodies/rigid_body_3d.hpp"
 #include "core/rotation_3d.hpp"
-#include "io/scene.hpp"
-#include "io/vtk_writer.hpp"
+#include "scene/scene.hpp"
+#include "results/vtk_writer.hpp"
 #include "tensegrity/tensegrity_structure.hpp"
-#include "tests/ffr_test_models.hpp"
+#include "problems/ffr_test_models.hpp"
 #include "tests/test_support.hpp"
 
 using namespace flexmbd;

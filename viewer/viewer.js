@@ -1,4 +1,4 @@
-// flexmbd's browser viewer: the script of the page `flexmbd view` writes (io/html_viewer.cpp
+// flexmbd's browser viewer: the script of the page `flexmbd view` writes (viewer/html_viewer.cpp
 // puts it there with three.js and the data; docs/viewer.md). An ES module, ASCII only.
 // The page reports how it went in the element of id flexmbd-status (JSON: frames, bodies,
 // errors, pixels drawn), which the browser test reads (tests/test_viewer.cpp).

@@ -348,7 +348,7 @@ def _merge(target, value):
 
 def _path_parts(path):
     """The names and indices of a dotted path "bodies[1].section.area", or InputError
-    (parsed by the engine, io/scene_path.hpp: the one parser of the syntax, which
+    (parsed by the engine, scene/scene_path.hpp: the one parser of the syntax, which
     sensitivity parameters use too)."""
     return _flexmbd.parse_scene_path(path)
 

@@ -40,7 +40,7 @@ PLOT_KEYS = {"x", "y", "group", "file", "title", "log_x", "log_y"}
 PLOT_FILE_TYPES = (".png", ".svg", ".pdf")
 MAX_TITLE_LENGTH = 300  # a title is one line over the figure; matplotlib fails on 100 kB ("raster overflow")
 
-# The engine's one rule for names (checkName, io/json_reader.hpp): axis and output names
+# The engine's one rule for names (checkName, scene/json_reader.hpp): axis and output names
 # become column names of study.csv and the plot's file name a file in --out.
 NAME_RULE = "names are 1 to 64 characters, each an ASCII letter, a digit, '_' or '-'"
 

@@ -1,4 +1,4 @@
-"""The build backend of `pip install .` (PEP 517, named by pyproject.toml; issue 28, item 2).
+"""The build backend of `pip install .` (PEP 517, named by pyproject.toml).
 
 It needs nothing but the Python standard library (no setuptools, no wheel, no download:
 pyproject.toml requires no build packages), so `pip install .` works offline with or

@@ -10,9 +10,9 @@
 #include "bodies/rigid_body_2d.hpp"
 #include "builders/planar_builders.hpp"
 #include "core/system_evaluation.hpp"
-#include "integrators/simulation.hpp"
-#include "io/results_writer.hpp"
-#include "io/scene.hpp"
+#include "simulation/simulation.hpp"
+#include "results/results_writer.hpp"
+#include "scene/scene.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-"""Every code block of README.md and docs/*.md runs or compiles as shown (issue 28: a
+"""Every code block of README.md and docs/*.md runs or compiles as shown (a
 newcomer's snippets failed on a missing pandas and showed a stale output).
 
 Python blocks: each runs in a fresh namespace with `flexmbd` imported (some blocks continue
@@ -132,8 +132,8 @@ def test_cpp_block_compiles(code, tmp_path):
             given.append(decls[:decls.rfind(";") + 1])  # the declarations, not the words after them
         else:
             body.append(line)
-    source = "\n".join(head + ["#include <cstdio>", "#include <cmath>", "#include \"io/scene.hpp\"",
-                               "#include \"integrators/simulation.hpp\"", "using namespace flexmbd;",
+    source = "\n".join(head + ["#include <cstdio>", "#include <cmath>", "#include \"scene/scene.hpp\"",
+                               "#include \"simulation/simulation.hpp\"", "using namespace flexmbd;",
                                "int main() {"] + given + body + ["}"]) + "\n"
     path = tmp_path / "block.cpp"
     path.write_text(source)

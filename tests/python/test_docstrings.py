@@ -1,4 +1,4 @@
-"""Issue 28, item 6: every public callable of the flexmbd package has a docstring.
+"""Every public callable of the flexmbd package has a docstring.
 
 Public: the names of flexmbd, flexmbd.study and flexmbd._flexmbd not starting with "_",
 the public methods of their classes and the properties (pybind11 attributes) of the

@@ -301,14 +301,14 @@ def test_tolerance_overrides_scale_every_class_as_the_command_line():
     assert s.atol == 1e-8 and math.isclose(s.atol_elastic, 1e-11, rel_tol=1e-12) and s.rtol == 1e-6
     t = scene.run().summary["tolerances"]
     assert math.isclose(t["elastic"], 1e-11, rel_tol=1e-12)
-    assert math.isclose(t["angle"], 1e-8, rel_tol=1e-12)  # atol in rad (integrators/tolerances.cpp)
+    assert math.isclose(t["angle"], 1e-8, rel_tol=1e-12)  # atol in rad (simulation/tolerances.cpp)
     assert math.isclose(t["velocity"], 1e-8, rel_tol=1e-12)  # atol per second
     s.override_tolerances(rtol=1e-8)  # rtol alone: every absolute tolerance by the same factor
     assert s.rtol == 1e-8 and math.isclose(s.atol, 1e-10, rel_tol=1e-12)
     assert math.isclose(s.atol_elastic, 1e-13, rel_tol=1e-12)
 
 
-# ----- issue 26: Ctrl-C during a run, the name rule -------------------------------------
+# ----- Ctrl-C during a run, the name rule ------------------------------------------------
 
 def test_ctrl_c_interrupts_a_run_and_leaves_the_interpreter_usable():
     """D7: a KeyboardInterrupt (here from SIGALRM's handler) reaches Python within the run,

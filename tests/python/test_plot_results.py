@@ -1,5 +1,5 @@
 """scripts/plot_results.py (flexmbd plot): the units it reads from spatial column names,
-and how it parts columns of one unit into panels by their size (issue 28: a spatial run's
+and how it parts columns of one unit into panels by their size (a spatial run's
 0.2 mm deflection and 0.3 m positions on one axis drew the deflection as a flat line).
 
 Run by CTest as part of python_bindings (tests/CMakeLists.txt).
@@ -51,7 +51,7 @@ def test_a_spatial_run_is_drawn_by_default(plot, tmp_path):
 @pytest.mark.parametrize("driver, unit", [("motor", "N m"), ("push", "N")])
 def test_a_driver_effort_has_the_unit_of_what_it_drives(plot, tmp_path, driver, unit):
     # summary.json's "units": a body_theta driver's effort is a torque, a body_x driver's a
-    # force (issue 28: the axis said "N or N m")
+    # force (the axis once said "N or N m")
     import json
     cli = os.environ.get("FLEXMBD_CLI")
     if not cli:

@@ -1,4 +1,4 @@
-"""The Python API under abuse (issue 26, item 6): every builder given wrong types and
+"""The Python API under abuse: every builder given wrong types and
 absurd values raises TypeError or flexmbd.InputError and never takes the interpreter down;
 the same scenes run in 8 threads at once give the numbers of one run, and the interpreter
 stays usable; a study on a Dask LocalCluster whose points fail on input, in the solver or
@@ -33,7 +33,7 @@ def example(name):
 # Values no builder should take for any argument, or only some: wrong types (None, strings,
 # containers of the wrong shape or kind, objects, modules, classes, functions, complex) and
 # absurd numbers (NaN, infinities, 1e308, negative, zero, integers beyond 64 bits). Sizes
-# that are merely large (10**6 elements) are left out: what sizes run is issue 26, item 7.
+# that are merely large (10**6 elements) are left out: what sizes run is tested in C++ (test_numeric_limits).
 HOSTILE = [None, "x", "", "a,b", "x\ny", "ground", b"bytes", 1j, True, 0, -1, 3.5, 2 ** 31, 2 ** 70, -2 ** 70,
            1e308, -1e308, math.nan, math.inf, -math.inf, 5e-324, [], [1, 2], [[1, 2], [3]], (0, 0, 0),
            {"a": 1}, object(), np.array([np.nan] * 3), np.zeros((3, 3)), np.zeros((2, 2, 2)),

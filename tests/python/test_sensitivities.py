@@ -35,7 +35,7 @@ def test_slider_position_derivative_by_rod_length_is_the_closed_form():
 
 
 def test_table_and_gradients_equal_the_command_lines(tmp_path):
-    # one engine path (io/sensitivity_results.hpp runSensitivityScene) behind both: the same
+    # one engine path (results/sensitivity_results.hpp runSensitivityScene) behind both: the same
     # numbers to the 17 digits results.csv prints
     res = flexmbd.load_scene(CRANK).run(sensitivities=[SLIDER_MASS, ROD_LENGTH])
     out = tmp_path / "out"
@@ -81,7 +81,7 @@ def free_crank():
 def test_adjoint_gradients_equal_the_forward_ones_and_the_command_lines(tmp_path):
     # int slider.x dt by the adjoint, against the forward sensitivities of slider.x at
     # outputs 1e-3 s apart integrated by Simpson's rule (error ~h^4: 1e-12) and against the
-    # command line (one engine path, io/adjoint_results.hpp: the same numbers)
+    # command line (one engine path, results/adjoint_results.hpp: the same numbers)
     scene = free_crank()
     res = flexmbd.scene_from_dict(scene).run(sensitivities=[SLIDER_MASS, ROD_LENGTH], adjoint="integral:slider.x")
     assert res.ok

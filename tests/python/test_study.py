@@ -186,7 +186,7 @@ AXIS = [{"key": "drivers[0].law.speed", "values": [100.0]}]
 
 
 @pytest.mark.parametrize("text,words", [
-    # found by the fuzz test (issue 26): each was a Python traceback, exit 1
+    # found by the fuzz test: each was a Python traceback, exit 1
     ("[" * 100000 + "]" * 100000, "not valid JSON: arrays or objects nested too deep"),
     ('{"scene": "x.json", "axes": [], "outputs": {"after": -1e400}}', "the number -1e400 is beyond the range of a double"),
     (json.dumps({"axes": AXIS, "outputs": {"summary": "steps"}}), "outputs: key 'summary' must be a list of column names"),

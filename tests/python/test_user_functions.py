@@ -1,4 +1,4 @@
-"""User functions from Python (issue 28, item 3; docs/python.md, "User functions"):
+"""User functions from Python (docs/python.md, "User functions"):
 Python callables as time laws (torques, loads, drivers) and spring-damper laws, run with
 the GIL released and taken only inside the callable; an exception in a callable ends the
 run as a solver failure with its message and the results so far."""
