@@ -6,7 +6,8 @@ that must not alter behaviour (a refactoring) against the build before it.
   scripts/compare_examples.py compare BEFORE AFTER   every results file, column by column
 
 A scene runs through the subcommand it is for: `kinematics` for a linkage (nodes, no bodies),
-`run` for the rest (tensegrity scenes included); a study file (a "scene" and "axes") is
+`run` for the rest (tensegrity scenes included), and the examples made for `modes` also
+through `flexmbd modes`; a study file (a "scene" and "axes") is
 left out: its points are runs of a scene that is compared on its own. `compare` reads
 every *.csv of each pair of folders and prints, per file, the largest difference of a
 column relative to that column's largest magnitude; it fails (exit 1) where a file or
@@ -26,9 +27,16 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 EXAMPLES = os.path.join(os.path.dirname(HERE), "examples")
 
 
+# the examples made for `flexmbd modes`, with the options their docs give
+MODES = {"modes_blade": ["--count", "3", "--steady", "--sweep", "motor:0:60:4"],
+         "spinning_blade": [], "rayleigh_rotor": []}
+
+
 def subcommand(scene):
     if "axes" in scene and "scene" in scene:
         return None
+    if scene.get("model") == "tensegrity":
+        return "run"
     if "nodes" in scene and "bodies" not in scene:  # a linkage of document 000
         return "kinematics"
     return "run"
@@ -54,6 +62,12 @@ def run_all(flexmbd, out):
         print(f"{stem}: flexmbd {command}, exit {done.returncode}, {time.monotonic() - t0:.1f} s")
         with open(os.path.join(out, stem + ".exit"), "w") as f:
             f.write(f"{done.returncode}\n{done.stderr}")
+        if stem in MODES:
+            done = subprocess.run([flexmbd, "modes", os.path.join(EXAMPLES, name), "--out", target + "_modes",
+                                   "--quiet"] + MODES[stem], capture_output=True, text=True)
+            print(f"{stem}: flexmbd modes, exit {done.returncode}")
+            with open(os.path.join(out, stem + "_modes.exit"), "w") as f:
+                f.write(f"{done.returncode}\n{done.stderr}")
     return status
 
 
