@@ -26,19 +26,37 @@ import glob
 import io
 import os
 import re
+import shlex
 import shutil
 import subprocess
 
 import pytest
 
 SOURCE = os.path.abspath(os.environ.get("FLEXMBD_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", "..")))
+TUTORIALS = sorted(glob.glob(os.path.join(SOURCE, "docs", "tutorials", "*.md")))
+
+
+def pages():
+    """README.md, docs/*.md and docs/tutorials/*.md."""
+    return [os.path.join(SOURCE, "README.md")] + sorted(glob.glob(os.path.join(SOURCE, "docs", "*.md"))) + TUTORIALS
+
+
+# A block that shows a file of the project is marked by the line before it,
+# `<!-- file: examples/NAME -->`: it must be that file, as it is (the file itself is built,
+# run and tested where it is), so it is compared, not run.
+FILE_MARK = re.compile(r"<!-- file: (\S+) -->\n```\w+\n(.*?)^```", re.S | re.M)
+
+
+def shows_a_file(text, start):
+    return re.search(r"<!-- file: \S+ -->\n$", text[:start]) is not None
 
 
 def python_blocks():
-    files = [os.path.join(SOURCE, "README.md")] + sorted(glob.glob(os.path.join(SOURCE, "docs", "*.md")))
-    for path in files:
+    for path in pages():
         text = open(path, encoding="utf-8").read()
         for k, m in enumerate(re.finditer(r"^```python\n(.*?)^```", text, re.S | re.M)):
+            if shows_a_file(text, m.start()):
+                continue
             line = text[:m.start()].count("\n") + 1
             yield pytest.param(m.group(1), id=f"{os.path.relpath(path, SOURCE)}:{line}")
 
@@ -68,16 +86,17 @@ def test_python_block_runs_as_shown(code, monkeypatch):
 # ----- shell blocks ----------------------------------------------------------------------------
 
 def blocks(languages):
-    files = [os.path.join(SOURCE, "README.md")] + sorted(glob.glob(os.path.join(SOURCE, "docs", "*.md")))
-    for path in files:
+    for path in pages():
+        if path in TUTORIALS and languages & {"sh", "bash"}:
+            continue  # a tutorial's commands run as one session (test_tutorial_runs_as_shown)
         text = open(path, encoding="utf-8").read()
         for m in re.finditer(r"^```(\w+)\n(.*?)^```", text, re.S | re.M):
-            if m.group(1) in languages:
+            if m.group(1) in languages and not shows_a_file(text, m.start()):
                 line = text[:m.start()].count("\n") + 1
                 yield f"{os.path.relpath(path, SOURCE)}:{line}", m.group(2)
 
 
-COMMAND = re.compile(r"^(flexmbd|build/app/flexmbd|build/python/flexmbd-study)\s")
+COMMAND = re.compile(r"^(flexmbd|build/app/flexmbd|build/python/flexmbd-study|build/examples/example_\w+)(\s|$)")
 PLACEHOLDER = re.compile(r"\[|\bSCENE\b|\bDIR\b|\bFILE\b|\bNAME\b|tcp://host")
 
 SHELL_COMMANDS = [pytest.param(line, id=f"{where}:{line.split()[1] if len(line.split()) > 1 else line}")
@@ -140,3 +159,45 @@ def test_cpp_block_compiles(code, tmp_path):
     r = subprocess.run([compiler, "-std=c++17", "-fsyntax-only", "-I", SOURCE, "-isystem", "/usr/include/eigen3",
                         "-isystem", "/usr/include/suitesparse", str(path)], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, f"{source}\n{r.stderr[-3000:]}"
+
+
+# ----- blocks that show a file, and the tutorials ------------------------------------------
+
+FILE_BLOCKS = [pytest.param(m.group(1), m.group(2), id=f"{os.path.relpath(path, SOURCE)}:{m.group(1)}")
+               for path in pages() for m in FILE_MARK.finditer(open(path, encoding="utf-8").read())]
+
+
+def test_the_tutorials_show_files():
+    assert len(TUTORIALS) >= 3 and len(FILE_BLOCKS) >= 3
+
+
+@pytest.mark.parametrize("name,code", FILE_BLOCKS)
+def test_a_block_that_shows_a_file_is_that_file(name, code):
+    with open(os.path.join(SOURCE, name), encoding="utf-8") as f:
+        assert code == f.read(), f"the block shown as {name} differs from the file: copy the file into the page"
+
+
+# A synopsis in a tutorial: an optional part "[--...]" or a placeholder word (a scene path
+# such as 'bodies[1].mass' is a concrete argument there).
+SYNOPSIS = re.compile(r"\[-|\bSCENE\b|\bDIR\b|\bFILE\b|\bNAME\b|tcp://host")
+
+
+@pytest.mark.parametrize("page", [pytest.param(p, id=os.path.basename(p)) for p in TUTORIALS])
+def test_tutorial_runs_as_shown(page, tmp_path):
+    # Every command line of the page's shell blocks, in order, in one folder: later steps
+    # read what earlier ones wrote, as they do for a reader who follows the page.
+    cli = os.environ.get("FLEXMBD_CLI")
+    if not cli:
+        pytest.skip("FLEXMBD_CLI not set (CTest sets it)")
+    build = os.path.dirname(os.path.dirname(cli))
+    os.symlink(os.path.join(SOURCE, "examples"), tmp_path / "examples")
+    os.symlink(build, tmp_path / "build")
+    text = open(page, encoding="utf-8").read()
+    lines = [line for m in re.finditer(r"^```(?:sh|bash)\n(.*?)^```", text, re.S | re.M)
+             for line in m.group(1).splitlines() if COMMAND.match(line) and not SYNOPSIS.search(line)]
+    assert lines, f"{page} has no command to run"
+    for line in lines:
+        words = shlex.split(line)
+        words[0] = cli if words[0] in ("flexmbd", "build/app/flexmbd") else words[0]
+        r = subprocess.run(words, cwd=tmp_path, capture_output=True, text=True, timeout=600)
+        assert r.returncode == 0, f"{os.path.basename(page)}: {line}\nexit {r.returncode}\n{r.stderr[-2000:]}"
