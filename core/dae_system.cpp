@@ -240,6 +240,284 @@ void localRateMatrices(const System& sys, ConstraintIndex ci, const double* q, c
   }
 }
 
+/// One constraint's columns, rows and scratch, as the Jacobian's stages read them.
+struct ConstraintBlock {
+  ConstraintIndex ci;
+  const Constraint& con;
+  const std::vector<int>& cols;
+  const std::vector<int>& qcols;
+  int nl, nql, row, me;
+  ConstraintScratch& cs;
+  const ConstraintEvaluation& ev;
+};
+
+/// The stages of DaeSystem::jacobian (the iteration matrix dF/dy + cj dF/dy'): bodies,
+/// forces, constraints, released equations. `identityT`: every velocity is a coordinate
+/// rate (planar models), where the T(q) terms compile away. Its members are the DAE's
+/// data under the DAE's own names.
+template <bool identityT>
+class JacobianAssembly {
+ public:
+  /// What the DAE holds for the assembly.
+  struct Model {
+    const System& sys;
+    const DaeLayout& layout;
+    Formulation formulation;
+    const VecX& metric;
+    const std::vector<int>& released;
+    const std::vector<std::vector<int>>& keptRows;
+    const std::vector<char>& partial;
+    const std::vector<SparsePattern>& ratePattern;
+    const std::vector<SparsePattern>& rateInversePattern;
+  };
+  JacobianAssembly(const Model& m, DaeSystemScratch& scratch, JacobianSink& sink, double time, const double* y,
+                   const double* yp, double cj)
+      : sys(m.sys), L(m.layout), formulation_(m.formulation), metric_(m.metric), released_(m.released),
+        keptRows_(m.keptRows), partial_(m.partial), ratePattern_(m.ratePattern),
+        rateInversePattern_(m.rateInversePattern), S(scratch), J(sink), t(time), y(y), cj(cj), q(y + L.q, L.nq),
+        v(y + L.v, L.nv), vp(yp + L.v, L.nv) {}
+
+  void run() {
+    bodyBlocks();
+    forceBlocks();
+    if (!identityT) {
+      S.DGtmu.setZero();
+      if (formulation_ == Formulation::Index1) coordinateRates(sys, q.data(), v.data(), S.Tv);
+    }
+    for (int c = 0; c < sys.numConstraints(); ++c) constraintRows(c);
+    releasedAndRateRows();
+  }
+
+ private:
+  /// F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body; F_q = q' - T w:
+  /// cj I and -T (with T = I: -I).
+  void bodyBlocks() {
+    const bool withGravity = sys.gravity() != Vec3::Zero();  // else its terms are zero
+    for (int b = 0; b < sys.numBodies(); ++b) {
+      const BodyIndex bi(b);
+      const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
+      if (nqb == 0) continue;
+      const Body& body = sys.body(bi);
+      const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
+      const auto qb = q.segment(qoff, nqb);
+      for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.q + qoff + k, cj);
+      if (identityT || body.velocitiesAreCoordinateRates()) {
+        for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.v + voff + k, -1.0);
+      } else {
+        fillPattern(ratePattern_[b], S.T[b], [&](const MatrixSink& T) { body.addCoordinateRateMatrix(qb, T); });
+        fillPattern(rateInversePattern_[b], S.Tinv[b],
+                    [&](const MatrixSink& T) { body.addCoordinateRateInverse(qb, T); });
+        // -T into F_q's velocity columns, its structural non-zeros only
+        const SparsePattern& Tp = ratePattern_[b];
+        for (int j = 0; j < nvb; ++j) {
+          for (int64_t k = Tp.colStart()[j]; k < Tp.colStart()[j + 1]; ++k) {
+            J.add(L.q + qoff + static_cast<int>(Tp.rowIndex()[k]), L.v + voff + j, -S.T[b][k]);
+          }
+        }
+      }
+      // each body writes its structural non-zeros only (sparse for large flexible bodies)
+      const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);
+      const MatrixSink cjM(J, L.v + voff, L.v + voff, cj), minusJv(J, L.v + voff, L.v + voff, -1.0);
+      body.addMassMatrixDerivative(qb, vp.segment(voff, nvb), Jq);
+      body.addInternalForceJacobians(qb, v.segment(voff, nvb), minusJq, minusJv);
+      if (withGravity) body.addGravityJacobian(qb, sys.gravity(), minusJq);
+      body.addMassMatrix(qb, cjM);
+    }
+  }
+
+  /// -dQ/dq and -dQ/dv of every force element.
+  void forceBlocks() {
+    for (int f = 0; f < sys.numForces(); ++f) {
+      const ForceIndex fi(f);
+      const auto& cols = sys.forceColumns(fi);
+      const auto& qcols = sys.forceCoordinateColumns(fi);
+      ForceScratch& fs = S.forces[f];
+      gather(cols, v.data(), fs.vl);
+      fs.Q.setZero();
+      fs.dQdq.setZero();
+      fs.dQdv.setZero();
+      sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, &fs.dQdq, &fs.dQdv, fs.work);
+      addBlock(J, L.v, fs.vRows, L.q, qcols, fs.dQdq, fs.column, -1.0);
+      addBlock(J, L.v, fs.vRows, L.v, cols, fs.dQdv, fs.column, -1.0);
+    }
+  }
+
+  /// Constraint c's blocks of every formulation (d(G^T lambda)/dq and G^T), then those of
+  /// its formulation's rows.
+  void constraintRows(int c) {
+    const ConstraintIndex ci(c);
+    const Constraint& con = sys.constraint(ci);
+    const auto& cols = sys.constraintColumns(ci);
+    const auto& qcols = sys.constraintCoordinateColumns(ci);
+    ConstraintScratch& cs = S.constraints[c];
+    const ConstraintEvaluation& ev = cs.ev;
+    const ConstraintBlock block{ci, con, cols, qcols, static_cast<int>(cols.size()), static_cast<int>(qcols.size()),
+                            sys.constraintOffset(ci), con.numEquations(), cs, ev};
+    const int row = block.row, me = block.me;
+    con.evaluate(sys.constraintStates(ci, q.data()), true, cs.ev);
+    gather(cols, v.data(), cs.vl);
+    if (!identityT) localRateMatrices(sys, ci, q.data(), S, ratePattern_, rateInversePattern_, cs.Tl, cs.Til);
+    // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
+    cs.Hx.setZero();
+    for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];
+    addBlock(J, L.v, cs.vRows, L.q, qcols, cs.Hx, cs.column);
+    addTransposedBlock(J, L.v, cs.vRows, L.lambda + row, ev.G, cs.column);
+    for (int a = 0; a < me; ++a) cs.vH.row(a).noalias() = cs.vl.transpose() * ev.H[a];  // d(G v)/dq
+    switch (formulation_) {
+      case Formulation::Ggl: return gglRows(c, block);
+      case Formulation::Index3:
+        if (identityT) {
+          addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
+        } else {
+          cs.dFdq.noalias() = ev.G * cs.Til;
+          addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
+        }
+        return;
+      case Formulation::Index1: return index1Rows(c, block);
+    }
+  }
+
+  /// GGL, the stabilised index 2 of Gear, Gupta and Leimkuhler: F_q += T D G^T mu,
+  /// F_g = h - f, F_mu = G v - f'.
+  void gglRows(int c, const ConstraintBlock& block) {
+    const auto& [ci, con, cols, qcols, nl, nql, row, me, cs, ev] = block;
+    // F_q += T D G^T mu: d/dq = T D sum_a mu_a H_a (+ the dT/dq term below), d/dmu = T D G^T
+    cs.Hx.setZero();
+    for (int a = 0; a < me; ++a) cs.Hx += y[L.mu + row + a] * ev.H[a];
+    if (identityT) {
+      for (int k = 0; k < nl; ++k) cs.Hx.row(k) *= metric_[cols[k]];  // D sum_a mu_a H_a
+      addBlock(J, L.q, cs.vRows, L.q, cols, cs.Hx, cs.column);
+      cs.TGt.resize(nl, me);  // (D G^T)
+      for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
+      addBlock(J, L.q, cs.vRows, L.mu + row, cs.TGt, cs.column);
+      addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
+    } else {
+      const double* mu = y + L.mu + row;
+      for (int k = 0; k < nl; ++k) {
+        cs.Hx.row(k) *= metric_[cols[k]];
+        S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
+      }
+      cs.THx.noalias() = cs.Tl * cs.Hx;
+      addBlock(J, L.q, cs.qRows, L.q, qcols, cs.THx, cs.column);
+      cs.TGt.resize(nl, me);
+      for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
+      cs.TDG.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
+      addBlock(J, L.q, cs.qRows, L.mu + row, cs.TDG, cs.column);
+      // F_g = h - f: dh/dq = G T+
+      cs.dFdq.noalias() = ev.G * cs.Til;
+      addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
+    }
+    addConstraintRows(J, c, L.mu + row, L.q, qcols, cs.vH, cs.column);
+    addConstraintRows(J, c, L.mu + row, L.v, cols, ev.G, cs.column);
+  }
+
+  /// Index 1: the acceleration-level rows F_a = G a + v^T H_a w - f''.
+  void index1Rows(int c, const ConstraintBlock& block) {
+    const auto& [ci, con, cols, qcols, nl, nql, row, me, cs, ev] = block;
+    // F_a = G a + v^T H_a w - f'', w = T v: d/dq = a^T H_a + d(v^T H_a w)/dq,
+    // d/dv = v^T H_a T + (H_a w)^T (2 v^T H_a with T = I), d/da = G. The third-derivative
+    // term d(v^T H_a w)/dq is the one block taken by central differences of the
+    // analytic H_a (and of T) (docs/formulations.md).
+    gather(cols, vp.data(), cs.al);
+    if (identityT) {
+      cs.wl = cs.vl;
+    } else {
+      gather(qcols, S.Tv.data(), cs.wl);
+    }
+    for (int a = 0; a < me; ++a) cs.dFdq.row(a).noalias() = cs.al.transpose() * ev.H[a];
+    S.qPlus = q;
+    S.qMinus = q;
+    for (int k = 0; k < nql; ++k) {
+      const int qc = qcols[k];
+      const double h = 1e-6 * (1.0 + std::abs(q[qc]));
+      S.qPlus[qc] = q[qc] + h;
+      S.qMinus[qc] = q[qc] - h;
+      con.evaluate(sys.constraintStates(ci, S.qPlus.data()), true, cs.plus);
+      con.evaluate(sys.constraintStates(ci, S.qMinus.data()), true, cs.minus);
+      if (!identityT) {  // (T v) at the perturbed coordinates, once per coordinate
+        coordinateRates(sys, S.qPlus.data(), v.data(), S.TvPlus);
+        gather(qcols, S.TvPlus.data(), cs.wl);
+        coordinateRates(sys, S.qMinus.data(), v.data(), S.TvPlus);
+        gather(qcols, S.TvPlus.data(), cs.wlMinus);
+      }
+      const VecX& wPlus = identityT ? cs.vl : cs.wl;
+      const VecX& wMinus = identityT ? cs.vl : cs.wlMinus;
+      for (int a = 0; a < me; ++a) {
+        cs.Hv.noalias() = cs.plus.H[a] * wPlus;
+        const double plus = cs.vl.dot(cs.Hv);
+        cs.Hv.noalias() = cs.minus.H[a] * wMinus;
+        cs.dFdq(a, k) += (plus - cs.vl.dot(cs.Hv)) / (2.0 * h);
+      }
+      S.qPlus[qc] = S.qMinus[qc] = q[qc];
+    }
+    addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
+    if (identityT) {
+      cs.vH *= 2.0;
+      cs.vH += cj * ev.G;
+      addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.vH, cs.column);
+    } else {
+      gather(qcols, S.Tv.data(), cs.wl);
+      cs.dFdv.resize(me, nl);
+      for (int a = 0; a < me; ++a) {
+        cs.Hv.noalias() = ev.H[a] * cs.wl;
+        cs.dFdv.row(a).noalias() = cs.vH.row(a) * cs.Tl;
+        cs.dFdv.row(a) += cs.Hv.transpose();
+      }
+      cs.dFdv += cj * ev.G;
+      addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.dFdv, cs.column);
+    }
+  }
+
+  /// The released equations' identity rows and, with T != I, the dT/dq term of F_q.
+  void releasedAndRateRows() {
+    // released equations: d(lambda_k)/d(lambda_k) = 1 (and d(mu_k)/d(mu_k) = 1)
+    for (const int r : released_) {
+      J.add(L.lambda + r, L.lambda + r, 1.0);
+      if (L.mu >= 0) J.add(L.mu + r, L.mu + r, 1.0);
+    }
+    if (!identityT) {
+      // F_q = q' + T(q) w, w = D G^T mu - v: the dT/dq term at fixed w
+      S.w = S.DGtmu - v;
+      for (int b = 0; b < sys.numBodies(); ++b) {
+        const BodyIndex bi(b);
+        const Body& body = sys.body(bi);
+        const int nqb = body.numCoordinates(), qoff = sys.coordinateOffset(bi);
+        if (nqb == 0 || body.velocitiesAreCoordinateRates()) continue;
+        body.addCoordinateRateJacobian(q.segment(qoff, nqb), S.w.segment(sys.velocityOffset(bi), body.numVelocities()),
+                                       MatrixSink(J, L.q + qoff, L.q + qoff));
+      }
+    }
+  }
+
+  /// J(row0 + i, colOffset + cols[j]) += B(i, j) over the kept rows i of constraint c.
+  void addConstraintRows(JacobianSink& J, int c, int row0, int colOffset, const std::vector<int>& cols, const MatX& B,
+                         VecX& buf) const {
+    if (!partial_[c]) return addRowsBlock(J, row0, colOffset, cols, B);
+    const std::vector<int>& kept = keptRows_[c];
+    const int n = static_cast<int>(kept.size());
+    for (size_t j = 0; j < cols.size(); ++j) {
+      for (int i = 0; i < n; ++i) buf[i] = B(kept[i], static_cast<Eigen::Index>(j));
+      J.addColumn(colOffset + cols[j], row0, kept.data(), buf.data(), n, 1.0);
+    }
+  }
+
+  const System& sys;
+  const DaeLayout& L;
+  Formulation formulation_;
+  const VecX& metric_;
+  const std::vector<int>& released_;
+  const std::vector<std::vector<int>>& keptRows_;
+  const std::vector<char>& partial_;
+  const std::vector<SparsePattern>& ratePattern_;
+  const std::vector<SparsePattern>& rateInversePattern_;
+  DaeSystemScratch& S;
+  JacobianSink& J;
+  double t;
+  const double* y;
+  double cj;
+  ConstMap q, v, vp;
+};
+
 }  // namespace
 
 std::string toString(Formulation f) {
@@ -612,210 +890,15 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
   }
 }
 
-void DaeSystem::addConstraintRows(JacobianSink& J, int c, int row0, int colOffset, const std::vector<int>& cols,
-                                  const MatX& B, VecX& buf) const {
-  if (!partial_[c]) return addRowsBlock(J, row0, colOffset, cols, B);
-  const std::vector<int>& kept = keptRows_[c];
-  const int n = static_cast<int>(kept.size());
-  for (size_t j = 0; j < cols.size(); ++j) {
-    for (int i = 0; i < n; ++i) buf[i] = B(kept[i], static_cast<Eigen::Index>(j));
-    J.addColumn(colOffset + cols[j], row0, kept.data(), buf.data(), n, 1.0);
-  }
-}
-
 template <bool IdentityT>
 void DaeSystem::jacobianImpl(double t, const double* y, const double* yp, double cj, JacobianSink& sink,
                              DaeScratch& scratch) const {
-  const DaeLayout& L = layout_;
-  const System& sys = sys_;
   DaeSystemScratch& S = scratchOf(scratch);
   // into the DAE's own pattern, the entries' positions as the last assembly found them
   JacobianSink positioned = sink.pattern() == &pattern_ ? sink.withPositions(S.positions) : sink;
-  JacobianSink& J = positioned;
-  constexpr bool identityT = IdentityT;
-  ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), vp(yp + L.v, L.nv);
-  // F_v = M v' - Q: d(M a)/dq - dQ/dq and cj M - dQ/dv, body by body; F_q = q' - T w:
-  // cj I and -T (with T = I: -I)
-  const bool withGravity = sys.gravity() != Vec3::Zero();  // else its terms are zero
-  for (int b = 0; b < sys.numBodies(); ++b) {
-    const BodyIndex bi(b);
-    const int nqb = sys.numCoordinates(bi), nvb = sys.numVelocities(bi);
-    if (nqb == 0) continue;
-    const Body& body = sys.body(bi);
-    const int qoff = sys.coordinateOffset(bi), voff = sys.velocityOffset(bi);
-    const auto qb = q.segment(qoff, nqb);
-    for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.q + qoff + k, cj);
-    if (identityT || body.velocitiesAreCoordinateRates()) {
-      for (int k = 0; k < nqb; ++k) J.add(L.q + qoff + k, L.v + voff + k, -1.0);
-    } else {
-      fillPattern(ratePattern_[b], S.T[b], [&](const MatrixSink& T) { body.addCoordinateRateMatrix(qb, T); });
-      fillPattern(rateInversePattern_[b], S.Tinv[b],
-                  [&](const MatrixSink& T) { body.addCoordinateRateInverse(qb, T); });
-      // -T into F_q's velocity columns, its structural non-zeros only
-      const SparsePattern& Tp = ratePattern_[b];
-      for (int j = 0; j < nvb; ++j) {
-        for (int64_t k = Tp.colStart()[j]; k < Tp.colStart()[j + 1]; ++k) {
-          J.add(L.q + qoff + static_cast<int>(Tp.rowIndex()[k]), L.v + voff + j, -S.T[b][k]);
-        }
-      }
-    }
-    // each body writes its structural non-zeros only (sparse for large flexible bodies)
-    const MatrixSink Jq(J, L.v + voff, L.q + qoff), minusJq(J, L.v + voff, L.q + qoff, -1.0);
-    const MatrixSink cjM(J, L.v + voff, L.v + voff, cj), minusJv(J, L.v + voff, L.v + voff, -1.0);
-    body.addMassMatrixDerivative(qb, vp.segment(voff, nvb), Jq);
-    body.addInternalForceJacobians(qb, v.segment(voff, nvb), minusJq, minusJv);
-    if (withGravity) body.addGravityJacobian(qb, sys.gravity(), minusJq);
-    body.addMassMatrix(qb, cjM);
-  }
-  for (int f = 0; f < sys.numForces(); ++f) {
-    const ForceIndex fi(f);
-    const auto& cols = sys.forceColumns(fi);
-    const auto& qcols = sys.forceCoordinateColumns(fi);
-    ForceScratch& fs = S.forces[f];
-    gather(cols, v.data(), fs.vl);
-    fs.Q.setZero();
-    fs.dQdq.setZero();
-    fs.dQdv.setZero();
-    sys.force(fi).addForce(t, sys.forceStates(fi, q.data()), fs.vl, fs.Q, &fs.dQdq, &fs.dQdv, fs.work);
-    addBlock(J, L.v, fs.vRows, L.q, qcols, fs.dQdq, fs.column, -1.0);
-    addBlock(J, L.v, fs.vRows, L.v, cols, fs.dQdv, fs.column, -1.0);
-  }
-  if (!identityT) {
-    S.DGtmu.setZero();
-    if (formulation_ == Formulation::Index1) coordinateRates(sys, q.data(), v.data(), S.Tv);
-  }
-  for (int c = 0; c < sys.numConstraints(); ++c) {
-    const ConstraintIndex ci(c);
-    const Constraint& con = sys.constraint(ci);
-    const auto& cols = sys.constraintColumns(ci);
-    const auto& qcols = sys.constraintCoordinateColumns(ci);
-    const int nl = static_cast<int>(cols.size()), nql = static_cast<int>(qcols.size());
-    const int row = sys.constraintOffset(ci), me = con.numEquations();
-    ConstraintScratch& cs = S.constraints[c];
-    const ConstraintEvaluation& ev = cs.ev;
-    con.evaluate(sys.constraintStates(ci, q.data()), true, cs.ev);
-    gather(cols, v.data(), cs.vl);
-    if (!identityT) localRateMatrices(sys, ci, q.data(), S, ratePattern_, rateInversePattern_, cs.Tl, cs.Til);
-    // d(G^T lambda)/dq = sum_a lambda_a H_a, and dF_v/dlambda = G^T
-    cs.Hx.setZero();
-    for (int a = 0; a < me; ++a) cs.Hx += y[L.lambda + row + a] * ev.H[a];
-    addBlock(J, L.v, cs.vRows, L.q, qcols, cs.Hx, cs.column);
-    addTransposedBlock(J, L.v, cs.vRows, L.lambda + row, ev.G, cs.column);
-    for (int a = 0; a < me; ++a) cs.vH.row(a).noalias() = cs.vl.transpose() * ev.H[a];  // d(G v)/dq
-    switch (formulation_) {
-      case Formulation::Ggl: {
-        // F_q += T D G^T mu: d/dq = T D sum_a mu_a H_a (+ the dT/dq term below), d/dmu = T D G^T
-        cs.Hx.setZero();
-        for (int a = 0; a < me; ++a) cs.Hx += y[L.mu + row + a] * ev.H[a];
-        if (identityT) {
-          for (int k = 0; k < nl; ++k) cs.Hx.row(k) *= metric_[cols[k]];  // D sum_a mu_a H_a
-          addBlock(J, L.q, cs.vRows, L.q, cols, cs.Hx, cs.column);
-          cs.TGt.resize(nl, me);  // (D G^T)
-          for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
-          addBlock(J, L.q, cs.vRows, L.mu + row, cs.TGt, cs.column);
-          addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
-        } else {
-          const double* mu = y + L.mu + row;
-          for (int k = 0; k < nl; ++k) {
-            cs.Hx.row(k) *= metric_[cols[k]];
-            S.DGtmu[cols[k]] += metric_[cols[k]] * columnDot(ev.G, k, mu);
-          }
-          cs.THx.noalias() = cs.Tl * cs.Hx;
-          addBlock(J, L.q, cs.qRows, L.q, qcols, cs.THx, cs.column);
-          cs.TGt.resize(nl, me);
-          for (int k = 0; k < nl; ++k) cs.TGt.row(k) = metric_[cols[k]] * ev.G.col(k).transpose();
-          cs.TDG.noalias() = cs.Tl * cs.TGt;  // T D G^T (nq_l x m)
-          addBlock(J, L.q, cs.qRows, L.mu + row, cs.TDG, cs.column);
-          // F_g = h - f: dh/dq = G T+
-          cs.dFdq.noalias() = ev.G * cs.Til;
-          addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
-        }
-        addConstraintRows(J, c, L.mu + row, L.q, qcols, cs.vH, cs.column);
-        addConstraintRows(J, c, L.mu + row, L.v, cols, ev.G, cs.column);
-        break;
-      }
-      case Formulation::Index3:
-        if (identityT) {
-          addConstraintRows(J, c, L.lambda + row, L.q, cols, ev.G, cs.column);
-        } else {
-          cs.dFdq.noalias() = ev.G * cs.Til;
-          addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
-        }
-        break;
-      case Formulation::Index1: {
-        // F_a = G a + v^T H_a w - f'', w = T v: d/dq = a^T H_a + d(v^T H_a w)/dq,
-        // d/dv = v^T H_a T + (H_a w)^T (2 v^T H_a with T = I), d/da = G. The third-derivative
-        // term d(v^T H_a w)/dq is the one block taken by central differences of the
-        // analytic H_a (and of T) (docs/formulations.md).
-        gather(cols, vp.data(), cs.al);
-        if (identityT) {
-          cs.wl = cs.vl;
-        } else {
-          gather(qcols, S.Tv.data(), cs.wl);
-        }
-        for (int a = 0; a < me; ++a) cs.dFdq.row(a).noalias() = cs.al.transpose() * ev.H[a];
-        S.qPlus = q;
-        S.qMinus = q;
-        for (int k = 0; k < nql; ++k) {
-          const int qc = qcols[k];
-          const double h = 1e-6 * (1.0 + std::abs(q[qc]));
-          S.qPlus[qc] = q[qc] + h;
-          S.qMinus[qc] = q[qc] - h;
-          con.evaluate(sys.constraintStates(ci, S.qPlus.data()), true, cs.plus);
-          con.evaluate(sys.constraintStates(ci, S.qMinus.data()), true, cs.minus);
-          if (!identityT) {  // (T v) at the perturbed coordinates, once per coordinate
-            coordinateRates(sys, S.qPlus.data(), v.data(), S.TvPlus);
-            gather(qcols, S.TvPlus.data(), cs.wl);
-            coordinateRates(sys, S.qMinus.data(), v.data(), S.TvPlus);
-            gather(qcols, S.TvPlus.data(), cs.wlMinus);
-          }
-          const VecX& wPlus = identityT ? cs.vl : cs.wl;
-          const VecX& wMinus = identityT ? cs.vl : cs.wlMinus;
-          for (int a = 0; a < me; ++a) {
-            cs.Hv.noalias() = cs.plus.H[a] * wPlus;
-            const double plus = cs.vl.dot(cs.Hv);
-            cs.Hv.noalias() = cs.minus.H[a] * wMinus;
-            cs.dFdq(a, k) += (plus - cs.vl.dot(cs.Hv)) / (2.0 * h);
-          }
-          S.qPlus[qc] = S.qMinus[qc] = q[qc];
-        }
-        addConstraintRows(J, c, L.lambda + row, L.q, qcols, cs.dFdq, cs.column);
-        if (identityT) {
-          cs.vH *= 2.0;
-          cs.vH += cj * ev.G;
-          addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.vH, cs.column);
-        } else {
-          gather(qcols, S.Tv.data(), cs.wl);
-          cs.dFdv.resize(me, nl);
-          for (int a = 0; a < me; ++a) {
-            cs.Hv.noalias() = ev.H[a] * cs.wl;
-            cs.dFdv.row(a).noalias() = cs.vH.row(a) * cs.Tl;
-            cs.dFdv.row(a) += cs.Hv.transpose();
-          }
-          cs.dFdv += cj * ev.G;
-          addConstraintRows(J, c, L.lambda + row, L.v, cols, cs.dFdv, cs.column);
-        }
-        break;
-      }
-    }
-  }
-  // released equations: d(lambda_k)/d(lambda_k) = 1 (and d(mu_k)/d(mu_k) = 1)
-  for (const int r : released_) {
-    J.add(L.lambda + r, L.lambda + r, 1.0);
-    if (L.mu >= 0) J.add(L.mu + r, L.mu + r, 1.0);
-  }
-  if (!identityT) {
-    // F_q = q' + T(q) w, w = D G^T mu - v: the dT/dq term at fixed w
-    S.w = S.DGtmu - v;
-    for (int b = 0; b < sys.numBodies(); ++b) {
-      const BodyIndex bi(b);
-      const Body& body = sys.body(bi);
-      const int nqb = body.numCoordinates(), qoff = sys.coordinateOffset(bi);
-      if (nqb == 0 || body.velocitiesAreCoordinateRates()) continue;
-      body.addCoordinateRateJacobian(q.segment(qoff, nqb), S.w.segment(sys.velocityOffset(bi), body.numVelocities()),
-                                     MatrixSink(J, L.q + qoff, L.q + qoff));
-    }
-  }
+  const typename JacobianAssembly<IdentityT>::Model model{
+      sys_, layout_, formulation_, metric_, released_, keptRows_, partial_, ratePattern_, rateInversePattern_};
+  JacobianAssembly<IdentityT>(model, S, positioned, t, y, yp, cj).run();
 }
 
 }  // namespace flexmbd

@@ -136,9 +136,6 @@ class DaeSystem final : public DaeProblem {
   /// vector and partial_ false for a constraint with none released.
   std::vector<std::vector<int>> keptRows_;
   std::vector<char> partial_;
-  /// J(row0 + i, colOffset + cols[j]) += B(i, j) over the kept rows i of constraint c.
-  void addConstraintRows(JacobianSink& J, int c, int row0, int colOffset, const std::vector<int>& cols,
-                         const MatX& B, VecX& buf) const;
   /// Per body with T != I: the structural non-zeros of T (nq x nv) and T+ (nv x nq), each in
   /// a square pattern of size nq (empty for T = I). Built once: a body's T is sparse (the
   /// identity on elastic coordinates), and assembling it densely made the Jacobian pattern
