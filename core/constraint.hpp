@@ -3,12 +3,14 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "core/body.hpp"
+#include "core/time_law.hpp"
 #include "core/types.hpp"
 
 namespace flexmbd {
@@ -168,6 +170,18 @@ class Constraint {
   /// axes) and moment exerted on the last body at its joint point; for drivers the
   /// generalised force applied along the driven quantity.
   virtual VecX reactions(const BodyStates& bodies, const VecX& lambda) const = 0;
+
+  /// A driver named `name` that prescribes this joint's free motion `quantity`
+  /// ("displacement": along the joint's line) by `law`, or null when the joint has no
+  /// such motion: the joint_displacement driver of a scene asks the joint for it, so a
+  /// new joint offers its drivers here, without a change to the readers.
+  virtual std::unique_ptr<Constraint> makeDriver(const std::string& quantity, std::string name,
+                                                 TimeLawPtr law) const {
+    (void)quantity;
+    (void)name;
+    (void)law;
+    return nullptr;
+  }
 
  private:
   std::string name_;

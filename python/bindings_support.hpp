@@ -140,4 +140,8 @@ inline ConstraintIndex joint(const System& sys, const py::handle& j, const char*
 /// methods on System.
 void bindSpatial(py::module_& m, py::class_<System>& system);
 
+/// The add_<type>_<kind> methods of the kinds declared through the registry
+/// (component_bindings.cpp).
+void bindComponentKinds(py::class_<System>& system);
+
 }  // namespace flexmbd::pybind

@@ -511,6 +511,7 @@ PYBIND11_MODULE(_flexmbd, m) {
           },
           py::arg("body"), "index of the body's first coordinate in the system's coordinates (after finalize())");
   bindSpatial(m, systemClass);
+  bindComponentKinds(systemClass);
 
   // ----- solver settings (simulation/simulation.hpp) ------------------------------------
   py::class_<SolverSettings>(m, "SolverSettings",

@@ -7,6 +7,7 @@
 #include "bodies/fe_stress.hpp"
 #include "scene/json_reader.hpp"
 #include "scene/flexible_body_reader.hpp"
+#include "scene/component_reader.hpp"
 #include "scene/scene_keys.hpp"
 #include "scene/spatial_scene.hpp"
 
@@ -249,7 +250,10 @@ void parseBody(const json& j, const std::string& where, System& sys) {
 void parseJoint(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
   r.peekName();
-  const std::string type = readType(r, "joint", {"revolute", "prismatic", "fixed"});
+  if (scenereaders::readRegisteredComponent("joints", 2, r, sys)) return;
+  std::vector<std::string> types = {"revolute", "prismatic", "fixed"};
+  for (const std::string& t : scenereaders::registeredTypes("joints", 2)) types.push_back(t);
+  const std::string type = readType(r, "joint", types);
   if (type != "prismatic" && r.has("axis")) {
     r.fail("key \"axis\" is only allowed for prismatic joints (this joint is " + type + ")");
   }
@@ -282,6 +286,7 @@ void parseDriver(const json& j, const std::string& where, System& sys) {
   if (onJoint) {
     const std::string jointName = r.name("joint");
     const ConstraintIndex joint = lookupJoint(sys, jointName, r);
+    if (scenereaders::readDriverOfRegisteredJoint(type, name, joint, r, sys)) return;
     const std::string jointType = sys.constraint(joint).typeName();
     const std::string needed = type == "joint_angle" ? "revolute" : "prismatic";
     if (jointType != needed) {

@@ -16,6 +16,7 @@
 #include "core/errors.hpp"
 #include "core/rotation_3d.hpp"
 #include "forces/spatial_forces.hpp"
+#include "scene/component_reader.hpp"
 #include "scene/fe_body_reader.hpp"
 #include "fe_import/sid_file.hpp"
 #include "scene/scene_keys.hpp"
@@ -442,8 +443,10 @@ void parseSpatialBody(const json& j, const std::string& where, System& sys, cons
 void parseSpatialJoint(const json& j, const std::string& where, System& sys) {
   ObjectReader r(j, where);
   r.peekName();
-  const std::string type =
-      readType(r, "joint", {"spherical", "revolute", "prismatic", "cylindrical", "universal", "fixed", "planar"});
+  if (readRegisteredComponent("joints", 3, r, sys)) return;
+  std::vector<std::string> known = {"spherical", "revolute", "prismatic", "cylindrical", "universal", "fixed", "planar"};
+  for (const std::string& t : registeredTypes("joints", 3)) known.push_back(t);
+  const std::string type = readType(r, "joint", known);
   r.allowOnly(scenekeys::kSpatialJoint, " for a joint in a spatial scene");
   const std::string name = r.name("name");
   const auto [bi, bj] = lookupBodyPair(sys, r, "a joint");
@@ -479,6 +482,7 @@ void parseSpatialDriver(const json& j, const std::string& where, System& sys) {
     return;
   }
   const std::string jointName = r.name("joint");
+  if (readDriverOfRegisteredJoint(type, name, lookupJoint(sys, jointName, r), r, sys)) return;
   const SpatialJoint& joint = spatialJoint(sys, lookupJoint(sys, jointName, r), r);
   const SpatialJointType jt = joint.type();
   const bool angle = type == "joint_angle";

@@ -33,6 +33,7 @@
 #include "forces/spring_damper.hpp"
 #include "joints/drivers.hpp"
 #include "joints/fixed_joint.hpp"
+#include "joints/point_on_line_joint.hpp"
 #include "joints/prismatic_joint.hpp"
 #include "joints/revolute_joint.hpp"
 #include "tests/test_support.hpp"
@@ -269,6 +270,9 @@ TEST(ConstraintJacobians, EveryConstraintTypeBetweenBodiesAndWithGround) {
         "ang" + sfx, i, ui, j, uj, makeHarmonicLaw(0.5, 2.0, 0.1, 0.2))));
     all.push_back(sys.addConstraint(std::make_unique<JointDisplacementDriver>(
         "dis" + sfx, i, ui, j, uj, displacementAxis, makeConstantSpeedLaw(0.3, 0.1))));
+    all.push_back(addPointOnLineJoint(sys, "pol" + sfx, i, ui, j, uj, prismaticAxis));
+    all.push_back(sys.addConstraint(sys.constraint(all.back()).makeDriver("displacement", "pold" + sfx,
+                                                                          makeHarmonicLaw(0.4, 1.5))));
   }
   // Body-coordinate drivers on every coordinate of b.
   for (const char* c : {"x", "y", "theta"}) {

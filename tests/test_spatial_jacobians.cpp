@@ -11,6 +11,8 @@
 #include "core/rotation_3d.hpp"
 #include "core/system.hpp"
 #include "forces/spatial_forces.hpp"
+#include "joints/point_in_plane_joint.hpp"
+#include "joints/point_on_line_joint.hpp"
 #include "joints/spatial_drivers.hpp"
 #include "joints/spatial_joint.hpp"
 #include "test_support.hpp"
@@ -227,6 +229,20 @@ TEST(SpatialDriverDerivatives, AngleAndDisplacementDriversMatchFiniteDifferences
   });
   checkBetweenRandomBodies(kSeed + 21, "joint displacement", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
     return std::make_unique<SpatialJointDisplacementDriver>("d", i, fi, j, fj, makeConstantLaw(0.0));
+  });
+}
+
+TEST(SpatialPointJointDerivatives, PointOnLineItsDriverAndPointInPlaneMatchFiniteDifferences) {
+  // the frames' points are the joints' points; the line's direction and the plane's
+  // normal the z axis of the random frame i
+  checkBetweenRandomBodies(kSeed + 30, "point on line", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+    return std::make_unique<PointOnLineJoint3d>("j", i, fi.point, j, fj.point, fi.axes.col(2));
+  });
+  checkBetweenRandomBodies(kSeed + 31, "point on line driver", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+    return PointOnLineJoint3d("j", i, fi.point, j, fj.point, fi.axes.col(2)).makeDriver("displacement", "d", makeConstantLaw(0.0));
+  });
+  checkBetweenRandomBodies(kSeed + 32, "point in plane", [](BodyIndex i, const JointFrame& fi, BodyIndex j, const JointFrame& fj) {
+    return std::make_unique<PointInPlaneJoint>("j", i, fi.point, j, fj.point, fi.axes.col(2));
   });
 }
 

@@ -66,6 +66,43 @@ def test_a_model_built_in_python_equals_the_same_scene_file():
     assert np.array_equal(a.data, b.data)
 
 
+def test_a_declared_joint_from_python_equals_the_scene_and_checks_its_keys():
+    # The slider on a point_on_line joint (System.add_point_on_line_joint, made from the
+    # kind's declaration) and the same joint in the scene: the same System, bit for bit;
+    # the slider still follows the closed form x = cos t + sqrt(4 - sin^2 t) (its
+    # rotation is free now, and nothing turns it).
+    line = {"name": "P", "type": "point_on_line", "bodies": ["ground", "slider"],
+            "points": [[0.0, 0.0], [0.0, 0.0]], "direction": [1.0, 0.0]}
+    a = flexmbd.load_scene(example("slider_crank_rigid.json"),
+                           overrides={"solver.output_step": math.pi / 30, "joints[3]": line}).run()
+    scene = flexmbd.Scene("rigid slider-crank, l1 = 1, l2 = 2 (source document 000)")
+    sys = scene.system
+    crank = sys.add_rigid_body("crank", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.1, com=(0.5, 0.0)),
+                               flexmbd.FrameState2d(position=(0.0, 0.0), angle=0.0))
+    rod = sys.add_rigid_body("rod", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.4, com=(1.0, 0.0)),
+                             flexmbd.FrameState2d(position=(1.0, 0.0)))
+    slider = sys.add_rigid_body("slider", flexmbd.RigidBodyProperties(mass=0.5, inertia=0.01),
+                                flexmbd.FrameState2d(position=(3.0, 0.0)))
+    sys.add_revolute_joint("O1", flexmbd.GROUND, (0, 0), crank, (0, 0))
+    sys.add_revolute_joint("O2", crank, (1, 0), rod, (0, 0))
+    sys.add_revolute_joint("O3", rod, (2, 0), slider, (0, 0))
+    joint = sys.add_point_on_line_joint(**{k: v for k, v in line.items() if k != "type"})
+    assert isinstance(joint, flexmbd.ConstraintIndex) and joint.value == 3
+    sys.add_body_coordinate_driver("motor", crank, "theta", flexmbd.constant_speed_law(1.0))
+    s = scene.solver
+    s.formulation = "ggl"
+    s.rtol, s.atol = 1e-8, 1e-10
+    s.t_end, s.output_step = 2 * math.pi, math.pi / 30
+    b = scene.run()
+    assert a.ok and b.ok, (a.message, b.message)
+    assert a.columns == b.columns and np.array_equal(a.data, b.data)
+    exact = np.cos(b.t) + np.sqrt(4.0 - np.sin(b.t) ** 2)
+    assert np.max(np.abs(b["slider.x"] - exact)) < 1e-7  # as the prismatic crank's test above
+    assert "points [m]" in flexmbd.System.add_point_on_line_joint.__doc__
+    with pytest.raises(flexmbd.InputError, match=r'add_point_on_line_joint: missing key "direction"'):
+        flexmbd.Scene("bad").system.add_point_on_line_joint(name="q", bodies=["ground", "ground"], points=[[0, 0], [0, 0]])
+
+
 def read_csv(path):
     with open(path, newline="") as f:
         rows = list(csv.reader(f))

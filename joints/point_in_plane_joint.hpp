@@ -1,0 +1,34 @@
+/// @file
+/// Point-in-plane joint (spatial): a point of body j stays in a plane fixed in body i;
+/// it moves freely in the plane and the bodies rotate freely.
+#pragma once
+
+#include "core/system.hpp"
+#include "joints/spatial_drivers.hpp"
+
+namespace flexmbd {
+
+/// h = z_i^T (r_j - r_i) = 0, with z_i the plane's normal (body-i axes) through point i
+/// (Haug 1989, sec. 9.3, the planar joint's gap equation). One equation.
+class PointInPlaneJoint final : public FramePairConstraint {
+ public:
+  /// @throws InputError if a point or the normal is not finite or the normal is zero.
+  PointInPlaneJoint(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
+                    const Vec3& normal);
+  int numEquations() const override { return 1; }
+  std::string typeName() const override { return "point_in_plane"; }
+  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
+  /// The force on body j at its point (world axes): along the normal, no moment.
+  std::vector<std::string> reactionNames() const override { return {"fx", "fy", "fz"}; }
+  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
+};
+
+/// pointJ of bodyJ in the plane through pointI of bodyI with `normal` (body-i axes).
+ConstraintIndex addPointInPlaneJoint(System& sys, const std::string& name, BodyIndex bodyI, const Vec3& pointI,
+                                     BodyIndex bodyJ, const Vec3& pointJ, const Vec3& normal);
+
+struct ComponentKind;
+/// The scene kind "point_in_plane" of "joints" (builders/component_kinds.cpp lists it).
+ComponentKind pointInPlaneJointKind();
+
+}  // namespace flexmbd
