@@ -81,8 +81,8 @@ class Report {
   std::set<std::string> shown_;
 };
 
-void printSummary(const ordered_json& j, const std::string& path) {
-  Report r(j);
+/// The header, scene, model, status and message; the time (or the kinematics' input) reached.
+void printStatusAndTime(Report& r, const ordered_json& j, const std::string& path) {
   const std::string status = r["status"].get<std::string>();
   std::cout << "summary of " << cli::oneLine(path) << "\n";
   if (r.has("scene")) r.line("scene", text(r["scene"]));
@@ -118,7 +118,10 @@ void printSummary(const ordered_json& j, const std::string& path) {
     r.line("input reached", a);
     r.shown({"alpha_reached", "alpha_end", "alpha_start"});
   }
+}
 
+/// Steps, evaluations and CPU time; the integrator and its settings.
+void printCostAndMethod(Report& r, const ordered_json& j) {
   // ----- cost -----
   if (r.has("steps")) {
     std::string s = text(r["steps"]);
@@ -164,7 +167,10 @@ void printSummary(const ordered_json& j, const std::string& path) {
     if (r.has("elastic_start")) r.line("elastic start", text(r["elastic_start"]));
     else r.shown({"elastic_start"});
   }
+}
 
+/// Constraint violation and energy; singular crossings, initial corrections, warnings.
+void printAccuracyAndEvents(Report& r, const ordered_json& j) {
   // ----- accuracy -----
   if (isNumber(j, "max_position_violation") || isNumber(j, "max_velocity_violation")) {
     std::string v;
@@ -228,6 +234,13 @@ void printSummary(const ordered_json& j, const std::string& path) {
     r.line("warnings", w.empty() ? "none" : std::to_string(w.size()));
     for (const auto& m : w) r.more("- " + text(m));
   }
+}
+
+void printSummary(const ordered_json& j, const std::string& path) {
+  Report r(j);
+  printStatusAndTime(r, j, path);
+  printCostAndMethod(r, j);
+  printAccuracyAndEvents(r, j);
   r.shown({"last_step_size", "linear_setups", "initial_position_iterations", "output_step", "steps_completed",
            "residual_evals", "rhs_evals", "jacobian_evals", "nonlinear_iterations", "error_test_failures",
            "nonlinear_conv_failures", "model_size"});

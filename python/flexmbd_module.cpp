@@ -146,12 +146,9 @@ py::array_t<double> table(const RunOutput& r) {
   return a;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_flexmbd, m) {
-  m.doc() = "flexmbd: flexible multibody dynamics (compiled part; use the flexmbd package)";
-
-  // ----- errors: the C++ types, the same messages ------------------------------------
+// ----- errors: the C++ types, the same messages ------------------------------------
+/// InputError and ModelError as Python exceptions, and their translator.
+void bindErrors(py::module_& m) {
   static py::exception<InputError> inputError(m, "InputError", PyExc_ValueError);
   static py::exception<ModelError> modelError(m, "ModelError", inputError.ptr());
   inputError.attr("__doc__") =
@@ -169,8 +166,11 @@ PYBIND11_MODULE(_flexmbd, m) {
       inputError(e.what());
     }
   });
+}
 
-  // ----- indices, states, properties -----------------------------------------------------
+// ----- indices, states, properties -----------------------------------------------------
+/// BodyIndex, ConstraintIndex, ForceIndex, GROUND, FrameState2d and RigidBodyProperties.
+void bindIndicesStatesAndProperties(py::module_& m) {
   py::class_<BodyIndex>(m, "BodyIndex", "The index of a body in its System (GROUND is body 0)")
       .def_readonly("value", &BodyIndex::value, "the index as an int")
       .def("__repr__", [](const BodyIndex& b) { return "BodyIndex(" + std::to_string(b.value) + ")"; });
@@ -198,10 +198,13 @@ PYBIND11_MODULE(_flexmbd, m) {
       .def_readwrite("mass", &RigidBodyProperties::mass, "kg")
       .def_readwrite("inertia", &RigidBodyProperties::inertia, "about the centre of mass (kg m^2)")
       .def_readwrite("com", &RigidBodyProperties::com, "centre of mass, body axes (m)");
+}
 
-  // ----- time laws (core/time_law.hpp) ----------------------------------------------------
-  // pybind11 holders cannot be shared_ptr<const T>: laws are held as shared_ptr<TimeLaw>
-  // (Law) and handed to the engine as TimeLawPtr (immutable there).
+// ----- time laws (core/time_law.hpp) ----------------------------------------------------
+// pybind11 holders cannot be shared_ptr<const T>: laws are held as shared_ptr<TimeLaw>
+// (Law) and handed to the engine as TimeLawPtr (immutable there).
+/// TimeLaw and the *_law functions.
+void bindTimeLaws(py::module_& m) {
   py::class_<TimeLaw, Law>(m, "TimeLaw", "A function of time f(t) with its derivatives, for drivers and loads (the *_law functions)")
       .def("__call__", [](const TimeLaw& law, double t) {
         const LawValue v = law.evaluate(t);
@@ -224,7 +227,11 @@ PYBIND11_MODULE(_flexmbd, m) {
         [](std::vector<double> t, std::vector<double> v) { return mutableLaw(makeTabulatedLaw(std::move(t), std::move(v))); },
         py::arg("times"), py::arg("values"),
         "A natural cubic spline through (times, values), times increasing; linear beyond the table");
-  // ----- user functions (core/user_function.hpp; python/user_functions.hpp) ---------------
+}
+
+// ----- user functions (core/user_function.hpp; python/user_functions.hpp) ---------------
+/// user_law, _time_law_calls, SpringLaw and spring_law.
+void bindUserFunctions(py::module_& m) {
   m.def(
       "user_law",
       [](const py::object& f, const py::object& df, const py::object& ddf) {
@@ -280,8 +287,11 @@ PYBIND11_MODULE(_flexmbd, m) {
       py::arg("f"), py::arg("derivative") = py::none(),
       "A spring-damper law f(t, x, xdot) (x: length or joint angle) given by a Python callable, in place of "
       "k (x - x0) + c xdot; derivative(t, x, xdot) -> (df/dx, df/dxdot), else central differences");
+}
 
-  // ----- flexible beams (bodies/ffr_beam_model.hpp) --------------------------------------
+// ----- flexible beams (bodies/ffr_beam_model.hpp) --------------------------------------
+/// Planar beam sections, meshes, options and models.
+void bindFlexibleBeams(py::module_& m) {
   py::class_<BeamSection>(m, "BeamSection", "Cross-section and material of a planar beam")
       .def(py::init([](double area, double inertia, double E, double rho, double damping) {
              BeamSection s;
@@ -361,14 +371,11 @@ PYBIND11_MODULE(_flexmbd, m) {
            "The model of the mesh under the options; owner names it in messages")
       .def("natural_frequencies", &FfrBeamModel::naturalFrequencies, "rad/s, ascending (frame held fixed)")
       .def_property_readonly("num_elastic", &FfrBeamModel::numElastic, "number of elastic coordinates nf");
+}
 
-  // ----- the system and the builders (builders/planar_builders.hpp) --------------------
-  py::class_<System> systemClass(
-      m, "System",
-      "A multibody system, planar or spatial: bodies, joints, drivers and forces are added (add_*), then "
-      "finalize() freezes it. Body 0 is the ground (GROUND or \"ground\"). Bodies and joints are given by "
-      "name or index.");
-  systemClass
+/// The planar builders as methods of System: bodies, joints, drivers, forces.
+void bindPlanarBuilders(py::class_<System>& system) {
+  system
       .def(
           "add_rigid_body",
           [](System& s, const std::string& name, const RigidBodyProperties& p, const FrameState2d& init) {
@@ -472,7 +479,12 @@ PYBIND11_MODULE(_flexmbd, m) {
           },
           py::arg("name"), py::arg("body"), py::arg("point"), py::arg("force_x") = py::none(),
           py::arg("force_y") = py::none(), py::arg("torque") = py::none(),
-          "Force and torque laws (time laws or callables f(t)), world axes")
+          "Force and torque laws (time laws or callables f(t)), world axes");
+}
+
+/// set_gravity, find_body, finalize and the numbering of the coordinates.
+void bindSystemQueries(py::class_<System>& system) {
+  system
       .def(
           "set_gravity",
           [](System& s, const py::object& g) {
@@ -510,10 +522,11 @@ PYBIND11_MODULE(_flexmbd, m) {
             return s.coordinateOffset(i);
           },
           py::arg("body"), "index of the body's first coordinate in the system's coordinates (after finalize())");
-  bindSpatial(m, systemClass);
-  bindComponentKinds(systemClass);
+}
 
-  // ----- solver settings (simulation/simulation.hpp) ------------------------------------
+// ----- solver settings (simulation/simulation.hpp) ------------------------------------
+/// SolverSettings.
+void bindSolverSettings(py::module_& m) {
   py::class_<SolverSettings>(m, "SolverSettings",
                               "How a run integrates: the scene's \"solver\" object (docs/scene-format.md, \"Solver\")")
       .def(py::init<>(), "The defaults of a scene that omits every solver key")
@@ -554,8 +567,11 @@ PYBIND11_MODULE(_flexmbd, m) {
           [](SolverSettings& s, const std::string& i) { s.integrator = parseIntegrator(i); },
           "the integrator by name (\"auto\": chosen from the model)")
       .def("validate", &SolverSettings::validate, "InputError naming the setting that is out of range");
+}
 
-  // ----- scenes and runs -----------------------------------------------------------------
+// ----- scenes and runs -----------------------------------------------------------------
+/// The compiled Scene: its system, solver, outputs, modes and run.
+void bindScene(py::module_& m) {
   py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene", "The compiled scene behind flexmbd.Scene (use that class)")
       .def(py::init([](const std::string& name) {
              auto s = std::make_shared<Scene>();
@@ -644,7 +660,11 @@ PYBIND11_MODULE(_flexmbd, m) {
             return py::make_tuple(r.columns, table(r), r.summary, r.ok);
           },
           py::arg("progress") = false);
-  // ----- kinematic analysis of linkages (linkage/, document 000) -------------------------
+}
+
+// ----- kinematic analysis of linkages (linkage/, document 000) -------------------------
+/// run_kinematics_text.
+void bindKinematics(py::module_& m) {
   m.def(
       "run_kinematics_text",
       [](const std::string& text, const std::string& source) {
@@ -694,7 +714,11 @@ PYBIND11_MODULE(_flexmbd, m) {
       },
       py::arg("text"), py::arg("source") = "<scene>",
       "A kinematics scene (docs/kinematics.md) analysed: (columns, table, summary dict)");
-  // ----- tensegrity structures (tensegrity/, document 001) --------------------------------
+}
+
+// ----- tensegrity structures (tensegrity/, document 001) --------------------------------
+/// run_tensegrity_text.
+void bindTensegrity(py::module_& m) {
   m.def(
       "run_tensegrity_text",
       [](const std::string& text, const std::string& source) {
@@ -765,6 +789,10 @@ PYBIND11_MODULE(_flexmbd, m) {
       },
       py::arg("text"), py::arg("source") = "<scene>",
       "A tensegrity scene (docs/tensegrity.md) run: (columns, table, summary dict with its events)");
+}
+
+/// Scene texts: parsed, read from a file, run with sensitivities or the adjoint; scene paths.
+void bindSceneTexts(py::module_& m) {
   m.def(
       "parse_scene_text",
       [](const std::string& text, const std::string& source) {
@@ -827,4 +855,33 @@ PYBIND11_MODULE(_flexmbd, m) {
       py::arg("path"),
       "The keys (str) and list indices (int) of a dotted scene path 'bodies[1].section.area', parsed by the "
       "engine's one parser of the syntax (scene/scene_path.hpp); InputError \"override '<path>': ...\" otherwise");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_flexmbd, m) {
+  m.doc() = "flexmbd: flexible multibody dynamics (compiled part; use the flexmbd package)";
+
+  bindErrors(m);
+  bindIndicesStatesAndProperties(m);
+  bindTimeLaws(m);
+  bindUserFunctions(m);
+  bindFlexibleBeams(m);
+
+  // ----- the system and the builders (builders/planar_builders.hpp) --------------------
+  py::class_<System> systemClass(
+      m, "System",
+      "A multibody system, planar or spatial: bodies, joints, drivers and forces are added (add_*), then "
+      "finalize() freezes it. Body 0 is the ground (GROUND or \"ground\"). Bodies and joints are given by "
+      "name or index.");
+  bindPlanarBuilders(systemClass);
+  bindSystemQueries(systemClass);
+  bindSpatial(m, systemClass);
+  bindComponentKinds(systemClass);
+
+  bindSolverSettings(m);
+  bindScene(m);
+  bindKinematics(m);
+  bindTensegrity(m);
+  bindSceneTexts(m);
 }

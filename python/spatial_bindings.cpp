@@ -169,10 +169,9 @@ bool isSpatialBody(const Body& b) {
   return dynamic_cast<const RigidBody3d*>(&b) != nullptr || dynamic_cast<const FfrBody3d*>(&b) != nullptr;
 }
 
-}  // namespace
-
-void bindSpatial(py::module_& m, py::class_<System>& system) {
-  // ----- orientations, frame states, rigid body properties ---------------------------------
+// ----- orientations, frame states, rigid body properties ---------------------------------
+/// Rotations, FrameState3d and RigidBody3dProperties.
+void bindOrientationsAndFrameStates(py::module_& m) {
   m.def(
       "rotation_from_axis_angle",
       [](const py::object& axis, const py::object& angle) {
@@ -219,8 +218,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
            "Mass (kg) and inertia about the centre of mass (body axes: 3 principal moments or a 3 x 3 tensor)")
       .def_readwrite("mass", &RigidBody3dProperties::mass, "kg")
       .def_readwrite("inertia", &RigidBody3dProperties::inertia, "3 x 3 inertia tensor about the centre of mass, body axes (kg m^2)");
+}
 
-  // ----- solid shapes (bodies/shape_inertia.hpp) -----------------------------------------------
+// ----- solid shapes (bodies/shape_inertia.hpp) -----------------------------------------------
+/// SolidShape, ShapePart, CompositeInertia and the shapes' inertia functions.
+void bindSolidShapes(py::module_& m) {
   py::class_<SolidShape>(m, "SolidShape",
                           "A solid of simple shape (box, cylinder, tube, sphere): inertia from geometry")
       .def_static(
@@ -314,8 +316,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       "shape_inertia", [](const SolidShape& s, const py::object& mass) { return shapeInertia(s, positiveArg(mass, "shape_inertia", "mass")); },
       py::arg("shape"), py::arg("mass"),
       "The 3 x 3 inertia tensor (kg m^2) of a shape of that mass about its centre, in body axes");
+}
 
-  // ----- joint frames (joints/frame_pair.hpp, joints/world_frames.hpp) -------------------------
+// ----- joint frames (joints/frame_pair.hpp, joints/world_frames.hpp) -------------------------
+/// JointFrame, world_joint_frame and SpatialJointType.
+void bindJointFrames(py::module_& m) {
   py::class_<JointFrame>(m, "JointFrame", "A frame fixed in a body (or in the world) that a spatial joint or bushing connects")
       .def(py::init([](const py::object& point, const py::object& axis, const py::object& orientation) {
              constexpr const char* fn = "JointFrame";
@@ -351,8 +356,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .value("UNIVERSAL", SpatialJointType::Universal)
       .value("FIXED", SpatialJointType::Fixed)
       .value("PLANAR", SpatialJointType::Planar);
+}
 
-  // ----- spatial beams (elements/beam_section.hpp, bodies/ffr_beam_model_3d.hpp) -----------------
+// ----- spatial beams (elements/beam_section.hpp, bodies/ffr_beam_model_3d.hpp) -----------------
+/// Spatial beam sections, meshes, options and models.
+void bindSpatialBeams(py::module_& m) {
   py::class_<BeamSection3d>(m, "BeamSection3d", "Cross-section and material of a spatial beam (section axes y, z: principal axes)")
       .def(py::init([](const py::object& area, const py::object& iy, const py::object& iz, const py::object& j,
                        const py::object& E, const py::object& G, const py::object& nu, const py::object& rho,
@@ -477,8 +485,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def_property_readonly(
           "invariants", [](const FfrBeamModel3d& mdl) { return mdl.invariants(); },
           "A copy of the model's invariants (FfrInvariants3d), to change or to add as a body of its own");
+}
 
-  // ----- given invariants (bodies/ffr_invariants_3d.hpp): NumPy arrays in, sparse inside ----
+// ----- given invariants (bodies/ffr_invariants_3d.hpp): NumPy arrays in, sparse inside ----
+/// FfrPoint3d and FfrInvariants3d.
+void bindGivenInvariants(py::module_& m) {
   py::class_<FfrPoint3d>(m, "FfrPoint3d", "An attachment point of given invariants (FfrInvariants3d.points)")
       .def(py::init([](const py::object& position, const py::object& shape, const py::object& rotationShape) {
              // converted to the fields' own 3 x nf types: a matrix of other rows is a
@@ -568,8 +579,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
             v.validateSectionRotation(owner);
           },
           py::arg("owner") = "invariants", "@raises InputError naming the offending invariant");
+}
 
-  // ----- the SID of a body (bodies/sid_data.hpp, fe_import/sid_file.hpp) ----------------------------
+// ----- the SID of a body (bodies/sid_data.hpp, fe_import/sid_file.hpp) ----------------------------
+/// write_sid and read_sid.
+void bindSid(py::module_& m) {
   m.def(
       "write_sid", [](const FfrInvariants3d& inv, const std::string& path) { writeSidFile(sidFromInvariants(inv), path); },
       py::arg("invariants"), py::arg("path"),
@@ -578,8 +592,11 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       "read_sid", [](const std::string& path, const std::string& owner) { return invariantsFromSid(readSidFile(path), owner); },
       py::arg("path"), py::arg("owner") = "SID body",
       "The invariants of a SID text file; InputError names the file and line, or the block and entry");
+}
 
-  // ----- bodies from FE codes (bodies/fe_body_model.hpp, fe_import/fe_abaqus.hpp, fe_import/fe_ansys.hpp) ----
+// ----- bodies from FE codes (bodies/fe_body_model.hpp, fe_import/fe_abaqus.hpp, fe_import/fe_ansys.hpp) ----
+/// FeBodyData, the Abaqus and Ansys readers and FeBodyModel.
+void bindFeBodies(py::module_& m) {
   py::class_<FeBodyData>(m, "FeBodyData", "A body exported from an FE code: nodes, elements, node sets, M and K")
       .def_property_readonly("num_nodes", &FeBodyData::numNodes, "number of nodes")
       .def_property_readonly("num_dofs", &FeBodyData::numDofs, "number of degrees of freedom of M and K")
@@ -675,8 +692,10 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           "invariants", [](const FeBodyModel& mdl) { return mdl.invariants(); },
           "A copy of the reduced invariants (FfrInvariants3d): add them with System.add_flexible_body_3d")
       .def_property_readonly("natural_frequencies", &FeBodyModel::naturalFrequencies, "rad/s, the kept modes");
+}
 
-  // ----- the builders: methods of System ------------------------------------------------------
+/// System.add_rigid_body_3d and add_flexible_body_3d.
+void bindSpatialBodyBuilders(py::class_<System>& system) {
   system
       .def(
           "add_rigid_body_3d",
@@ -708,7 +727,12 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           },
           py::arg("name"), py::arg("model"), py::arg("initial") = py::none(),
           py::arg("elastic_coordinates") = py::none(), py::arg("elastic_velocities") = py::none(),
-          "A spatial FFR body of a beam model (FfrBeamModel3d) or of given invariants (FfrInvariants3d)")
+          "A spatial FFR body of a beam model (FfrBeamModel3d) or of given invariants (FfrInvariants3d)");
+}
+
+/// The spatial joints and their drivers; initial_joint_angle.
+void bindSpatialJointBuilders(py::class_<System>& system) {
+  system
       .def(
           "add_spatial_joint",
           [](System& s, const std::string& name, const py::object& type, const py::object& bi, const py::object& fi,
@@ -766,7 +790,12 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
       .def(
           "initial_joint_angle",
           [](const System& s, const py::object& j) { return initialJointAngle(s, joint(s, j, "initial_joint_angle")); },
-          py::arg("joint"), "The angle of a spatial joint (name or index) at the initial coordinates (rad)")
+          py::arg("joint"), "The angle of a spatial joint (name or index) at the initial coordinates (rad)");
+}
+
+/// Spatial spring-dampers, bushings and applied loads.
+void bindSpatialForceBuilders(py::class_<System>& system) {
+  system
       .def(
           "add_spatial_spring_damper",
           [](System& s, const std::string& name, const py::object& bi, const py::object& pi, const py::object& bj,
@@ -848,7 +877,25 @@ void bindSpatial(py::module_& m, py::class_<System>& system) {
           },
           py::arg("name"), py::arg("body"), py::arg("point") = py::make_tuple(0, 0, 0), py::arg("force_x") = py::none(),
           py::arg("force_y") = py::none(), py::arg("force_z") = py::none(), py::arg("torque_x") = py::none(),
-          py::arg("torque_y") = py::none(), py::arg("torque_z") = py::none(), "Force and torque laws, world axes")
+          py::arg("torque_y") = py::none(), py::arg("torque_z") = py::none(), "Force and torque laws, world axes");
+}
+
+}  // namespace
+
+void bindSpatial(py::module_& m, py::class_<System>& system) {
+  bindOrientationsAndFrameStates(m);
+  bindSolidShapes(m);
+  bindJointFrames(m);
+  bindSpatialBeams(m);
+  bindGivenInvariants(m);
+  bindSid(m);
+  bindFeBodies(m);
+
+  // ----- the builders: methods of System ------------------------------------------------------
+  bindSpatialBodyBuilders(system);
+  bindSpatialJointBuilders(system);
+  bindSpatialForceBuilders(system);
+  system
       .def_property_readonly(
           "is_spatial",
           [](const System& s) {

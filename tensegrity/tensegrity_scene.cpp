@@ -51,55 +51,8 @@ std::pair<int, int> nodePair(const TensegrityStructure& s, const Reader& r) {
   return {lookupNode(s, v[0].get<std::string>(), r), lookupNode(s, v[1].get<std::string>(), r)};
 }
 
-}  // namespace
-
-bool isTensegritySceneFile(const std::string& path) {
-  std::string text;
-  try {
-    text = readSceneFile(path);
-    checkJsonNesting(text, path);
-  } catch (const InputError&) {
-    return false;  // the scene loader reports it
-  }
-  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (!j.is_object()) return false;
-  const auto it = j.find("model");
-  return it != j.end() && it->is_string() && it->get<std::string>() == "tensegrity";
-}
-
-TensegrityScene loadTensegrityScene(const std::string& path) {
-  const std::string text = readSceneFile(path);
-  checkJsonNesting(text, path);
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    throw InputError(path + ": not valid JSON (" + e.what() + ")");
-  } catch (const json::exception& e) {
-    // 406: a number literal that does not fit a double (1e999)
-    throw InputError(path + ": invalid JSON: " + plainMessage(e) + " (numbers must be finite)");
-  }
-  try {
-    return parseTensegrityScene(j);
-  } catch (const InputError& e) {
-    throw InputError(path + ": " + e.what());
-  }
-}
-
-TensegrityScene parseTensegrityScene(const json& j) {
-  Reader top(j, "scene");
-  top.allowOnly(scenekeys::kTensegrityScene);
-  if (top.string("model") != "tensegrity") top.fail("key \"model\" must be \"tensegrity\"");
-  TensegrityScene scene;
-  scene.name = top.string("name", "");
-  const long dim = top.integer("dimension", 3, 2);
-  if (dim != 2 && dim != 3) top.fail("key \"dimension\" must be 2 or 3, got " + std::to_string(dim));
-  const int d = static_cast<int>(dim);
-  scene.structure = std::make_unique<TensegrityStructure>(d);
-  TensegrityStructure& s = *scene.structure;
-  if (top.has("gravity")) s.setGravity(top.vector("gravity", d));
-  if (top.has("max_struts_per_node")) s.setMaxStrutsPerNode(static_cast<int>(top.integer("max_struts_per_node", 1, 1)));
-
+/// The nodes (key "nodes", at least one).
+void readNodes(const Reader& top, TensegrityStructure& s, int d) {
   const json& nodes = top.array("nodes");
   if (nodes.empty()) top.fail("key \"nodes\" must be a non-empty array of nodes");
   for (std::size_t k = 0; k < nodes.size(); ++k) {
@@ -123,8 +76,13 @@ TensegrityScene parseTensegrityScene(const json& j) {
     }
     located(r.where(), [&] { return s.addNode(name, x, m, fixed, v); });
   }
-  const VecX x0 = s.initialPositions();
-  auto initialLength = [&](std::pair<int, int> n) { return (x0.segment(d * n.first, d) - x0.segment(d * n.second, d)).norm(); };
+}
+
+/// The struts, cables and loads; a member without "natural_length" takes its length at x0.
+void readMembersAndLoads(const Reader& top, TensegrityStructure& s, int d, const VecX& x0) {
+  auto initialLength = [&](std::pair<int, int> n) {
+    return (x0.segment(d * n.first, d) - x0.segment(d * n.second, d)).norm();
+  };
 
   const json& struts = top.array("struts");
   for (std::size_t k = 0; k < struts.size(); ++k) {
@@ -174,31 +132,37 @@ TensegrityScene parseTensegrityScene(const json& j) {
     }
     located(r.where(), [&] { s.addLoad(name, node, comps); });
   }
-  s.finalize();
+}
 
-  if (top.has("prestress")) {
-    Reader r(top.required("prestress"), "prestress");
-    r.allowOnly(scenekeys::kPrestress);
-    const std::string cableName = r.name("cable");
-    const double tension = r.positive("tension");
-    const SelfStressStates st = computeSelfStress(s, s.initialPositions());
-    if (st.forceDensities.cols() != 1) {
-      r.fail("the structure has " + std::to_string(st.forceDensities.cols()) +
-             " independent self-stress states (expected exactly 1 to prestress from)");
-    }
-    int member = -1;
-    for (int c = 0; c < s.numCables(); ++c) {
-      if (s.cable(c).name == cableName) member = s.numStruts() + c;
-    }
-    if (member < 0) r.fail("unknown cable " + inQuotes(cableName));
-    VecX qd = st.forceDensities.col(0);
-    const auto [ni, nj] = s.memberNodes({false, member - s.numStruts()});
-    const double l = (x0.segment(d * ni, d) - x0.segment(d * nj, d)).norm();
-    if (std::abs(qd[member]) < 1e-12) r.fail("cable " + inQuotes(cableName) + " carries no force in the self-stress state");
-    qd *= tension / (qd[member] * l);  // force of the reference cable: q l = tension
-    located(r.where(), [&] { applyPrestress(s, qd, 1.0); });
+/// The prestress of the finalized structure: its one self-stress state scaled to the tension of one cable.
+void readPrestress(const Reader& top, TensegrityStructure& s, int d, const VecX& x0) {
+  Reader r(top.required("prestress"), "prestress");
+  r.allowOnly(scenekeys::kPrestress);
+  const std::string cableName = r.name("cable");
+  const double tension = r.positive("tension");
+  const SelfStressStates st = computeSelfStress(s, s.initialPositions());
+  if (st.forceDensities.cols() != 1) {
+    r.fail("the structure has " + std::to_string(st.forceDensities.cols()) +
+           " independent self-stress states (expected exactly 1 to prestress from)");
   }
+  int member = -1;
+  for (int c = 0; c < s.numCables(); ++c) {
+    if (s.cable(c).name == cableName) member = s.numStruts() + c;
+  }
+  if (member < 0) r.fail("unknown cable " + inQuotes(cableName));
+  VecX qd = st.forceDensities.col(0);
+  const auto [ni, nj] = s.memberNodes({false, member - s.numStruts()});
+  const double l = (x0.segment(d * ni, d) - x0.segment(d * nj, d)).norm();
+  if (std::abs(qd[member]) < 1e-12) {
+    r.fail("cable " + inQuotes(cableName) + " carries no force in the self-stress state");
+  }
+  qd *= tension / (qd[member] * l);  // force of the reference cable: q l = tension
+  located(r.where(), [&] { applyPrestress(s, qd, 1.0); });
+}
 
+/// The solver object: the settings of the time stepper or of the massless-cable integrator, checked by
+/// constructing it.
+void readSolver(const Reader& top, const TensegrityStructure& s, TensegrityScene& scene) {
   Reader sv(top.required("solver"), "solver");
   const std::string method = sv.string("method");
   if (method == "time_stepping") {
@@ -236,6 +200,65 @@ TensegrityScene parseTensegrityScene(const json& j) {
   } else {
     sv.fail("unknown method " + inQuotes(method) + " (expected one of: time_stepping, massless_cables)");
   }
+}
+
+}  // namespace
+
+bool isTensegritySceneFile(const std::string& path) {
+  std::string text;
+  try {
+    text = readSceneFile(path);
+    checkJsonNesting(text, path);
+  } catch (const InputError&) {
+    return false;  // the scene loader reports it
+  }
+  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!j.is_object()) return false;
+  const auto it = j.find("model");
+  return it != j.end() && it->is_string() && it->get<std::string>() == "tensegrity";
+}
+
+TensegrityScene loadTensegrityScene(const std::string& path) {
+  const std::string text = readSceneFile(path);
+  checkJsonNesting(text, path);
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(path + ": not valid JSON (" + e.what() + ")");
+  } catch (const json::exception& e) {
+    // 406: a number literal that does not fit a double (1e999)
+    throw InputError(path + ": invalid JSON: " + plainMessage(e) + " (numbers must be finite)");
+  }
+  try {
+    return parseTensegrityScene(j);
+  } catch (const InputError& e) {
+    throw InputError(path + ": " + e.what());
+  }
+}
+
+TensegrityScene parseTensegrityScene(const json& j) {
+  Reader top(j, "scene");
+  top.allowOnly(scenekeys::kTensegrityScene);
+  if (top.string("model") != "tensegrity") top.fail("key \"model\" must be \"tensegrity\"");
+  TensegrityScene scene;
+  scene.name = top.string("name", "");
+  const long dim = top.integer("dimension", 3, 2);
+  if (dim != 2 && dim != 3) top.fail("key \"dimension\" must be 2 or 3, got " + std::to_string(dim));
+  const int d = static_cast<int>(dim);
+  scene.structure = std::make_unique<TensegrityStructure>(d);
+  TensegrityStructure& s = *scene.structure;
+  if (top.has("gravity")) s.setGravity(top.vector("gravity", d));
+  if (top.has("max_struts_per_node")) s.setMaxStrutsPerNode(static_cast<int>(top.integer("max_struts_per_node", 1, 1)));
+
+  readNodes(top, s, d);
+  const VecX x0 = s.initialPositions();
+  readMembersAndLoads(top, s, d, x0);
+  s.finalize();
+
+  if (top.has("prestress")) readPrestress(top, s, d, x0);
+
+  readSolver(top, s, scene);
   checkTensegrityTimes(scene);
   return scene;
 }

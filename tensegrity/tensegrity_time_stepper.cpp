@@ -216,271 +216,380 @@ TensegrityTimeStepper::TensegrityTimeStepper(const TensegrityStructure& structur
   LcpSolver check(o.lcp);  // validates the LCP options
 }
 
-TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observer) const {
-  const TimeSteppingSettings& o = settings_;
-  const std::clock_t cpuStart = std::clock();
-  const LcpSolver lcp(o.lcp);
-  const int nc = s_.numCables();
-  const int nf = s_.numFreeCoordinates();
-  const MatX Minv = s_.massMatrix().ldlt().solve(MatX::Identity(nf, nf));
+namespace {
+
+/// The pairs of members that may touch (contact constraints): every two members sharing
+/// no node, with r_a + r_b and the mean of their initial lengths.
+std::vector<ContactPair> memberContactPairs(const TensegrityStructure& s) {
   std::vector<ContactPair> cpairs;
-  if (o.contactConstraints) {
-    const std::vector<MemberRef> mem = s_.members();
-    const VecX x0 = s_.initialPositions();
-    auto length = [&](int i, int j) { return (x0.segment(s_.dimension() * j, s_.dimension()) - x0.segment(s_.dimension() * i, s_.dimension())).norm(); };
-    for (std::size_t a = 0; a < mem.size(); ++a) {
-      for (std::size_t b = a + 1; b < mem.size(); ++b) {
-        const auto [ai, aj] = s_.memberNodes(mem[a]);
-        const auto [bi, bj] = s_.memberNodes(mem[b]);
-        if (ai == bi || ai == bj || aj == bi || aj == bj) continue;
-        cpairs.push_back({ai, aj, bi, bj, s_.memberRadius(mem[a]) + s_.memberRadius(mem[b]),
-                          0.5 * (length(ai, aj) + length(bi, bj))});
-      }
+  const std::vector<MemberRef> mem = s.members();
+  const VecX x0 = s.initialPositions();
+  auto length = [&](int i, int j) {
+    return (x0.segment(s.dimension() * j, s.dimension()) - x0.segment(s.dimension() * i, s.dimension())).norm();
+  };
+  for (std::size_t a = 0; a < mem.size(); ++a) {
+    for (std::size_t b = a + 1; b < mem.size(); ++b) {
+      const auto [ai, aj] = s.memberNodes(mem[a]);
+      const auto [bi, bj] = s.memberNodes(mem[b]);
+      if (ai == bi || ai == bj || aj == bi || aj == bj) continue;
+      cpairs.push_back({ai, aj, bi, bj, s.memberRadius(mem[a]) + s.memberRadius(mem[b]),
+                        0.5 * (length(ai, aj) + length(bi, bj))});
     }
   }
+  return cpairs;
+}
 
-  TensegrityRunSummary sum;
-  sum.method = "time_stepping";
-  sum.lcpSolver = toString(o.lcp.method);
+/// M^-1 on the free coordinates (the mass matrix is constant).
+MatX inverseMassMatrix(const TensegrityStructure& s) {
+  const int nf = s.numFreeCoordinates();
+  return s.massMatrix().ldlt().solve(MatX::Identity(nf, nf));
+}
 
-  VecX x = s_.initialPositions(), v = s_.initialVelocities();
-  double t = o.tStart;
-  auto energy = [&](const VecX& xx, const VecX& vv) { return s_.kineticEnergy(vv) + s_.potentialEnergy(xx); };
-  sum.energyStart = energy(x, v);
-
-  std::vector<bool> slack(nc, false), carried(nc, false);
-  {
-    const VecX l = s_.cableLengths(x);
-    for (int c = 0; c < nc; ++c) slack[c] = l[c] < s_.cable(c).naturalLength * (1.0 - o.slackTolerance);
-  }
-  VecX lastImpulse = VecX::Zero(nc), snapImpulse = VecX::Zero(nc);
-  double lastDt = o.timeStep;
-
-  std::optional<MemberContactDetector> contacts;
-  std::vector<TensegrityEvent> pending;
-  auto emit = [&](TensegrityEvent e) {
-    sum.count(e);
-    if (observer.onEvent) observer.onEvent(e);
-  };
-  if (o.detectContacts) {
-    contacts.emplace(s_);
-    contacts->start(t, x, pending);
-    for (auto& e : pending) emit(e);
-    pending.clear();
-  }
-
-  long stepsTaken = 0;
-  auto sample = [&]() {
-    if (!observer.onSample) return;
-    TensegritySample smp;
-    smp.t = t;
-    smp.steps = stepsTaken;
-    smp.x = x;
-    smp.v = v;
-    smp.cableLength = s_.cableLengths(x);
-    smp.cableTension = s_.elasticCableTensions(x);
-    for (int c = 0; c < nc; ++c) {
-      if (s_.cable(c).inextensible) smp.cableTension[c] = lastImpulse[c] / lastDt;
-    }
-    smp.cableImpulse = snapImpulse;
-    smp.slack = slack;
-    smp.kineticEnergy = s_.kineticEnergy(v);
-    smp.potentialEnergy = s_.potentialEnergy(x);
-    observer.onSample(smp);
-    snapImpulse.setZero();
-  };
-  sample();
-
+/// The number of steps over [tStart, tEnd]; the last one is shortened to end at tEnd.
+long numberOfSteps(const TimeSteppingSettings& o) {
   const double span = o.tEnd - o.tStart;
-  const long nSteps = std::max(1L, static_cast<long>(std::ceil(span / o.timeStep - 1e-9)));
-  const long outEvery = o.outputStep > 0.0 ? std::max(1L, std::lround(o.outputStep / o.timeStep)) : 1L;
+  return std::max(1L, static_cast<long>(std::ceil(span / o.timeStep - 1e-9)));
+}
 
-  try {
-    for (long step = 1; step <= nSteps; ++step) {
-      pollStop(t);  // core/stop_request.hpp
-      const double dt = step == nSteps ? o.tEnd - t : o.timeStep;
-      const double tm = t + 0.5 * dt;
-      const VecX xi = x, vi = v;
-      const double Ei = energy(xi, vi);
-      const VecX vFreeI = s_.restrict(vi);
-      // Midpoint u_m = u_i + v_i dt/2 (doc. 001, sec. 3.2).
-      const VecX xm = xi + 0.5 * dt * vi;
-      // v_free = v_i + M^-1 (f(t_m) - g(u_m)) dt
-      const VecX force = s_.restrict(s_.externalForces(tm) - s_.internalForces(xm));
-      VecX vf = vFreeI + Minv * (force * dt);
-      // Active set: inextensible cables at or beyond their natural length at u_m.
-      const VecX lm = s_.cableLengths(xm);
-      std::vector<int> active;
-      std::vector<Row> B;
-      for (int c = 0; c < nc; ++c) {
-        const TensegrityCable& cb = s_.cable(c);
-        if (!cb.inextensible) continue;
-        if (lm[c] >= cb.naturalLength * (1.0 - o.slackTolerance)) {
-          active.push_back(c);
-          B.push_back(s_.cableGradientEntries(xm, c));
-        }
-      }
-      // Contact constraints (option): rows after the cables' ones.
-      for (const ContactPair& cp : cpairs) {
-        ContactRow r = contactRow(s_, xm, cp);
-        if (r.gap <= o.slackTolerance * cp.scale) B.push_back(std::move(r.b));
-      }
-      VecX p = VecX::Zero(static_cast<int>(B.size()));
-      if (!B.empty()) {
-        const MatX W = delassus(B, Minv);
-        VecX q(static_cast<int>(B.size()));
-        for (std::size_t a = 0; a < B.size(); ++a) q[a] = -rowDot(B[a], vf);
-        const LcpSolution sol = lcp.solve(W, q);
-        sum.maxLcpResidual = std::max(sum.maxLcpResidual, sol.residual);
-        sum.maxLcpSize = std::max(sum.maxLcpSize, static_cast<int>(active.size()));
-        sum.lcpIterations += sol.iterations;
-        ++sum.lcpSolves;
-        sum.lcpSizeSum += static_cast<long>(B.size());
-        if (!sol.ok) {
-          throw SolverError("LCP (" + toString(o.lcp.method) + ") of the cable impulses failed at step " +
-                                std::to_string(step) + " (t = " + num(t) + ", dt = " + num(dt) + ", " +
-                                std::to_string(active.size()) + " active cables, " +
-                                std::to_string(B.size() - active.size()) + " contacts): residual " + num(sol.residual) +
-                                " > tolerance " + num(o.lcp.tolerance) + " after " + std::to_string(sol.iterations) +
-                                " iterations (Siconos info " + std::to_string(sol.info) + ")",
-                            t, dt);
-        }
-        p = sol.z;
-        for (std::size_t a = active.size(); a < B.size(); ++a) sum.contactImpulseSum += p[a];
-        vf -= impulseResponse(B, p, Minv);
-      }
-      VecX xf = xm + 0.5 * dt * s_.expand(vf, VecX::Zero(s_.numCoordinates()));
-      // Drift of inextensible cables and its projection.
-      auto drift = [&](const VecX& xx) {
-        const VecX l = s_.cableLengths(xx);
-        double d = 0.0;
-        for (int c = 0; c < nc; ++c) {
-          if (s_.cable(c).inextensible) d = std::max(d, (l[c] - s_.cable(c).naturalLength) / s_.cable(c).naturalLength);
-        }
-        for (const ContactPair& cp : cpairs) d = std::max(d, -contactRow(s_, xx, cp).gap / cp.scale);
-        return d;
-      };
-      double d = drift(xf);
-      sum.maxDriftBeforeProjection = std::max(sum.maxDriftBeforeProjection, d);
-      if (o.projectPositions) {
-        for (int it = 0; it < o.maxProjectionIterations && d > o.projectionTolerance; ++it) {
-          ++sum.projectionIterations;
-          const VecX l = s_.cableLengths(xf);
-          std::vector<Row> Bp;
-          VecX g;
-          std::vector<double> gs;
-          for (int c = 0; c < nc; ++c) {
-            const TensegrityCable& cb = s_.cable(c);
-            if (cb.inextensible && l[c] >= cb.naturalLength * (1.0 - o.slackTolerance)) {
-              Bp.push_back(s_.cableGradientEntries(xf, c));
-              gs.push_back(l[c] - cb.naturalLength);
-            }
-          }
-          for (const ContactPair& cp : cpairs) {
-            ContactRow r = contactRow(s_, xf, cp);
-            if (r.gap <= o.slackTolerance * cp.scale) {
-              Bp.push_back(std::move(r.b));
-              gs.push_back(-r.gap);
-            }
-          }
-          g = Eigen::Map<const VecX>(gs.data(), static_cast<int>(gs.size()));
-          const LcpSolution sol = lcp.solve(delassus(Bp, Minv), -g);
-          if (!sol.ok) {
-            throw SolverError("LCP (" + toString(o.lcp.method) + ") of the position projection failed at step " +
-                                  std::to_string(step) + " (t = " + num(t) + "): residual " + num(sol.residual) +
-                                  " > tolerance " + num(o.lcp.tolerance),
-                              t, dt);
-          }
-          xf -= s_.expand(impulseResponse(Bp, sol.z, Minv), VecX::Zero(s_.numCoordinates()));
-          d = drift(xf);
-        }
-        sum.maxDriftAfterProjection = std::max(sum.maxDriftAfterProjection, d);
-      } else {
-        sum.maxDriftAfterProjection = sum.maxDriftBeforeProjection;
-      }
+/// One run of TensegrityTimeStepper: the state carried from step to step (positions,
+/// velocities, time, the cables' slack and carrying flags, the impulses the samples
+/// report, the summary, the contact detector) and the stages of a step.
+class TimeSteppingRun {
+ public:
+  /// The initial state: positions, velocities, slack cables, the summary's start.
+  TimeSteppingRun(const TensegrityStructure& s, const TimeSteppingSettings& o, const TensegrityObserver& observer);
 
-      // Commit the step.
-      const double tf = t + dt;
-      x = xf;
-      v = s_.expand(vf, VecX::Zero(s_.numCoordinates()));
-      const double Ef = energy(x, v);
-      lastImpulse.setZero();
-      for (std::size_t a = 0; a < active.size(); ++a) lastImpulse[active[a]] = p[a];
-      // Events: snaps (impulse on a cable that was not carrying tension and was
-      // lengthening), taut and slack transitions. Times: where the gap l - l0 crosses
-      // zero, interpolated linearly between u_i and u_f.
-      const VecX li = s_.cableLengths(xi), lf = s_.cableLengths(x);
-      bool snapped = false;
-      for (int c = 0; c < nc; ++c) {
-        const double l0 = s_.cable(c).naturalLength;
-        const bool nowSlack = lf[c] < l0 * (1.0 - o.slackTolerance);
-        const double gi = li[c] - l0, gf = lf[c] - l0;
-        const double crossing = (gi < 0.0 && gf >= 0.0) || (gi >= 0.0 && gf < 0.0) ? t + dt * gi / (gi - gf) : tm;
-        const double pc = lastImpulse[c];
-        double rate = 0.0;
-        if (pc > 0.0) {
-          const auto ai = std::find(active.begin(), active.end(), c) - active.begin();
-          rate = rowDot(B[ai], vFreeI);
-        }
-        TensegrityEvent e;
-        e.step = step;
-        e.member = s_.cable(c).name;
-        if (pc > 0.0 && !carried[c] && rate > o.snapRateTolerance) {
-          e.type = TensegrityEvent::Type::Snap;
-          e.t = std::clamp(crossing, t, tf);
-          e.impulse = pc;
-          e.elongationRate = rate;
-          e.energyChange = Ef - Ei;
-          snapImpulse[c] += pc;
-          snapped = true;
-          emit(e);
-        } else if (slack[c] && !nowSlack) {
-          e.type = TensegrityEvent::Type::Taut;
-          e.t = std::clamp(crossing, t, tf);
-          emit(e);
-        }
-        if (!slack[c] && nowSlack) {
-          e.type = TensegrityEvent::Type::Slack;
-          e.t = std::clamp(crossing, t, tf);
-          e.impulse = 0.0;
-          emit(e);
-        }
-        slack[c] = nowSlack;
-        carried[c] = pc > 0.0;
-      }
-      if (snapped) sum.maxEnergyIncreaseAtSnap = std::max(sum.maxEnergyIncreaseAtSnap, Ef - Ei);
-      if (snapped) {
-        // the loads' work over the step at the force the step applied (midpoint time tm)
-        const double loadWork = s_.loadForces(tm).dot(x - xi);
-        if (const std::optional<std::string> grown = snapEnergyGrowth(Ei, Ef, loadWork)) {
-          throw SolverError("between t = " + num(t) + " and t = " + num(tf) + ": " + *grown, t, dt);
-        }
-      }
-      if (contacts) {
-        contacts->advance(t, xi, tf, x, pending);
-        std::sort(pending.begin(), pending.end(),
-                  [](const TensegrityEvent& a, const TensegrityEvent& b) { return a.t < b.t; });
-        for (auto& e : pending) {
-          e.step = step;
-          emit(e);
-        }
-        pending.clear();
-      }
-      t = tf;
-      lastDt = dt;
-      sum.steps = step;
-      sum.tReached = t;
-      stepsTaken = step;
-      if (step % outEvery == 0 || step == nSteps) sample();
-    }
-    sum.ok = true;
-    sum.message = "ok";
-  } catch (const SolverError& e) {
-    sum.ok = false;
-    sum.message = e.what();
-    sum.tReached = t;
+  /// The first contact events and sample, then the steps. A SolverError ends the run
+  /// with ok = false; the summary has everything but cpuSeconds.
+  TensegrityRunSummary run();
+
+ private:
+  /// The velocity and impulses of one step (the LCP at the midpoint).
+  struct StepImpulses {
+    VecX vf;                  ///< v_f on the free coordinates, after the impulses
+    std::vector<int> active;  ///< the inextensible cables in the LCP
+    std::vector<Row> B;       ///< the rows of the active cables, then of the touching contact pairs
+    VecX p;                   ///< the impulses, one per row of B
+  };
+
+  double energy(const VecX& xx, const VecX& vv) const { return s_.kineticEnergy(vv) + s_.potentialEnergy(xx); }
+  /// Counts the event in the summary and hands it to the observer.
+  void emit(TensegrityEvent e);
+  /// The contact detector (option) and the contacts of the initial positions.
+  void startContactDetection();
+  /// The sample written to the observer (the snap impulses are summed until it).
+  void sample();
+  /// One time step from t_ over dt (the last one shortened to end at tEnd).
+  void takeStep(long step);
+  /// Midpoint, free velocity, active set and the LCP of the impulses.
+  StepImpulses stepImpulses(long step, double dt, double tm, const VecX& xm, const VecX& vFreeI);
+  /// Largest relative drift of the inextensible cables and penetration of the contact pairs.
+  double drift(const VecX& xx) const;
+  /// The projection of the drift at u_f (option) and its bookkeeping.
+  void projectPositions(long step, double dt, VecX& xf);
+  /// x, v and the impulses of the step taken; its snap, taut and slack events; the energy
+  /// check of a snap; the contact events; the time advanced.
+  void commitStep(long step, double dt, double tm, const VecX& xi, double Ei, const VecX& vFreeI, const VecX& xf,
+                  const StepImpulses& imp);
+  /// The contact events between (t_, xi) and (tf, x_), in time order.
+  void emitContactEvents(long step, double tf, const VecX& xi);
+
+  const TensegrityStructure& s_;
+  const TimeSteppingSettings& o_;
+  const TensegrityObserver& observer_;
+  const LcpSolver lcp_;
+  const int nc_;
+  const MatX Minv_;
+  const std::vector<ContactPair> cpairs_;
+  const long nSteps_;
+  const long outEvery_;
+  TensegrityRunSummary sum_;
+  VecX x_, v_;
+  double t_;
+  std::vector<bool> slack_, carried_;
+  VecX lastImpulse_, snapImpulse_;
+  double lastDt_;
+  std::optional<MemberContactDetector> contacts_;
+  std::vector<TensegrityEvent> pending_;
+  long stepsTaken_ = 0;
+};
+
+TimeSteppingRun::TimeSteppingRun(const TensegrityStructure& s, const TimeSteppingSettings& o,
+                                 const TensegrityObserver& observer)
+    : s_(s),
+      o_(o),
+      observer_(observer),
+      lcp_(o.lcp),
+      nc_(s.numCables()),
+      Minv_(inverseMassMatrix(s)),
+      cpairs_(o.contactConstraints ? memberContactPairs(s) : std::vector<ContactPair>()),
+      nSteps_(numberOfSteps(o)),
+      outEvery_(o.outputStep > 0.0 ? std::max(1L, std::lround(o.outputStep / o.timeStep)) : 1L),
+      x_(s.initialPositions()),
+      v_(s.initialVelocities()),
+      t_(o.tStart),
+      slack_(nc_, false),
+      carried_(nc_, false),
+      lastImpulse_(VecX::Zero(nc_)),
+      snapImpulse_(VecX::Zero(nc_)),
+      lastDt_(o.timeStep) {
+  sum_.method = "time_stepping";
+  sum_.lcpSolver = toString(o_.lcp.method);
+  sum_.energyStart = energy(x_, v_);
+  const VecX l = s_.cableLengths(x_);
+  for (int c = 0; c < nc_; ++c) slack_[c] = l[c] < s_.cable(c).naturalLength * (1.0 - o_.slackTolerance);
+}
+
+void TimeSteppingRun::emit(TensegrityEvent e) {
+  sum_.count(e);
+  if (observer_.onEvent) observer_.onEvent(e);
+}
+
+void TimeSteppingRun::startContactDetection() {
+  if (o_.detectContacts) {
+    contacts_.emplace(s_);
+    contacts_->start(t_, x_, pending_);
+    for (auto& e : pending_) emit(e);
+    pending_.clear();
   }
-  sum.energyEnd = energy(x, v);
+}
+
+void TimeSteppingRun::sample() {
+  if (!observer_.onSample) return;
+  TensegritySample smp;
+  smp.t = t_;
+  smp.steps = stepsTaken_;
+  smp.x = x_;
+  smp.v = v_;
+  smp.cableLength = s_.cableLengths(x_);
+  smp.cableTension = s_.elasticCableTensions(x_);
+  for (int c = 0; c < nc_; ++c) {
+    if (s_.cable(c).inextensible) smp.cableTension[c] = lastImpulse_[c] / lastDt_;
+  }
+  smp.cableImpulse = snapImpulse_;
+  smp.slack = slack_;
+  smp.kineticEnergy = s_.kineticEnergy(v_);
+  smp.potentialEnergy = s_.potentialEnergy(x_);
+  observer_.onSample(smp);
+  snapImpulse_.setZero();
+}
+
+TensegrityRunSummary TimeSteppingRun::run() {
+  startContactDetection();
+  sample();
+  try {
+    for (long step = 1; step <= nSteps_; ++step) takeStep(step);
+    sum_.ok = true;
+    sum_.message = "ok";
+  } catch (const SolverError& e) {
+    sum_.ok = false;
+    sum_.message = e.what();
+    sum_.tReached = t_;
+  }
+  sum_.energyEnd = energy(x_, v_);
+  return sum_;
+}
+
+void TimeSteppingRun::takeStep(long step) {
+  pollStop(t_);  // core/stop_request.hpp
+  const double dt = step == nSteps_ ? o_.tEnd - t_ : o_.timeStep;
+  const double tm = t_ + 0.5 * dt;
+  const VecX xi = x_, vi = v_;
+  const double Ei = energy(xi, vi);
+  const VecX vFreeI = s_.restrict(vi);
+  // Midpoint u_m = u_i + v_i dt/2 (doc. 001, sec. 3.2).
+  const VecX xm = xi + 0.5 * dt * vi;
+  const StepImpulses imp = stepImpulses(step, dt, tm, xm, vFreeI);
+  VecX xf = xm + 0.5 * dt * s_.expand(imp.vf, VecX::Zero(s_.numCoordinates()));
+  projectPositions(step, dt, xf);
+  commitStep(step, dt, tm, xi, Ei, vFreeI, xf, imp);
+  if (step % outEvery_ == 0 || step == nSteps_) sample();
+}
+
+TimeSteppingRun::StepImpulses TimeSteppingRun::stepImpulses(long step, double dt, double tm, const VecX& xm,
+                                                            const VecX& vFreeI) {
+  // v_free = v_i + M^-1 (f(t_m) - g(u_m)) dt
+  const VecX force = s_.restrict(s_.externalForces(tm) - s_.internalForces(xm));
+  VecX vf = vFreeI + Minv_ * (force * dt);
+  // Active set: inextensible cables at or beyond their natural length at u_m.
+  const VecX lm = s_.cableLengths(xm);
+  std::vector<int> active;
+  std::vector<Row> B;
+  for (int c = 0; c < nc_; ++c) {
+    const TensegrityCable& cb = s_.cable(c);
+    if (!cb.inextensible) continue;
+    if (lm[c] >= cb.naturalLength * (1.0 - o_.slackTolerance)) {
+      active.push_back(c);
+      B.push_back(s_.cableGradientEntries(xm, c));
+    }
+  }
+  // Contact constraints (option): rows after the cables' ones.
+  for (const ContactPair& cp : cpairs_) {
+    ContactRow r = contactRow(s_, xm, cp);
+    if (r.gap <= o_.slackTolerance * cp.scale) B.push_back(std::move(r.b));
+  }
+  VecX p = VecX::Zero(static_cast<int>(B.size()));
+  if (!B.empty()) {
+    const MatX W = delassus(B, Minv_);
+    VecX q(static_cast<int>(B.size()));
+    for (std::size_t a = 0; a < B.size(); ++a) q[a] = -rowDot(B[a], vf);
+    const LcpSolution sol = lcp_.solve(W, q);
+    sum_.maxLcpResidual = std::max(sum_.maxLcpResidual, sol.residual);
+    sum_.maxLcpSize = std::max(sum_.maxLcpSize, static_cast<int>(active.size()));
+    sum_.lcpIterations += sol.iterations;
+    ++sum_.lcpSolves;
+    sum_.lcpSizeSum += static_cast<long>(B.size());
+    if (!sol.ok) {
+      throw SolverError("LCP (" + toString(o_.lcp.method) + ") of the cable impulses failed at step " +
+                            std::to_string(step) + " (t = " + num(t_) + ", dt = " + num(dt) + ", " +
+                            std::to_string(active.size()) + " active cables, " +
+                            std::to_string(B.size() - active.size()) + " contacts): residual " + num(sol.residual) +
+                            " > tolerance " + num(o_.lcp.tolerance) + " after " + std::to_string(sol.iterations) +
+                            " iterations (Siconos info " + std::to_string(sol.info) + ")",
+                        t_, dt);
+    }
+    p = sol.z;
+    for (std::size_t a = active.size(); a < B.size(); ++a) sum_.contactImpulseSum += p[a];
+    vf -= impulseResponse(B, p, Minv_);
+  }
+  return {std::move(vf), std::move(active), std::move(B), std::move(p)};
+}
+
+double TimeSteppingRun::drift(const VecX& xx) const {
+  const VecX l = s_.cableLengths(xx);
+  double d = 0.0;
+  for (int c = 0; c < nc_; ++c) {
+    if (s_.cable(c).inextensible) d = std::max(d, (l[c] - s_.cable(c).naturalLength) / s_.cable(c).naturalLength);
+  }
+  for (const ContactPair& cp : cpairs_) d = std::max(d, -contactRow(s_, xx, cp).gap / cp.scale);
+  return d;
+}
+
+void TimeSteppingRun::projectPositions(long step, double dt, VecX& xf) {
+  // Drift of inextensible cables and its projection.
+  double d = drift(xf);
+  sum_.maxDriftBeforeProjection = std::max(sum_.maxDriftBeforeProjection, d);
+  if (o_.projectPositions) {
+    for (int it = 0; it < o_.maxProjectionIterations && d > o_.projectionTolerance; ++it) {
+      ++sum_.projectionIterations;
+      const VecX l = s_.cableLengths(xf);
+      std::vector<Row> Bp;
+      VecX g;
+      std::vector<double> gs;
+      for (int c = 0; c < nc_; ++c) {
+        const TensegrityCable& cb = s_.cable(c);
+        if (cb.inextensible && l[c] >= cb.naturalLength * (1.0 - o_.slackTolerance)) {
+          Bp.push_back(s_.cableGradientEntries(xf, c));
+          gs.push_back(l[c] - cb.naturalLength);
+        }
+      }
+      for (const ContactPair& cp : cpairs_) {
+        ContactRow r = contactRow(s_, xf, cp);
+        if (r.gap <= o_.slackTolerance * cp.scale) {
+          Bp.push_back(std::move(r.b));
+          gs.push_back(-r.gap);
+        }
+      }
+      g = Eigen::Map<const VecX>(gs.data(), static_cast<int>(gs.size()));
+      const LcpSolution sol = lcp_.solve(delassus(Bp, Minv_), -g);
+      if (!sol.ok) {
+        throw SolverError("LCP (" + toString(o_.lcp.method) + ") of the position projection failed at step " +
+                              std::to_string(step) + " (t = " + num(t_) + "): residual " + num(sol.residual) +
+                              " > tolerance " + num(o_.lcp.tolerance),
+                          t_, dt);
+      }
+      xf -= s_.expand(impulseResponse(Bp, sol.z, Minv_), VecX::Zero(s_.numCoordinates()));
+      d = drift(xf);
+    }
+    sum_.maxDriftAfterProjection = std::max(sum_.maxDriftAfterProjection, d);
+  } else {
+    sum_.maxDriftAfterProjection = sum_.maxDriftBeforeProjection;
+  }
+}
+
+void TimeSteppingRun::commitStep(long step, double dt, double tm, const VecX& xi, double Ei, const VecX& vFreeI,
+                                 const VecX& xf, const StepImpulses& imp) {
+  // Commit the step.
+  const double tf = t_ + dt;
+  x_ = xf;
+  v_ = s_.expand(imp.vf, VecX::Zero(s_.numCoordinates()));
+  const double Ef = energy(x_, v_);
+  lastImpulse_.setZero();
+  for (std::size_t a = 0; a < imp.active.size(); ++a) lastImpulse_[imp.active[a]] = imp.p[a];
+  // Events: snaps (impulse on a cable that was not carrying tension and was
+  // lengthening), taut and slack transitions. Times: where the gap l - l0 crosses
+  // zero, interpolated linearly between u_i and u_f.
+  const VecX li = s_.cableLengths(xi), lf = s_.cableLengths(x_);
+  bool snapped = false;
+  for (int c = 0; c < nc_; ++c) {
+    const double l0 = s_.cable(c).naturalLength;
+    const bool nowSlack = lf[c] < l0 * (1.0 - o_.slackTolerance);
+    const double gi = li[c] - l0, gf = lf[c] - l0;
+    const double crossing = (gi < 0.0 && gf >= 0.0) || (gi >= 0.0 && gf < 0.0) ? t_ + dt * gi / (gi - gf) : tm;
+    const double pc = lastImpulse_[c];
+    double rate = 0.0;
+    if (pc > 0.0) {
+      const auto ai = std::find(imp.active.begin(), imp.active.end(), c) - imp.active.begin();
+      rate = rowDot(imp.B[ai], vFreeI);
+    }
+    TensegrityEvent e;
+    e.step = step;
+    e.member = s_.cable(c).name;
+    if (pc > 0.0 && !carried_[c] && rate > o_.snapRateTolerance) {
+      e.type = TensegrityEvent::Type::Snap;
+      e.t = std::clamp(crossing, t_, tf);
+      e.impulse = pc;
+      e.elongationRate = rate;
+      e.energyChange = Ef - Ei;
+      snapImpulse_[c] += pc;
+      snapped = true;
+      emit(e);
+    } else if (slack_[c] && !nowSlack) {
+      e.type = TensegrityEvent::Type::Taut;
+      e.t = std::clamp(crossing, t_, tf);
+      emit(e);
+    }
+    if (!slack_[c] && nowSlack) {
+      e.type = TensegrityEvent::Type::Slack;
+      e.t = std::clamp(crossing, t_, tf);
+      e.impulse = 0.0;
+      emit(e);
+    }
+    slack_[c] = nowSlack;
+    carried_[c] = pc > 0.0;
+  }
+  if (snapped) sum_.maxEnergyIncreaseAtSnap = std::max(sum_.maxEnergyIncreaseAtSnap, Ef - Ei);
+  if (snapped) {
+    // the loads' work over the step at the force the step applied (midpoint time tm)
+    const double loadWork = s_.loadForces(tm).dot(x_ - xi);
+    if (const std::optional<std::string> grown = snapEnergyGrowth(Ei, Ef, loadWork)) {
+      throw SolverError("between t = " + num(t_) + " and t = " + num(tf) + ": " + *grown, t_, dt);
+    }
+  }
+  if (contacts_) emitContactEvents(step, tf, xi);
+  t_ = tf;
+  lastDt_ = dt;
+  sum_.steps = step;
+  sum_.tReached = t_;
+  stepsTaken_ = step;
+}
+
+void TimeSteppingRun::emitContactEvents(long step, double tf, const VecX& xi) {
+  contacts_->advance(t_, xi, tf, x_, pending_);
+  std::sort(pending_.begin(), pending_.end(),
+            [](const TensegrityEvent& a, const TensegrityEvent& b) { return a.t < b.t; });
+  for (auto& e : pending_) {
+    e.step = step;
+    emit(e);
+  }
+  pending_.clear();
+}
+
+}  // namespace
+
+TensegrityRunSummary TensegrityTimeStepper::run(const TensegrityObserver& observer) const {
+  const std::clock_t cpuStart = std::clock();
+  TensegrityRunSummary sum = TimeSteppingRun(s_, settings_, observer).run();
   sum.cpuSeconds = static_cast<double>(std::clock() - cpuStart) / CLOCKS_PER_SEC;
   return sum;
 }
