@@ -643,7 +643,7 @@ PYBIND11_MODULE(_flexmbd, m) {
             return py::make_tuple(r.columns, table(r), r.summary, r.ok);
           },
           py::arg("progress") = false);
-  // ----- kinematic analysis of linkages (linkage/, document 000) -------------------------
+  // ----- kinematic analysis of linkages (linkage/, Doc000) -------------------------------
   m.def(
       "run_kinematics_text",
       [](const std::string& text, const std::string& source) {
@@ -693,7 +693,7 @@ PYBIND11_MODULE(_flexmbd, m) {
       },
       py::arg("text"), py::arg("source") = "<scene>",
       "A kinematics scene (docs/kinematics.md) analysed: (columns, table, summary dict)");
-  // ----- tensegrity structures (tensegrity/, document 001) --------------------------------
+  // ----- tensegrity structures (tensegrity/, Doc001) --------------------------------------
   m.def(
       "run_tensegrity_text",
       [](const std::string& text, const std::string& source) {
