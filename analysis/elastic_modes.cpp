@@ -37,7 +37,7 @@ std::vector<BodyModes> elasticModes(const System& sys, std::vector<std::string>*
       continue;
     }
     const MatX M(*em.mass);
-    // K phi = omega^2 M phi, phi^T M phi = 1 (M, K symmetric, M positive definite: validated)
+    // K phi = omega^2 M phi, phi^T M phi = 1 (GeradinRixen; M, K symmetric, M positive definite: validated)
     const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(
         MatX(*em.stiffness), M, withShapes ? Eigen::ComputeEigenvectors : Eigen::EigenvaluesOnly);
     if (eig.info() != Eigen::Success) {

@@ -1,6 +1,6 @@
 /// @file
 /// The natural modes of every flexible body's elastic coordinates with its frame held
-/// (K_ff phi = omega^2 M_ff phi, phi^T M_ff phi = 1), and where those coordinates sit in the
+/// (K_ff phi = omega^2 M_ff phi, phi^T M_ff phi = 1; GeradinRixen), and where those coordinates sit in the
 /// system's q and v: what the automatic integrator choice, the quasi-static elastic start
 /// and the modal participation report look at (docs/formulations.md).
 #pragma once

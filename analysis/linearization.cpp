@@ -286,8 +286,8 @@ std::vector<Mode> denseModes(const ReducedSystem& red, int count) {
   const MatX M = red.M, C = red.C, K = red.K;
   Eigen::LLT<MatX> llt(M);
   if (llt.info() != Eigen::Success) throw ModelError("modes: the reduced mass matrix is not positive definite");
-  // first-order form z = [x; x' / w], z' = A z, scaled by a frequency w of the model's
-  // top range so that both block rows have norms ~ w: unscaled, |M^-1 K| ~ w_max^2
+  // first-order form z = [x; x' / w], z' = A z (a linearisation, TisseurMeerbergen2001), scaled
+  // by a frequency w of the model's top range so that both block rows have norms ~ w: unscaled, |M^-1 K| ~ w_max^2
   // against 1 costs the low eigenvalues digits (eps w_max^2 instead of eps w_max)
   const double w = frequencyScale(red);
   MatX A = MatX::Zero(2 * n, 2 * n);
@@ -309,7 +309,8 @@ std::vector<Mode> denseModes(const ReducedSystem& red, int count) {
   return selectModes(std::move(all), count, kZeroEigenvalueFraction * largest);
 }
 
-/// Spectra operator of the shift-invert of the pencil (A, E), A = [0 I; -K -C], E = [I 0; 0 M]:
+/// Spectra operator of the shift-invert of the pencil (A, E), A = [0 I; -K -C], E = [I 0; 0 M]
+/// (the linearisation of the quadratic eigenvalue problem, TisseurMeerbergen2001):
 /// y = (A - sigma E)^-1 E x, whose largest eigenvalues 1 / (s - sigma) are the s nearest sigma.
 class ShiftInvertPencil {
  public:

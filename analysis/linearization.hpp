@@ -1,8 +1,7 @@
 /// @file
 /// Linearisation of the constrained equations of motion about a state, and modal analysis
-/// of the result (docs/modes.md). Sources: Géradin & Cardona, Flexible Multibody Dynamics
-/// (2001), ch. 11 "Linearized analysis"; Shabana, Dynamics of Multibody Systems, 3rd ed.,
-/// sec. 6.x on the embedding (null-space) technique.
+/// of the result (docs/modes.md). Sources: GeradinCardona2001, ch. 11 "Linearized analysis";
+/// Shabana2005, sec. 6.x on the embedding (null-space) technique.
 #pragma once
 
 #include <complex>
@@ -48,7 +47,7 @@ ReferenceState solveSteadyMotion(const System& sys, double t0, const VecX& q0, c
 /// The linearised equations in velocity space (nv unknowns; increments dq = T(q) dx,
 /// q = q_ref (+) dx, Body::applyIncrement), frozen at the reference state:
 ///   M dx'' + C dx' + K dx + G^T dlambda = 0,   G dx = 0,
-/// with (Géradin & Cardona sec. 11.2; B the kinematic term below)
+/// with (GeradinCardona2001, sec. 11.2; B the kinematic term below)
 ///   M = M(q),  C = -dQ/dv - M B,  K = (d(M a)/dq - dQ/dq + sum_a lambda_a dG_a^T/dq) T - (-dQ/dv) B,
 /// where B dx = T+ (d(T v)/dq T dx - d(T dx)/dq T v) is the rate of a velocity-space
 /// increment carried by the reference motion: dx' = dv + B dx (zero when T = I, the
@@ -70,14 +69,15 @@ struct LinearizedSystem {
 LinearizedSystem linearize(const System& sys, const ReferenceState& state);
 
 /// A basis N (nv x nx, nx = nv - rank G) of the null space of G: the independent
-/// coordinates x with dx = N x.
+/// coordinates x with dx = N x (the embedding technique, Shabana2005, sec. 6.x).
 enum class BasisKind {
   Svd,                    ///< orthonormal (dense SVD): small systems
   CoordinatePartitioning  ///< dx = [x; -G_d^-1 G_i x] (rows permuted): sparse, frame coordinates dependent first
 };
 
 /// The reduced equations Mr x'' + Cr x' + Kr x = 0 and N: Mr = N^T M N, Cr = N^T C N,
-/// Kr = N^T K N when G is constant along the reference; otherwise dx = N(t) x with
+/// Kr = N^T K N when G is constant along the reference (the embedding, Shabana2005, sec. 6.x;
+/// GeradinCardona2001, ch. 11); otherwise dx = N(t) x with
 /// N' = -R G' N, N'' = -R (2 G' N' + G'' N) (R the right inverse of G of coordinate
 /// partitioning: body-axes increments stay the independent coordinates) and
 /// Cr = N^T (2 M N' + C N), Kr = N^T (M N'' + C N' + K N) (docs/modes.md).
@@ -106,7 +106,7 @@ ReducedSystem reduceNear(const LinearizedSystem& lin, const SpMat& near, const s
 
 /// One eigenvalue s of the first-order form [0 I; -Mr^-1 Kr, -Mr^-1 Cr] and its mode.
 struct Mode {
-  std::complex<double> eigenvalue;   ///< s = -zeta omega + i omega sqrt(1 - zeta^2)
+  std::complex<double> eigenvalue;   ///< s = -zeta omega + i omega sqrt(1 - zeta^2) (GeradinRixen)
   double omega = 0.0;                ///< |s| (rad/s): the undamped natural frequency for light damping
   double frequencyHz = 0.0;          ///< omega / (2 pi)
   double dampingRatio = 0.0;         ///< -Re(s) / |s| (0 for s = 0; -1 for a real positive s)
@@ -135,7 +135,7 @@ struct ModesOptions {
 std::vector<Mode> computeModes(const ReducedSystem& red, const ModesOptions& options = {});
 
 /// The modal assurance criterion of two mode shapes: |a^H b|^2 / ((a^H a) (b^H b)), 1 for
-/// the same shape, 0 for orthogonal ones (Allemang & Brown 1982).
+/// the same shape, 0 for orthogonal ones (AllemangBrown1982).
 double modalAssurance(const Eigen::VectorXcd& a, const Eigen::VectorXcd& b);
 
 /// Two modes are taken for the same branch when their modal assurance is at least this

@@ -21,7 +21,7 @@ void ModalParticipation::add(const VecX& q, const VecX& v) {
   for (size_t b = 0; b < modes_.size(); ++b) {
     const BodyModes& m = modes_[b];
     const int nf = m.size();
-    eta_.head(nf).noalias() = m.projector * q.segment(m.coordinateOffset, nf);  // eta = Phi^T M q_f
+    eta_.head(nf).noalias() = m.projector * q.segment(m.coordinateOffset, nf);  // eta = Phi^T M q_f (GeradinRixen)
     etaDot_.head(nf).noalias() = m.projector * v.segment(m.velocityOffset, nf);
     for (int k = 0; k < nf; ++k) {
       maxEta_[b][k] = std::max(maxEta_[b][k], std::abs(eta_[k]));

@@ -1,5 +1,5 @@
 /// @file
-/// Static equilibrium of a constrained system: Q(t, q, 0) = G^T lambda, g(q, t) = 0.
+/// Static equilibrium of a constrained system: Q(t, q, 0) = G^T lambda, g(q, t) = 0 (Haug1989).
 #pragma once
 
 #include <vector>
@@ -29,7 +29,7 @@ struct StaticEquilibrium {
   double constraintResidual = 0.0;  ///< max |g|
 };
 
-/// Newton iterations on r = [ -Q(t, q, 0) + G^T lambda ; g(q, t) ] = 0 (nv + m equations,
+/// Newton iterations on r = [ -Q(t, q, 0) + G^T lambda ; g(q, t) ] = 0 (Haug1989; nv + m equations,
 /// Q and G in velocity space) from q0 and lambda = 0 (or, where the tangent is singular at
 /// lambda = 0, as for a pendulum held only by its joint, the least-squares multipliers
 /// G^T lambda ~ Q of the starting load). The unknowns are velocity-space

@@ -1,5 +1,5 @@
 /// @file
-/// The kinematic equation q' = T(q) v of a spatial body whose coordinates start with a
+/// The kinematic equation q' = T(q) v (Nikravesh1988, eq. 6.41) of a spatial body whose coordinates start with a
 /// frame (R, p): origin R (world) and Euler parameters p, with velocities (R' world,
 /// w body axes), followed by `extra` coordinates that are their own velocities' integrals
 /// (elastic coordinates). Shared by RigidBody3d (extra = 0) and FfrBody3d (extra = nf).
@@ -11,14 +11,14 @@
 namespace flexmbd {
 
 /// T+ of the rotation block: 2 L(p) / |p|^2 (3 x 4), the body-axes rotation of an
-/// increment dp (Nikravesh 1988, eq. 6.41, with the gauge |p| divided out).
+/// increment dp (Nikravesh1988, eq. 6.41, with the gauge |p| divided out).
 inline Mat34 eulerRateInverse(const ConstVecRef& q) {
   const Vec4 p = q.segment<4>(3);
   return (2.0 / p.squaredNorm()) * quaternionL(p);
 }
 
 /// T = diag(I3, 1/2 L(p)^T, I_extra) ((7 + extra) x (6 + extra)), its 15 + extra
-/// structural non-zeros (p' = 1/2 L^T w, Nikravesh 1988, eq. 6.41).
+/// structural non-zeros (p' = 1/2 L^T w, Nikravesh1988, eq. 6.41).
 inline void addEulerFrameRateMatrix(const ConstVecRef& q, int extra, const MatrixSink& T) {
   for (int k = 0; k < 3; ++k) T.add(k, k, 1.0);
   T.addBlock(3, 3, 0.5 * quaternionL(q.segment<4>(3)).transpose());

@@ -1,5 +1,5 @@
-// Derivation (docs/fe-import.md; definitions of document 003 / Shabana, Dynamics of
-// Multibody Systems, ch. 5, as in docs/spatial-flexible.md). A solid element mesh moves
+// Derivation (docs/fe-import.md; definitions of Doc003 / Shabana2005, ch. 5, as in
+// docs/spatial-flexible.md). A solid element mesh moves
 // its material points by u(P) = sum_a n_a(P) (X_a + q_a): the same shape functions
 // carry the geometry X_a and the nodal displacements q_a (isoparametric elements; a
 // lumped mass is the case of point masses at the nodes). Its mass matrix is then
@@ -13,7 +13,7 @@
 //   m_ff = S_xx + S_yy + S_zz = M,  K_ff = K (scaled).
 // A point mass m_p at node a is a lumped m_aa += m_p (M gains it in the node's three
 // diagonal entries), so every invariant above includes it; modal damping
-// D_ff = diag(2 zeta omega_i) with the mass-normalised modes (Geradin & Rixen, 2.3).
+// D_ff = diag(2 zeta omega_i) with the mass-normalised modes (GeradinRixen, 2.3).
 // The cross terms (k != l) are not blocks of M (which is zero there): they need m_ab,
 // so the mass must have the solid element structure, checked below. Solid nodes carry
 // no rotation: rotation shapes zero, rKL and hI absent.
@@ -307,11 +307,12 @@ FfrInvariants3d structuralInvariants(const FeBodyData& d, const SpMat& mass, con
   const MatX MR = mass * R;
   const Eigen::Matrix<double, 6, 6> A = R.transpose() * MR;  // the rigid body's mass matrix about the origin
   FfrInvariants3d v;
-  // m = r_k^T M r_k; t_k^T M rho_l = (e_l x first)_k; rho_k^T M rho_l = I_kl (Shabana 5.2)
+  // m = r_k^T M r_k; t_k^T M rho_l = (e_l x first)_k; rho_k^T M rho_l = I_kl (Shabana2005, 5.2)
   v.mass = A.topLeftCorner<3, 3>().trace() / 3.0;
   v.firstMoment = 0.5 * Vec3(A(1, 5) - A(2, 4), A(2, 3) - A(0, 5), A(0, 4) - A(1, 3));
   const Mat3 I = 0.5 * (A.bottomRightCorner<3, 3>() + A.bottomRightCorner<3, 3>().transpose());
-  v.secondMoment = 0.5 * I.trace() * Mat3::Identity() - I;  // int rho u0 u0^T = tr(I)/2 1 - I
+  // int rho u0 u0^T = tr(I)/2 1 - I (inverting I = tr(J) 1 - J, Shabana2005, eq. 5.110)
+  v.secondMoment = 0.5 * I.trace() * Mat3::Identity() - I;
   v.sBar = MR.leftCols<3>().transpose();                     // row k = r_k^T M
   // positionShape[k] row l = g_kl^T M, g_kl the nodal interpolant of the field u0_k e_l:
   // translations X_ak e_l, rotations its curl / 2 = (e_k x e_l) / 2 (exact for rigid rotations)
@@ -489,7 +490,7 @@ void FeBodyModel::addInertiaModes(const FeBodyOptions& options, const MatX& R) {
     basis_ = withStaticResponses(K, nodal_.mff, basis_, freeStaticResponses(K, nodal_.mff, R, F, owner_));
     return;
   }
-  // Craig-Bampton: K y = F on the DOF other than the reference interface's (held: y = 0)
+  // Craig-Bampton (CraigBampton1968): K y = F on the DOF other than the reference interface's (held: y = 0)
   const int n = static_cast<int>(K.rows());
   std::vector<int> free(n, 0);
   for (int i : held_) free[i] = -1;
@@ -518,7 +519,7 @@ void FeBodyModel::addInertiaModes(const FeBodyOptions& options, const MatX& R) {
 
 void FeBodyModel::addModalDamping(double zeta) {
   // D_ff = diag(2 zeta omega) on the (free-free or fixed-interface) normal modes; none on
-  // constraint or inertia modes (Geradin & Rixen, 2.3)
+  // constraint or inertia modes (GeradinRixen, 2.3)
   const int nm = static_cast<int>(omega_.size());
   std::vector<Eigen::Triplet<double>> t;
   for (int i = 0; i < nm; ++i) t.emplace_back(firstNormal_ + i, firstNormal_ + i, 2.0 * zeta * omega_[i]);
@@ -549,7 +550,8 @@ void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
   std::vector<int> fixed = held;
   fixed.insert(fixed.end(), boundary.begin(), boundary.end());
   const MatX Phi = clampedModes(nodal_.kff, nodal_.mff, fixed, o.modes, owner_, &omega_);
-  // constraint modes: psi_b = e_b at the boundary, 0 at the reference, -K_ii^-1 K_ib inside
+  // constraint modes (CraigBampton1968): psi_b = e_b at the boundary, 0 at the reference,
+  // -K_ii^-1 K_ib inside
   std::vector<int> inner(n, 0);  // position among the inner DOF, or -1
   for (int i : fixed) inner[i] = -1;
   int ni = 0;
@@ -573,7 +575,7 @@ void FeBodyModel::reduceCraigBampton(const FeBodyOptions& o) {
     throw InputError(owner_ + ": the stiffness with the rigid interfaces held is singular (a part of the body moves "
                      "freely: is every part connected to an interface?)");
   }
-  const MatX inside = -(ldlt.solve(MatX(Kib)));  // -K_ii^-1 K_ib (Craig & Bampton 1968)
+  const MatX inside = -(ldlt.solve(MatX(Kib)));  // -K_ii^-1 K_ib (CraigBampton1968)
   MatX Psi = MatX::Zero(n, static_cast<int>(boundary.size()));
   for (std::size_t j = 0; j < boundary.size(); ++j) Psi(boundary[j], static_cast<int>(j)) = 1.0;
   for (int i = 0; i < n; ++i) {

@@ -45,7 +45,7 @@ struct FeInterface {
 
 /// How the nodal model is reduced.
 ///  - FreeFree: `modes` free-free normal modes on mean axes (Tisserand frame).
-///  - CraigBampton (Craig & Bampton 1968): the frame follows the rigid interface named
+///  - CraigBampton (CraigBampton1968): the frame follows the rigid interface named
 ///    `reference` (its 6 DOF held: the reference conditions); the coordinates are the 6
 ///    constraint modes of every other rigid interface (static shapes, psi = -K_ii^-1 K_ib,
 ///    exact for static loads there) and `modes` fixed-interface modes (every rigid
@@ -69,7 +69,7 @@ struct FeSpinStiffening {
 struct FeBodyOptions {
   int modes = 8;                ///< free-free elastic modes kept (the six rigid ones dropped)
   double stiffnessScale = 1.0;  ///< K multiplied by it (EXUDYN's ScaleStiffnessMatrix; > 0)
-  double dampingRatio = 0.0;    ///< modal damping: D_ff = diag(2 zeta omega_i), in [0, 1]
+  double dampingRatio = 0.0;    ///< modal damping: D_ff = diag(2 zeta omega_i), in [0, 1] (GeradinRixen, 2.3)
   std::vector<FePointMass> pointMasses;
   std::vector<FeInterface> interfaces;  ///< their points follow the nodes' in the invariants
   FeReduction reduction = FeReduction::FreeFree;
@@ -101,7 +101,7 @@ class FeBodyModel {
   const SpMat& nodalMap() const { return map_; }
   /// The index of interface `k` among the invariants' points (numNodes + k).
   int interfacePoint(int k) const { return firstInterface_ + k; }
-  /// The invariants in the free-free modal coordinates (m_ff = I, K_ff = diag(omega^2)).
+  /// The invariants in the free-free modal coordinates (m_ff = I, K_ff = diag(omega^2); GeradinRixen).
   const FfrInvariants3d& invariants() const { return reduced_; }
   /// The modes (nodal DOF x modes, columns M-normalised, M-orthogonal to the rigid motions).
   const MatX& basis() const { return basis_; }
@@ -128,7 +128,7 @@ class FeBodyModel {
   /// basis_ extended by the inertia modes (FeBodyOptions::inertiaModes); `R` the rigid
   /// motions of the nodal DOF (free-free).
   void addInertiaModes(const FeBodyOptions& options, const MatX& R);
-  /// D_ff = diag(2 zeta omega) on the normal modes (firstNormal_ ...), none elsewhere.
+  /// D_ff = diag(2 zeta omega) on the normal modes (firstNormal_ ...), none elsewhere (GeradinRixen, 2.3).
   void addModalDamping(double zeta);
 
   std::string owner_;

@@ -129,9 +129,10 @@ MatX FfrBeamModelT<Traits>::referenceConditions(const Invariants& nodal, const s
       break;
     }
     case Type::FreeFree: {
+      // mean-axis conditions (Shabana2005, ch. 5):
       C.topRows(Traits::kDim) = nodal.sBar;  // int rho u_f dV = S-bar q_n = 0
       for (int k = 0; k < Traits::kDim; ++k) rowNames.push_back(std::string("mean-axis ") + "xyz"[k]);
-      Traits::meanAxisRotationRows(nodal, C, rowNames);  // int rho u0 x u_f dV = 0
+      Traits::meanAxisRotationRows(nodal, C, rowNames);  // int rho u0 x u_f dV = 0 (Shabana2005, ch. 5)
       break;
     }
   }

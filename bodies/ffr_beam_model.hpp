@@ -51,7 +51,7 @@ class FfrBeamModelT {
   const SpMatRow& basis() const { return basis_; }
   int numElastic() const { return static_cast<int>(basis_.cols()); }
   /// Natural frequencies (rad/s) of the body with its frame held fixed, ascending:
-  /// K_ff phi = omega^2 m_ff phi (dense: for tests and small models).
+  /// K_ff phi = omega^2 m_ff phi (GeradinRixen; dense: for tests and small models).
   VecX naturalFrequencies() const;
   /// Craig-Bampton: the nodal coordinate (kNodeDofs node + k) of each constraint mode,
   /// i.e. of the first elastic coordinates q_1..q_nc (q_k is that nodal displacement);
@@ -100,7 +100,7 @@ class FfrBeamModelT {
   void buildElements(const std::string& owner);
   /// The bytes this model and a run of it take, about (requireMemory before building).
   double memoryEstimate() const;
-  /// Rows C of the reference conditions C q_n = 0 (kNodeDofs x nodal coordinates).
+  /// Rows C of the reference conditions C q_n = 0 (Doc003, B2; kNodeDofs x nodal coordinates).
   MatX referenceConditions(const Invariants& nodal, const std::string& owner) const;
   /// B2 times the modal basis P (normal modes or Craig-Bampton, then inertia modes), or
   /// B2 unchanged without a reduction.

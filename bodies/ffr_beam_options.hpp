@@ -11,7 +11,7 @@
 
 namespace flexmbd {
 
-/// Reference conditions (document 003, B2): what fixes the body frame in the body, as
+/// Reference conditions (Doc003, B2): what fixes the body frame in the body, as
 /// conditions on the nodal coordinates (3 in the plane, 6 in space).
 template <int Dim>
 struct ReferenceConditionsT {
@@ -24,7 +24,7 @@ struct ReferenceConditionsT {
     /// Node A fixed in the frame, its cross-section rotation(s) zero (tangent frame).
     Clamped,
     /// Mean axes (Tisserand / Buckens): int rho u_f dV = 0 and int rho u0 x u_f dV = 0,
-    /// exactly on the nodal coordinates.
+    /// exactly on the nodal coordinates (the mean-axis conditions: Shabana2005, ch. 5).
     FreeFree,
   };
   /// Default: pinned-pinned in the plane, clamped in space.

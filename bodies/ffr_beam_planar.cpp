@@ -34,7 +34,7 @@ void PlanarBeam::InertiaAssembly::add(const Element& el, const ElementRows& idx)
   // (Rayleigh, Timoshenko: el.sectionMoment(); zero for Euler-Bernoulli's centre line)
   nodal_.polarMoment +=
       rhoA * (l * XA.squaredNorm() + l * l * XA.dot(R.col(0)) + l * l * l / 3.0) + el.sectionMoment();
-  const Eigen::Matrix<double, 2, 6> sb = R * el.sBar() * T;  // int rho N dV, N = R S T
+  const Eigen::Matrix<double, 2, 6> sb = R * el.sBar() * T;  // int rho N dV, N = R S T (Doc003)
   // int rho N^T u0 = T^T (S-bar^T R^T X_A + int rho (x S_x + y S_y)^T dV)
   const BeamElement2d::Vec6 i1 =
       T.transpose() * (el.sBar().transpose() * RtX + el.sX().row(0).transpose() + el.sY().row(1).transpose());
@@ -79,7 +79,7 @@ void PlanarBeam::pinnedPinnedRows(int a, int b, const Mesh& mesh, MatX& C, std::
 }
 
 void PlanarBeam::meanAxisRotationRows(const Invariants& nodal, MatX& C, std::vector<std::string>& names) {
-  C.row(2) = nodal.j0.transpose();  // int rho u0 x u_f dV = J0^T q_n
+  C.row(2) = nodal.j0.transpose();  // int rho u0 x u_f dV = J0^T q_n (mean axes, Shabana2005, ch. 5)
   names.push_back("mean-axis rotation");
 }
 

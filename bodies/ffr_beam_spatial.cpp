@@ -24,7 +24,7 @@ SpatialBeam::InertiaAssembly::InertiaAssembly(int numNodalDofs) : nd_(numNodalDo
   for (int k = 0; k < 3; ++k) nodal_.positionShape[k] = Mat3X::Zero(3, nd_);
 }
 
-// Element el: u0 = s + C x0, N = C S T over its 12 nodal coordinates (s = start).
+// Element el: u0 = s + C x0, N = C S T over its 12 nodal coordinates (s = start; Doc003).
 void SpatialBeam::InertiaAssembly::add(const Element& el, const ElementRows& idx) {
   using Mat12 = BeamElement3d::Mat12;
   const auto& T = el.transformation();
@@ -126,8 +126,8 @@ void SpatialBeam::pinnedPinnedRows(int a, int b, const Mesh& mesh, MatX& C, std:
 }
 
 void SpatialBeam::meanAxisRotationRows(const Invariants& nodal, MatX& C, std::vector<std::string>& names) {
-  // int rho u0 x u_f dV = 0, row k of u0 x N: (u0 x N)_x = u0_y N_z - u0_z N_y etc., from
-  // the position-shape integrals
+  // int rho u0 x u_f dV = 0 (mean axes, Shabana2005, ch. 5), row k of u0 x N:
+  // (u0 x N)_x = u0_y N_z - u0_z N_y etc., from the position-shape integrals
   for (int k = 0; k < 3; ++k) {
     const int i = (k + 1) % 3, j = (k + 2) % 3;
     C.row(3 + k) = nodal.positionShape[i].row(j) - nodal.positionShape[j].row(i);

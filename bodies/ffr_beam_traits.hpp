@@ -75,10 +75,12 @@ struct PlanarBeam : BeamDimension<2> {
     Triplets tR_;  // R (Rayleigh and Timoshenko elements only)
   };
 
-  /// Conditions C q_n = 0 of the chord frame: node a fixed, node b on the chord a-b.
+  /// Conditions C q_n = 0 of the chord frame: node a fixed, node b on the chord a-b (Doc003's
+  /// pinned-pinned reference conditions).
   static void pinnedPinnedRows(int a, int b, const Mesh& mesh, MatX& C, std::vector<std::string>& names,
                                const std::string& owner);
-  /// The mean-axis rotation condition int rho u0 x u_f dV = J0^T q_n = 0: row 2 of C.
+  /// The mean-axis rotation condition int rho u0 x u_f dV = J0^T q_n = 0 (Shabana2005, ch. 5):
+  /// row 2 of C.
   static void meanAxisRotationRows(const Invariants& nodal, MatX& C, std::vector<std::string>& names);
   /// Inertia loads of the frame's rigid motion on q_f at q_f = 0 (Q_v, Q_g in
   /// docs/flexible-bodies.md): translation S-bar^T, centrifugal I1, angular J0.
@@ -128,7 +130,8 @@ struct SpatialBeam : BeamDimension<3> {
   /// translations and the twist at a zero (node b on the body x axis through a).
   static void pinnedPinnedRows(int a, int b, const Mesh& mesh, MatX& C, std::vector<std::string>& names,
                                const std::string& owner);
-  /// The mean-axis rotation conditions int rho u0 x u_f dV = 0: rows 3..5 of C.
+  /// The mean-axis rotation conditions int rho u0 x u_f dV = 0 (Shabana2005, ch. 5): rows 3..5
+  /// of C.
   static void meanAxisRotationRows(const Invariants& nodal, MatX& C, std::vector<std::string>& names);
   /// Inertia loads of the frame's rigid motion on q_f at q_f = 0: translation S-bar^T,
   /// and int rho N^T (W u0) dV for every 3 x 3 W (alpha~ + omega~ omega~ spans them).

@@ -97,7 +97,7 @@ namespace {
 /// `polar`: m_ff + R, the quadratic part of int rho |u0 + u|^2 dV.
 template <class Qf>
 Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const SpMat& polar, const Mat2& A, const Qf& qf) {
-  // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T (m_ff + R) qf
+  // m_RR = m I, m_R theta = S A s, m_theta theta = I0 + 2 I1.qf + qf^T (m_ff + R) qf (Shabana2005, ch. 5)
   const Vec2 sas = perp(A * (inv.firstMoment + inv.sBar * qf));
   Eigen::Matrix3d M;
   M << inv.mass, 0.0, sas.x(),  //
@@ -109,7 +109,7 @@ Eigen::Matrix3d frameMassAt(const FfrInvariants& inv, const SpMat& polar, const 
 }  // namespace
 
 Eigen::Vector3d FfrBody2d::frameElasticMassColumn(const Mat2& A, const ConstVecRef& qf, int k) const {
-  // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~ (column k)
+  // m_Rf = A S-bar, m_theta f = J0^T + qf^T S~ (column k; Shabana2005, ch. 5)
   Eigen::Vector3d c;
   c.head<2>() = A * inv_.sBar.col(k);
   c[2] = inv_.j0[k] + columnDot(inv_.sTilde, k, qf);
@@ -133,12 +133,12 @@ void FfrBody2d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   const auto qf = q.tail(nf), af = a.tail(nf);
   const Mat2 A = rotation(q[2]);
   const double at = a[2];
-  // frame rows: M_rr a_r + M_rf a_f with M_rf a_f = (A S-bar a_f, J0.a_f + qf^T S~ a_f)
+  // frame rows: M_rr a_r + M_rf a_f with M_rf a_f = (A S-bar a_f, J0.a_f + qf^T S~ a_f) (Shabana2005, ch. 5)
   Eigen::Vector3d mrf;
   mrf.head<2>() = A * (inv_.sBar * af);
   mrf[2] = inv_.j0.dot(af) + bilinear(inv_.sTilde, qf, af);
   out.head<3>() += frameMassAt(inv_, polar_, A, qf) * a.head<3>() + mrf;
-  // elastic rows: M_fr a_r + m_ff a_f = S-bar^T A^T a_R + (J0 + S~^T qf) a_t + m_ff a_f
+  // elastic rows: M_fr a_r + m_ff a_f = S-bar^T A^T a_R + (J0 + S~^T qf) a_t + m_ff a_f (Shabana2005, ch. 5)
   auto of = out.tail(nf);
   of.noalias() += inv_.sBar.transpose() * (A.transpose() * a.head<2>());
   of += at * inv_.j0;
@@ -177,7 +177,8 @@ void FfrBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, Ve
   const Mat2 A = rotation(q[2]);
   const Vec2 As = A * (inv_.firstMoment + inv_.sBar * qf);
   const Vec2 ASbp = A * (inv_.sBar * p);
-  // Quadratic velocity vector Q_v = -int rho (dr/dq)^T (-A u w^2 + 2 S A N p w) dV, with
+  // Quadratic velocity vector Q_v = -int rho (dr/dq)^T (-A u w^2 + 2 S A N p w) dV (Shabana2005,
+  // ch. 5), with
   // iu = I1 + (m_ff + R) qf = int rho N^T u dV (+ R qf: half the gradient of the
   // sections' second-order rotation in the polar moment)
   Q.head<2>() += As * w * w - 2.0 * perp(ASbp) * w;
@@ -213,13 +214,13 @@ void FfrBody2d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
     dQdq.addBlock(0, 3 + k, Vec2(ASb(k) * w * w));
     dQdv.addBlock(0, 3 + k, Vec2(-2.0 * w * perp(ASb(k))));
   }
-  // Q_theta = -2 w iu^T p
+  // Q_theta = -2 w iu^T p (Shabana2005, ch. 5)
   dQdv.add(2, 2, -2.0 * (inv_.i1.dot(p) + bilinear(polar_, p, qf)));
   for (int k = 0; k < nf; ++k) {
     dQdq.add(2, 3 + k, -2.0 * w * columnDot(polar_, k, p));
     dQdv.add(2, 3 + k, -2.0 * w * iu(k));
   }
-  // Q_f = w^2 iu + 2 w S~ p - dU/dqf - D p
+  // Q_f = w^2 iu + 2 w S~ p - dU/dqf - D p (Shabana2005, ch. 5)
   dQdq.addSparse(3, 3, polar_, w * w);
   if (model_ && model_->geometricStiffening()) {
     dQdq.addSparse(3, 3, model_->strainEnergyHessian(qf), -1.0);
@@ -309,7 +310,7 @@ PointKinematics FfrBody2d::pointKinematics(const ConstVecRef& q, const FfrPoint&
 
 void FfrBody2d::kinematicsOn(const ConstVecRef& q, const FfrPoint& pt, const std::vector<int>* cols,
                              bool withHessians, PointKinematics& p) const {
-  // r = R + A u,  u = u0 + N qf;  dr/dtheta = S A u;  dr/dqf = A N;
+  // r = R + A u,  u = u0 + N qf (Shabana2005, ch. 5);  dr/dtheta = S A u;  dr/dqf = A N;
   // d2r/dtheta2 = -A u;  d2r/dtheta dqf = S A N;  phi = theta + Nphi qf.
   const int nf = numElastic(), n = cols ? static_cast<int>(cols->size()) : numCoordinates();
   const Mat2 A = rotation(q[2]);

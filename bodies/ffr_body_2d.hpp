@@ -14,7 +14,7 @@ namespace flexmbd {
 /// Coordinates q = (x, y, theta, q_1..q_nf): frame position, frame angle, elastic
 /// coordinates. A material point is at r = R + A(theta) (u0 + N q_f). The mass matrix,
 /// quadratic velocity vector and gravity force come from the constant invariants and
-/// the current q_f (docs/flexible-bodies.md; document 003; Shabana ch. 5):
+/// the current q_f (docs/flexible-bodies.md; Doc003; Shabana2005, ch. 5):
 ///   M = [ m I    S A s          A S-bar                 ]   s = int rho u dV
 ///       [        I0 + 2 I1.qf + qf^T m_ff qf   J0^T + qf^T S~ ]       = first moment + S-bar qf
 ///       [ sym.                                m_ff        ]
@@ -62,7 +62,7 @@ class FfrBody2d final : public Body {
   double internalPotential(const ConstVecRef& q) const override;
   bool isDissipative() const override { return inv_.dff.nonZeros() > 0 && inv_.dff.coeffs().cwiseAbs().maxCoeff() > 0.0; }
   /// Attachment points are the nodes (points of the invariants): r = R + A (u0 + N q_f),
-  /// phi = theta + Nphi q_f.
+  /// phi = theta + Nphi q_f (Shabana2005, ch. 5).
   ElasticMatrices elasticMatrices() const override { return {&inv_.mff, &inv_.kff, &inv_.dff}; }
   using Body::pointKinematics;
   void pointKinematics(const ConstVecRef& q, const Vec2& point, int pointId, const std::vector<int>* cols,

@@ -289,11 +289,11 @@ Mat3 FfrBody3d::secondMomentDerivative(const ConstVecRef& qf, int c) const {
 
 Mat3 FfrBody3d::inertiaAt(const ConstVecRef& q) const {
   const Mat3 J = secondMomentAt(q.tail(nf_));
-  return J.trace() * Mat3::Identity() - J;  // int rho u~^T u~ dV = tr(J) 1 - J (Shabana eq. 5.110)
+  return J.trace() * Mat3::Identity() - J;  // int rho u~^T u~ dV = tr(J) 1 - J (Shabana2005, eq. 5.110)
 }
 
 Vec3 FfrBody3d::skewShapeColumn(const ConstVecRef& qf, int k) const {
-  // Y = int rho u~ N dV = X0 + int rho (N qf)~ N dV; column k: X0_k + (qf^T W_i e_k)_i
+  // Y = int rho u~ N dV (Shabana2005, ch. 5) = X0 + int rho (N qf)~ N dV; column k: X0_k + (qf^T W_i e_k)_i
   // + (qf^T H_i e_k)_i = (H_i qf)_k, the sections' second-order rotation (H symmetric)
   return x0_.col(k) + Vec3(columnDot(w_[0], k, qf) + columnDot(h_[0], k, qf),
                            columnDot(w_[1], k, qf) + columnDot(h_[1], k, qf),
@@ -304,11 +304,11 @@ void FfrBody3d::addMassMatrix(const ConstVecRef& q, const MatrixSink& M) const {
   const auto qf = q.tail(nf_);
   const Mat3 A = rotationOf(q);
   const Vec3 s = firstMomentAt(q);
-  // Shabana eq. 5.108-5.117: m_RR = m I, m_Rtheta = -A s~, m_thetatheta = I(qf)
+  // Shabana2005, eqs. 5.108-5.117: m_RR = m I, m_Rtheta = -A s~, m_thetatheta = I(qf)
   Eigen::Matrix<double, 6, 6> mrr;
   mrr << inv_.mass * Mat3::Identity(), -A * skew(s), skew(s) * A.transpose(), inertiaAt(q);  // (-A s~)^T = s~ A^T
   M.addBlock(0, 0, mrr);
-  // m_Rf = A S-bar, m_thetaf = Y (columns), and their transposes
+  // m_Rf = A S-bar, m_thetaf = Y (columns), and their transposes (Shabana2005, eqs. 5.108-5.117)
   for (int k = 0; k < nf_; ++k) {
     Vec6 c;
     c << A * inv_.sBar.col(k), skewShapeColumn(qf, k);
@@ -373,7 +373,7 @@ void FfrBody3d::addMassTimes(const ConstVecRef& q, const ConstVecRef& a, Eigen::
   const Mat3 J = secondMomentFrom(qf, quadratic);
   // row R: m aR - A s~ aw + A S-bar af
   out.head<3>() += inv_.mass * aR + A * (aw.cross(s) + inv_.sBar * af);
-  // row theta: s~ A^T aR + I aw + Y af, I = tr(J) 1 - J (Shabana eq. 5.110)
+  // row theta: s~ A^T aR + I aw + Y af, I = tr(J) 1 - J (Shabana2005, eq. 5.110)
   out.segment<3>(3) += s.cross(bR) + (J.trace() * aw - J * aw) + yaf;
   // rows f: S-bar^T A^T aR + Y^T aw + m_ff af
   of.noalias() += inv_.sBar.transpose() * bR + x0_.transpose() * aw;
@@ -390,10 +390,10 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
   const Vec3 aR = a.head<3>(), aw = a.segment<3>(3);
   const Vec3 bR = A.transpose() * aR;
   const Mat3 bRs = skew(bR), awS = skew(aw);
-  // row R = m aR + A (aw~ s + S-bar af)
+  // row R = m aR + A (aw~ s + S-bar af) (Shabana2005, eqs. 5.108-5.117)
   const Vec3 c = aw.cross(s) + inv_.sBar * af;
   K.addBlock(0, 3, Mat34(-A * skew(c) * Rinv));
-  // row theta = s~ A^T aR + I aw + Y af
+  // row theta = s~ A^T aR + I aw + Y af (Shabana2005, eqs. 5.108-5.117)
   K.addBlock(3, 3, Mat34(skew(s) * bRs * Rinv));
   for (int k = 0; k < nf_; ++k) {
     const Vec3 sk = inv_.sBar.col(k);
@@ -406,7 +406,7 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
     col << A * (awS * sk), -bRs * sk + Dk.trace() * aw - Dk * aw + dY;
     K.addBlock(0, 7 + k, col);
   }
-  // rows f = S-bar^T A^T aR + Y^T aw + m_ff af
+  // rows f = S-bar^T A^T aR + Y^T aw + m_ff af (Shabana2005, eqs. 5.108-5.117)
   const Mat34 B = bRs * Rinv;  // d(A^T aR)/dp
   for (int j = 0; j < 4; ++j) {
     K.addColumn(6, 3 + j, nf_, [&](int k) { return inv_.sBar.col(k).dot(B.col(j)); });
@@ -422,7 +422,7 @@ void FfrBody3d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRef&
 // ----- forces ------------------------------------------------------------------------
 
 void FfrBody3d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const {
-  // Q_v = -int rho (dr'/dv)^T A (w~ w~ u + 2 w~ N qf') dV (Shabana eq. 5.120-5.127):
+  // Q_v = -int rho (dr'/dv)^T A (w~ w~ u + 2 w~ N qf') dV (Shabana2005, eqs. 5.120-5.127):
   //   Q_R = -A (w~ w~ s + 2 w~ S-bar qf'),
   //   Q_theta = -w~ I w - 2 (tr(G) w - G w),   G = int rho (N qf') u^T dV,
   //   Q_f = -sum_kl (w~ w~)_kl int rho N_k^T u_l dV + 2 sum_i w_i W_i qf'.
@@ -544,13 +544,13 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
     G(t.k, t.l) += g;
     if (t.k != t.l) G(t.l, t.k) += g;
   }
-  // Q_R = -A c, c = w~ w~ s + 2 w~ S-bar qf'
+  // Q_R = -A c, c = w~ w~ s + 2 w~ S-bar qf' (Shabana2005, eqs. 5.120-5.127)
   const Vec3 c = Om * s + 2.0 * ws * sp;
   dQdq.addBlock(0, 3, Mat34(A * skew(c) * Rinv));
   // d(w x (w x s))/dw = w s^T + (w.s) 1 - 2 s w^T;  d(2 w x sp)/dw = -2 sp~
   dQdv.addBlock(0, 3,
                 Mat3(-A * (w * s.transpose() + w.dot(s) * Mat3::Identity() - 2.0 * s * w.transpose() - 2.0 * skew(sp))));
-  // Q_theta = -w~ I w - 2 (tr(G) w - G w)
+  // Q_theta = -w~ I w - 2 (tr(G) w - G w) (Shabana2005, eqs. 5.120-5.127)
   Mat3 dQwdw = -(ws * I - skew(I * w)) - 2.0 * (G.trace() * Mat3::Identity() - G);
   if (hasCoupling_) {
     Vec3 b;  // b_i = qf^T H_i qf': d(-w x b)/dw = b~
@@ -591,6 +591,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
     dQdv.addBlock(0, 6 + k, cv);
   }
   // Q_f = -sum_kl Om_kl (positionShape[l].row(k)^T + S_kl qf) + 2 sum_i w_i W_i qf' - K qf - D qf'
+  // (Shabana2005, eqs. 5.120-5.127)
   for (int k = 0; k < 3; ++k) {
     for (int l = 0; l < 3; ++l) dQdq.addSparse(6, 7, inv_.sKL[k][l], -Om(k, l));
   }
@@ -633,7 +634,7 @@ void FfrBody3d::addInternalForceJacobians(const ConstVecRef& q, const ConstVecRe
 }
 
 void FfrBody3d::addGravityForce(const ConstVecRef& q, const Vec3& g, VecX& Q) const {
-  // V = -g . (m R + A s): Q_R = m g, Q_theta = s x (A^T g), Q_f = S-bar^T A^T g
+  // V = -g . (m R + A s): Q_R = m g, Q_theta = s x (A^T g), Q_f = S-bar^T A^T g (Shabana2005, ch. 5)
   const Mat3 A = rotationOf(q);
   const Vec3 gb = A.transpose() * g;
   Q.head<3>() += inv_.mass * g;
@@ -672,7 +673,7 @@ FfrBody3d::BeamDeflection FfrBody3d::beamDeflection(const ConstVecRef& q, int el
   BeamDeflection d;
   d.displacement = p.shape * qf;
   const Mat3 A = rotationOf(q);
-  d.position = q.head<3>() + A * (p.position + d.displacement);  // r = R + A (u0 + N q_f)
+  d.position = q.head<3>() + A * (p.position + d.displacement);  // r = R + A (u0 + N q_f) (Shabana2005, ch. 5)
   d.worldDisplacement = A * d.displacement;
   d.sectionForces = model_->sectionForces(qf, element, xi);
   return d;
@@ -734,7 +735,7 @@ std::vector<int> FfrBody3d::pointSupport(const Vec3& point, int pointId) const {
 
 void FfrBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int pointId, const std::vector<int>* cols,
                                 const std::vector<int>* qcols, FrameKinematics& out) const {
-  // r = R + A u, u = u0 + N qf;  r' = R' - A u~ w + A N qf';
+  // r = R + A u, u = u0 + N qf;  r' = R' - A u~ w + A N qf' (Shabana2005, ch. 5);
   // A_node = A (I + theta~), theta = Ntheta qf;  omega_node = A (w + Ntheta qf')  (first order)
   const auto qf = q.tail(nf_);
   const NodeMotion m = nodeMotion(point, pointId, qf);

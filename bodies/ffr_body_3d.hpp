@@ -20,11 +20,11 @@ namespace flexmbd {
 ///
 /// Choice: R' in WORLD axes, as RigidBody3d. Then the translational rows of a point's
 /// Jacobian are the identity, gravity is m g, and T = diag(I, 1/2 L(p)^T, I) as for the
-/// rigid body; the price is that the R-w and R-f mass blocks carry A(p) (Shabana ch. 5:
+/// rigid body; the price is that the R-w and R-f mass blocks carry A(p) (Shabana2005, ch. 5:
 /// m_RR = m I, m_Rtheta = -A s~, m_Rf = A S-bar), so the mass matrix depends on p. Body-axis
 /// R' would make M independent of p but put A into every point Jacobian and into gravity.
 ///
-/// Mass matrix (docs/spatial-flexible.md, "Spatial FFR body"; Shabana ch. 5):
+/// Mass matrix (docs/spatial-flexible.md, "Spatial FFR body"; Shabana2005, ch. 5):
 ///   M = [ m I    -A s~        A S-bar  ]   s = int rho u dV = first moment + S-bar q_f
 ///       [        I(q_f)       Y(q_f)   ]   I = int rho u~^T u~ dV = tr(J) 1 - J, J = int rho u u^T dV
 ///       [ sym.                m_ff     ]   Y = int rho u~ N dV
@@ -127,12 +127,12 @@ class FfrBody3d final : public Body {
   static Mat3 rotationOf(const ConstVecRef& q) { return quaternionRotation(q.segment<4>(3)); }
   /// int rho u dV (body axes).
   Vec3 firstMomentAt(const ConstVecRef& q) const;
-  /// I(q_f) = int rho u~^T u~ dV about the frame origin, body axes.
+  /// I(q_f) = int rho u~^T u~ dV about the frame origin, body axes (Shabana2005, eq. 5.110).
   Mat3 inertiaAt(const ConstVecRef& q) const;
 
  private:
   int nodeIndex(const Vec3& point, int pointId) const;
-  /// A node and its motion at q_f: u = u0 + N q_f, theta = Ntheta q_f.
+  /// A node and its motion at q_f: u = u0 + N q_f, theta = Ntheta q_f (Shabana2005, ch. 5).
   struct NodeMotion {
     const FfrPoint3d& point;
     Vec3 u, theta;
@@ -146,7 +146,7 @@ class FfrBody3d final : public Body {
   Mat3 secondMomentFrom(const ConstVecRef& qf, const Mat3& quadratic) const;
   /// dJ/dq_f,k.
   Mat3 secondMomentDerivative(const ConstVecRef& qf, int k) const;
-  /// Column k of Y(q_f) = int rho u~ N dV.
+  /// Column k of Y(q_f) = int rho u~ N dV (Shabana2005, ch. 5).
   Vec3 skewShapeColumn(const ConstVecRef& qf, int k) const;
 
   /// The checks of the invariants and the initial state, and the constants derived from

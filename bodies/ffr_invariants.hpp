@@ -16,7 +16,7 @@ namespace flexmbd {
 using FfrPoint = FfrPointT<2>;
 
 /// With u(x) = u0(x) + N(x) q_f the body-frame position of a material point
-/// (document 003; Shabana ch. 5), all integrals over the undeformed body; besides the
+/// (Doc003; Shabana2005, ch. 5), all integrals over the undeformed body; besides the
 /// shared mass, first moment, S-bar, m_ff = S_xx + S_yy, K_ff, D_ff and points:
 struct FfrInvariants : FfrInvariantsBase<2> {
   double polarMoment = 0.0;             ///< I0 = int rho u0.u0 dV (about the frame origin)

@@ -1,8 +1,8 @@
 /// @file
 /// The inertia and stiffness invariants of a spatial floating-frame-of-reference body:
 /// everything its equations of motion need at run time, besides the current q_f.
-/// Definitions: docs/spatial-flexible.md (document 003; Shabana, Dynamics of Multibody
-/// Systems, ch. 5, eq. 5.96-5.140 for the spatial mass matrix blocks).
+/// Definitions: docs/spatial-flexible.md (Doc003; Shabana2005, ch. 5, eqs. 5.96-5.140 for the
+/// spatial mass matrix blocks).
 #pragma once
 
 #include <array>
@@ -17,17 +17,17 @@ namespace flexmbd {
 /// (3 x nf, body axes).
 using FfrPoint3d = FfrPointT<3>;
 
-/// With u(P) = u0(P) + N(P) q_f the body-frame position of a material point P, all
-/// integrals over the undeformed body (dV, density rho); besides the shared mass, first
+/// With u(P) = u0(P) + N(P) q_f the body-frame position of a material point P (Doc003;
+/// Shabana2005, ch. 5), all integrals over the undeformed body (dV, density rho); besides the shared mass, first
 /// moment, S-bar, m_ff = S_xx + S_yy + S_zz, K_ff, D_ff and points
 /// (bodies/ffr_invariants_base.hpp):
 struct FfrInvariants3d : FfrInvariantsBase<3> {
   Mat3 secondMoment = Mat3::Zero();         ///< int rho u0 u0^T dV (the inertia tensor about
-                                            ///< the frame origin is tr(.) I - (.))
+                                            ///< the frame origin is tr(.) I - (.): Shabana2005, eq. 5.110)
   /// positionShape[k] (3 x nf): row l = int rho u0_k N_l dV (N_l row l of N), k, l in
   /// {x, y, z}: the coupling of the undeformed geometry with the deformation.
   std::array<Mat3X, 3> positionShape;
-  /// sKL[k][l] = S_kl = int rho N_k^T N_l dV (nf x nf), S_lk = S_kl^T (document 003's
+  /// sKL[k][l] = S_kl = int rho N_k^T N_l dV (nf x nf), S_lk = S_kl^T (Doc003's
   /// nine inertia shape integrals, six independent). Sparse: banded for nodal meshes,
   /// full for modal models.
   std::array<std::array<SpMat, 3>, 3> sKL;

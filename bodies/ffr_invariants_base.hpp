@@ -13,7 +13,7 @@
 namespace flexmbd {
 
 /// A material point of the body where joints and forces attach (a node): undeformed
-/// position u0 (body frame), u = u0 + N q_f, and the small rotation of its cross-section
+/// position u0 (body frame), u = u0 + N q_f (Doc003), and the small rotation of its cross-section
 /// Ntheta q_f: one angle psi in the plane (Dim 2), three body-axis components in space
 /// (Dim 3; the section's axes are (I + skew(theta)) to first order in q_f).
 template <int Dim>
@@ -25,16 +25,16 @@ struct FfrPointT {
 };
 
 /// With u(P) = u0(P) + N(P) q_f the body-frame position of a material point P, the
-/// integrals over the undeformed body that every FFR body has (document 003):
+/// integrals over the undeformed body that every FFR body has (Doc003):
 template <int Dim>
 struct FfrInvariantsBase {
   using Point = FfrPointT<Dim>;
   double mass = 0.0;                                               ///< m = int rho dV
   Eigen::Matrix<double, Dim, 1> firstMoment = Eigen::Matrix<double, Dim, 1>::Zero();  ///< int rho u0 dV
-  Eigen::Matrix<double, Dim, Eigen::Dynamic> sBar;                 ///< S-bar = int rho N dV (Dim x nf)
+  Eigen::Matrix<double, Dim, Eigen::Dynamic> sBar;                 ///< S-bar = int rho N dV (Dim x nf; Doc003)
   // Sparse: banded for nodal beam meshes (the body's cost stays linear in its size),
   // full for modal models.
-  SpMat mff;                                                       ///< m_ff = int rho N^T N dV
+  SpMat mff;                                                       ///< m_ff = int rho N^T N dV (Doc003)
   SpMat kff;                                                       ///< stiffness under the reference conditions
   SpMat dff;                                                       ///< damping
   std::vector<Point> points;                                       ///< attachment points (nodes)

@@ -257,7 +257,7 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
   MatX Gi(nc, n);
   for (int k = 0; k < nc; ++k) Gi.row(k) = G.row(cb.interfaceRows[k]);
 
-  // constraint modes (Craig & Bampton 1968): K Psi = Gi^T Lambda, Gi Psi = I, so
+  // constraint modes (CraigBampton1968): K Psi = Gi^T Lambda, Gi Psi = I, so
   // Psi = K^-1 Gi^T (Gi K^-1 Gi^T)^-1 (static condensation on the interface)
   MatX Psi(n, nc);
   if (nc > 0) {
@@ -268,7 +268,7 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
     Psi = Y * S.llt().solve(MatX::Identity(nc, nc));
   }
 
-  // fixed-interface normal modes (Craig & Bampton 1968): K, M restricted to null(Gi)
+  // fixed-interface normal modes (CraigBampton1968): K, M restricted to null(Gi)
   const MatX Z = nc > 0 ? nullSpaceBasis(Gi) : MatX(MatX::Identity(n, n));
   const MatX KZ = K * Z, MZ = M * Z;
   const MatX Kz = Z.transpose() * KZ, Mz = Z.transpose() * MZ;

@@ -2,8 +2,8 @@
 /// Reduction bases shared by the planar and spatial beam models (FfrBeamModel,
 /// FfrBeamModel3d), both given the body's stiffness K and mass M in its elastic
 /// coordinates after the reference conditions (q_n = B2 x):
-///  - normal modes of K phi = omega^2 M phi;
-///  - Craig-Bampton: static constraint modes (unit displacement of each interface
+///  - normal modes of K phi = omega^2 M phi (GeradinRixen);
+///  - Craig-Bampton (CraigBampton1968): static constraint modes (unit displacement of each interface
 ///    coordinate, the rest statically condensed) and fixed-interface normal modes (the
 ///    interface held). docs/flexible-bodies.md, "Craig-Bampton reduction";
 ///  - static modes appended to either basis (the inertia modes: static responses to the
@@ -41,7 +41,7 @@ std::vector<int> chosenModes(int count, const std::vector<int>& set, const std::
 /// (design sensitivities, docs/sensitivities.md), gives modal coordinates of the same shapes.
 void fixModeSigns(MatX& phi);
 
-/// The mass-normalised eigenvectors (columns, phi^T M phi = I) of K phi = omega^2 M phi
+/// The mass-normalised eigenvectors (columns, phi^T M phi = I) of K phi = omega^2 M phi (GeradinRixen)
 /// numbered `keep` (1-based, ascending frequency); `omega` (if given) receives their
 /// natural frequencies (rad/s). K symmetric, M symmetric positive definite (dense).
 /// @throws InputError naming `owner` if a chosen mode does not exist (`what`: "mode" or
@@ -87,7 +87,7 @@ MatX clampedModes(const SpMat& K, const SpMat& M, const std::vector<int>& held, 
 MatX interfaceConditions(const SpMat& B2, int nodeDofs, const std::vector<int>& nodes, const std::string& owner,
                          std::vector<int>& dofs);
 
-/// A Craig-Bampton basis x = [Psi Phi] (eta_c, eta_m) in the coordinates x of K and M.
+/// A Craig-Bampton basis x = [Psi Phi] (eta_c, eta_m) in the coordinates x of K and M (CraigBampton1968).
 struct CraigBamptonBasis {
   /// n x (nc + nm): the nc constraint modes, then the nm fixed-interface modes.
   MatX basis;
@@ -99,8 +99,8 @@ struct CraigBamptonBasis {
   VecX fixedInterfaceFrequencies;
 };
 
-/// Craig-Bampton reduction (Craig & Bampton 1968, AIAA J. 6(7); Geradin & Rixen,
-/// Mechanical Vibrations, the chapter on substructuring / component mode synthesis)
+/// Craig-Bampton reduction (CraigBampton1968; GeradinRixen, the chapter on substructuring /
+/// component mode synthesis)
 /// of the structure with
 /// stiffness K (symmetric positive definite: the reference conditions hold the body)
 /// and mass M, interface coordinates G x (G r x n):
@@ -115,8 +115,8 @@ CraigBamptonBasis craigBamptonBasis(const SpMat& K, const SpMat& M, const MatX& 
                                     const std::string& owner);
 
 /// The basis (columns) extended by the static responses K^-1 F to the load vectors F
-/// (columns), less what it already holds: modal truncation augmentation (Dickens,
-/// Nakagawa & Wittbrodt, Comput. Struct. 62(6), 1997). Y = K^-1 F is made K-orthogonal
+/// (columns), less what it already holds: modal truncation augmentation
+/// (DickensNakagawaWittbrodt1997). Y = K^-1 F is made K-orthogonal
 /// to the basis, then K-orthogonalised within itself (eigenvectors of Y^T K Y); parts
 /// with a strain energy below 1e-12 of the largest static response's are dropped
 /// (already held, or a zero load); the new columns are mass-normalised.
@@ -130,8 +130,8 @@ MatX withStaticResponses(const SpMat& K, const SpMat& M, const MatX& basis, MatX
 /// loads F with inertia relief: the part of F that accelerates the body rigidly removed,
 /// F' = F - M R (R^T M R)^-1 R^T F, and K y = F' solved with R^T M y = 0 (mean axes) as the
 /// saddle-point system [K  M R; R^T M  0] (y, lambda) = (F', 0) (sparse LU; lambda = 0
-/// since R^T F' = 0). Geradin & Rixen, Mechanical Vibrations, the section on inertia relief
-/// and the pseudo-inverse of a floating structure.
+/// since R^T F' = 0). GeradinRixen, the section on inertia relief and the pseudo-inverse of
+/// a floating structure.
 /// @throws InputError naming `owner` if the system is singular (a mechanism besides the
 /// six rigid motions).
 MatX freeStaticResponses(const SpMat& K, const SpMat& M, const MatX& R, const MatX& F, const std::string& owner);

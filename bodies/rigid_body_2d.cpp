@@ -59,7 +59,7 @@ void RigidBody2d::addMassMatrixDerivative(const ConstVecRef& q, const ConstVecRe
 
 void RigidBody2d::addInternalForces(const ConstVecRef& q, const ConstVecRef& v, VecX& Q) const {
   // Quadratic velocity vector: Q_R = m A c thetadot^2, Q_theta = 0 (Lagrange's equations
-  // of T = 1/2 m |Rdot + S A c thetadot|^2 + 1/2 J thetadot^2).
+  // of T = 1/2 m |Rdot + S A c thetadot|^2 + 1/2 J thetadot^2; Shabana2005, ch. 5).
   const Vec2 ac = rotation(q[2]) * props_.com;
   Q.head<2>() += props_.mass * ac * v[2] * v[2];
 }
@@ -91,7 +91,7 @@ double RigidBody2d::gravityPotential(const ConstVecRef& q, const Vec3& g3) const
 
 void RigidBody2d::pointKinematics(const ConstVecRef& q, const Vec2& point, int, const std::vector<int>* cols,
                                   bool withHessians, PointKinematics& p) const {
-  // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta.
+  // r = R + A u;  dr/dtheta = S A u;  d2r/dtheta2 = -A u;  phi = theta (Nikravesh1988).
   const Vec2 au = rotation(q[2]) * point;
   const int n = cols ? static_cast<int>(cols->size()) : 3;
   p.r = q.head<2>() + au;

@@ -23,7 +23,7 @@ struct FrameState2d {
 
 /// Coordinates q = (x, y, theta) of the body frame; a point u (body frame) is at
 /// r = R + A(theta) u. With the centre of mass c off the frame origin the mass matrix
-/// couples translation and rotation (Shabana, Dynamics of Multibody Systems, ch. 5):
+/// couples translation and rotation (Shabana2005, ch. 5):
 ///   M = [ m I        m S A c        ]
 ///       [ sym.   J + m c^T c        ]
 class RigidBody2d final : public Body {

@@ -85,7 +85,8 @@ void RigidBody3d::addCoordinateRateInverse(const ConstVecRef& q, const MatrixSin
 
 void RigidBody3d::addCoordinateRate(const ConstVecRef& q, const ConstVecRef& w, Eigen::Ref<VecX> out) const {
   out.head<3>() += w.head<3>();
-  out.segment<4>(3) += 0.5 * quaternionL(q.segment<4>(3)).transpose() * w.tail<3>();  // p' = 1/2 L^T w
+  // p' = 1/2 L^T w (Nikravesh1988, eq. 6.41)
+  out.segment<4>(3) += 0.5 * quaternionL(q.segment<4>(3)).transpose() * w.tail<3>();
 }
 
 void RigidBody3d::addCoordinateRateJacobian(const ConstVecRef&, const ConstVecRef& w, const MatrixSink& K) const {
@@ -129,7 +130,7 @@ void RigidBody3d::addMassTimes(const ConstVecRef&, const ConstVecRef& a, Eigen::
 
 void RigidBody3d::addInternalForces(const ConstVecRef&, const ConstVecRef& v, VecX& Q) const {
   const Vec3 w = v.tail<3>();
-  Q.tail<3>() -= w.cross(props_.inertia * w);  // Euler's equations: J w' + w x J w = torque
+  Q.tail<3>() -= w.cross(props_.inertia * w);  // Euler's equations: J w' + w x J w = torque (Nikravesh1988)
 }
 
 void RigidBody3d::addInternalForceJacobians(const ConstVecRef&, const ConstVecRef& v, const MatrixSink&,
@@ -154,7 +155,7 @@ void RigidBody3d::pointKinematics(const ConstVecRef&, const Vec2&, int, const st
 
 void RigidBody3d::frameKinematics(const ConstVecRef& q, const Vec3& point, int, const std::vector<int>* cols,
                                   const std::vector<int>* qcols, FrameKinematics& out) const {
-  // r = R + A u;  r' = R' - A u~ w;  omega = A w  (w in body axes)
+  // r = R + A u;  r' = R' - A u~ w;  omega = A w  (w in body axes; Nikravesh1988)
   const Mat3 A = rotationOf(q);
   out.A = A;
   out.r = q.head<3>() + A * point;

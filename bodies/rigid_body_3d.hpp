@@ -26,8 +26,8 @@ struct FrameState3d {
 
 /// q = (x, y, z, e0, e1, e2, e3): centre of mass and Euler parameters p; v = (x', y', z',
 /// wx, wy, wz), angular velocity w in body axes. A point u (body axes) is at r = R + A(p) u.
-/// Kinematics q' = T(q) v with T = diag(I, 1/2 L(p)^T) (Nikravesh 1988, eq. 6.41); mass
-/// matrix diag(m I, J) and gyroscopic force -w x J w (Euler's equations). The length of p
+/// Kinematics q' = T(q) v with T = diag(I, 1/2 L(p)^T) (Nikravesh1988, eq. 6.41); mass
+/// matrix diag(m I, J) and gyroscopic force -w x J w (Euler's equations; Nikravesh1988). The length of p
 /// is a gauge (A uses p / |p|, T is tangent to the sphere |p| = const): it changes only by
 /// integration error and does not enter any result; increments renormalise it.
 class RigidBody3d final : public Body {

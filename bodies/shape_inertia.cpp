@@ -59,20 +59,21 @@ Mat3 shapeInertia(const SolidShape& s, double m) {
   switch (s.type) {
     case SolidShape::Type::Box: {
       const Vec3 e2 = s.size.cwiseAbs2();
-      // solid cuboid: Ixx = m (b^2 + c^2) / 12, ... (e.g. Meriam & Kraige, Dynamics, table D/4)
+      // solid cuboid: Ixx = m (b^2 + c^2) / 12, ... (e.g. MeriamKraige, table D/4)
       I << m * (e2[1] + e2[2]) / 12.0, m * (e2[0] + e2[2]) / 12.0, m * (e2[0] + e2[1]) / 12.0;
       break;
     }
     case SolidShape::Type::Cylinder:
     case SolidShape::Type::Tube: {
       // tube (ri = 0: solid cylinder): axial m (ri^2 + ro^2) / 2, transverse m (3 (ri^2 + ro^2) + h^2) / 12
+      // (a solid cylinder less its bore: MeriamKraige, table D/4)
       const double sum2 = r2 + ri2;
       I.setConstant(m * (3.0 * sum2 + h2) / 12.0);
       I[s.axis] = m * sum2 / 2.0;
       break;
     }
     case SolidShape::Type::Sphere:
-      I.setConstant(0.4 * m * r2);  // solid sphere: 2/5 m r^2
+      I.setConstant(0.4 * m * r2);  // solid sphere: 2/5 m r^2 (MeriamKraige, table D/4)
       break;
   }
   return I.asDiagonal();
@@ -117,7 +118,7 @@ CompositeInertia compositeInertia(const std::vector<ShapePart>& parts) {
       const double m = p.mass > 0.0 ? p.mass : p.density * shapeVolume(s);
       const Mat3 Ic = s.orientation * shapeInertia(s, m) * s.orientation.transpose();  // I' = A I A^T
       const Vec3& d = s.offset;
-      // parallel-axis theorem: I_O = I_c + m (|d|^2 E - d d^T) (Meriam & Kraige, Dynamics, eq. 7/10)
+      // parallel-axis theorem: I_O = I_c + m (|d|^2 E - d d^T) (MeriamKraige, eq. 7/10)
       aboutOrigin += Ic + m * (d.squaredNorm() * Mat3::Identity() - d * d.transpose());
       c.mass += m;
       c.centreOfMass += m * d;

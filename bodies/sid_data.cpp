@@ -14,9 +14,9 @@ namespace {
 
 using Mat3Grid = std::array<std::array<MatX, 3>, 3>;
 
-/// The inertia tensor of a second moment: int rho u~^T u~ dV = tr(J) 1 - J.
+/// The inertia tensor of a second moment: int rho u~^T u~ dV = tr(J) 1 - J (Shabana2005, eq. 5.110).
 Mat3 inertiaOf(const Mat3& secondMoment) { return secondMoment.trace() * Mat3::Identity() - secondMoment; }
-/// Its inverse: J = tr(I) / 2 1 - I.
+/// Its inverse: J = tr(I) / 2 1 - I (inverting Shabana2005, eq. 5.110).
 Mat3 secondMomentOf(const Mat3& inertia) { return 0.5 * inertia.trace() * Mat3::Identity() - inertia; }
 
 /// P_j(k, l) = int rho u0_k N_lj dV = positionShape[k](l, j).
@@ -46,7 +46,7 @@ constexpr std::array<std::pair<int, int>, 6> kOeColumn = {{{0, 0}, {1, 1}, {2, 2
 
 /// The row of Oe for a change E = dJ/dq_j of the second moment: the centrifugal force
 /// Q_j = 1/2 w^T (dI/dq_j) w (Lagrange, T = 1/2 w^T I(q) w) with Oe w-bar = -Q_j, w-bar =
-/// (w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z).
+/// (w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z) (the SID's Oe: Wallrapp1994).
 Eigen::Matrix<double, 1, 6> centrifugalRow(const Mat3& E) {
   const double tr = E.trace();
   Eigen::Matrix<double, 1, 6> r;

@@ -1,7 +1,6 @@
 /// @file
-/// The Standard Input Data (SID) of a flexible body (Wallrapp 1994, "Standardization of
-/// flexible body modeling in multibody system codes, Part I", Mech. Struct. Mach. 22(3);
-/// Schwertassek & Wallrapp, Dynamik flexibler Mehrkoerpersysteme, 1999, ch. 6): the reduced
+/// The Standard Input Data (SID) of a flexible body (Wallrapp1994; SchwertassekWallrapp1999,
+/// ch. 6): the reduced
 /// body as Taylor objects in its elastic coordinates q, and its conversion to and from
 /// flexmbd's spatial invariants (FfrInvariants3d). The text file is fe_import/sid_file.hpp; the
 /// blocks, their conventions and what is checked: docs/fe-import.md, "SID".
@@ -15,7 +14,7 @@
 namespace flexmbd {
 
 /// A Taylor object: the matrix function A(q) = M0 + sum_k M1_k q_k (order 1)
-/// + sum_kl M2_kl q_k q_l (order 2) of the nq elastic coordinates.
+/// + sum_kl M2_kl q_k q_l (order 2) of the nq elastic coordinates (Wallrapp1994).
 struct SidTaylor {
   /// How M0 is stored in the file: 0 zero (no entries), 1 diagonal, 2 symmetric (the
   /// lower triangle i >= j), 3 full. M1 and M2 entries are stored as they are.
@@ -44,7 +43,7 @@ struct SidNode {
   SidTaylor ap;        ///< "AP" 3 x 3, order 1: the node frame I + skew(N_theta q)
 };
 
-/// A whole SID (blocks named as in the file).
+/// A whole SID (blocks named as in the file; their definitions: Wallrapp1994).
 struct SidData {
   double mass = 0.0;                   ///< refmod: m
   std::vector<std::string> modeNames;  ///< refmod: ielastq(1..nq)
@@ -54,7 +53,7 @@ struct SidData {
   SidTaylor Ct;      ///< nq x 3: S-bar^T, the coupling with translation
   SidTaylor Cr;      ///< nq x 3: (int rho u~ N dV)^T, the coupling with rotation
   SidTaylor Me;      ///< nq x nq: m_ff
-  SidTaylor Gr;      ///< 3 x 3 nq: block j = -2 int rho u~ N_j~ dV (gyroscopic, rotation rows)
+  SidTaylor Gr;      ///< 3 x 3 nq: block j = -2 int rho u~ N_j~ dV (gyroscopic, rotation rows; Wallrapp1994)
   SidTaylor Ge;      ///< nq x 3 nq: block j = 2 int rho N^T N_j~ dV (gyroscopic, elastic rows)
   SidTaylor Oe;      ///< nq x 6: centrifugal, columns w_x^2, w_y^2, w_z^2, w_x w_y, w_y w_z, w_x w_z;
                      ///< its first-order term holds the spin softening and stiffening

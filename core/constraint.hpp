@@ -100,7 +100,7 @@ struct Attachment {
   Vec3 point = Vec3::Zero();  ///< the point in body axes
 };
 
-/// Constraint equations g(q, t) = h(q) - f(t) = 0 of the constraint's bodies. Their
+/// Constraint equations g(q, t) = h(q) - f(t) = 0 of the constraint's bodies (Haug1989). Their
 /// velocity form is G v_local = f'(t), v_local = [used velocities of body 0; of body 1; ...]
 /// (see BodyState). The caller keeps one per constraint: evaluations into it reuse its memory.
 struct ConstraintEvaluation {
@@ -112,7 +112,7 @@ struct ConstraintEvaluation {
   KinematicsWork work;  ///< working memory of evaluate()
 };
 
-/// The interface of joints and drivers: m equations g(q, t) = h(q) - f(t) = 0 on the
+/// The interface of joints and drivers: m equations g(q, t) = h(q) - f(t) = 0 (Haug1989) on the
 /// coordinates of its bodies (ConstraintEvaluation), with their Jacobian G and, on
 /// request, Hessians; drivers add a prescribed f(t). The system's multipliers lambda of
 /// its equations give the reactions(). Added to a System with System::addConstraint

@@ -768,8 +768,8 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
   constexpr bool identityT = IdentityT;
   ConstMap q(y + L.q, L.nq), v(y + L.v, L.nv), qp(yp + L.q, L.nq), vp(yp + L.v, L.nv);
   Eigen::Map<VecX> Fq(F + L.q, L.nq), Fv(F + L.v, L.nv);
-  // F_q = q' - T (v - D G^T mu): with T = I written at once, otherwise after the
-  // constraints have accumulated D G^T mu.
+  // F_q = q' - T (v - D G^T mu) (GearGuptaLeimkuhler1985): with T = I written at once,
+  // otherwise after the constraints have accumulated D G^T mu.
   if (identityT) {
     Fq = qp - v;
   } else {
@@ -830,7 +830,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     switch (formulation_) {
       case Formulation::Ggl: {
         // F_v += G^T lambda;  F_q += T D G^T mu;  F_g = h - f;  F_gv = G v - f': one pass
-        // over the columns of G
+        // over the columns of G (GearGuptaLeimkuhler1985)
         const double* mu = y + L.mu + row;
         if (const double period = sys.constraintPeriod(ci); period > 0.0) {
           for (int a = 0; a < me; ++a) cs.f[a] = ev.h[a] - std::remainder(ev.h[a] - cs.f[a], period);
@@ -856,7 +856,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
         Fc = ev.h - cs.f;
         break;
       case Formulation::Index1: {
-        // F_a = G a + v^T H_a T v - f''
+        // F_a = G a + v^T H_a T v - f'' (the acceleration equation, Haug1989)
         gather(cols, v.data(), cs.vl);
         gather(cols, vp.data(), cs.al);
         if (identityT) {
@@ -878,7 +878,7 @@ void DaeSystem::residualImpl(double t, const double* y, const double* yp, double
     if (L.mu >= 0) F[L.mu + r] = y[L.mu + r];
   }
   if (!identityT) {
-    S.w = S.DGtmu - v;  // F_q = q' + T (D G^T mu - v)
+    S.w = S.DGtmu - v;  // F_q = q' + T (D G^T mu - v) (GearGuptaLeimkuhler1985)
     for (int b = 0; b < sys.numBodies(); ++b) {
       const BodyIndex bi(b);
       const Body& body = sys.body(bi);

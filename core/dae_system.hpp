@@ -15,7 +15,7 @@ namespace flexmbd {
 
 /// How the constrained equations of motion are posed (see docs/formulations.md).
 enum class Formulation {
-  Ggl,     ///< stabilised index 2 (Gear-Gupta-Leimkuhler): y = [q, v, lambda, mu]
+  Ggl,     ///< stabilised index 2 (GearGuptaLeimkuhler1985): y = [q, v, lambda, mu]
   Index3,  ///< position constraints: y = [q, v, lambda]
   Index1,  ///< acceleration constraints: y = [q, v, lambda]; drift not corrected
 };
@@ -44,7 +44,7 @@ inline constexpr double kElasticStabilisationWeight = 1e-6;
 /// D = 1 on frame coordinates, kElasticStabilisationWeight on elastic ones.
 VecX defaultStabilisationMetric(const System& sys);
 
-/// GGL residual (STYLE.md, Gear-Gupta-Leimkuhler 1985), with q' = T(q) v (docs/spatial.md):
+/// GGL residual (STYLE.md; GearGuptaLeimkuhler1985), with q' = T(q) v (docs/spatial.md):
 ///   F_q  = q' - T(q) (v - D G^T mu),  F_v = M v' - Q + G^T lambda,  F_g = g(q, t),
 ///   F_gv = G v + g_t,
 /// G the velocity Jacobian (m x nv). Index 3 drops mu and F_gv; index 1 replaces F_g by
@@ -60,7 +60,8 @@ class DaeSystem final : public DaeProblem {
  public:
   /// @throws InputError if the system is not finalized.
   DaeSystem(const System& sys, Formulation formulation);
-  /// GGL with the stabilisation metric D (diagonal, nv, positive): F_q = q' - T (v - D G^T mu).
+  /// GGL with the stabilisation metric D (diagonal, nv, positive): F_q = q' - T (v - D G^T mu)
+  /// (GearGuptaLeimkuhler1985).
   /// The first constructor takes defaultStabilisationMetric(sys).
   DaeSystem(const System& sys, Formulation formulation, VecX stabilisationMetric);
   /// With the constraint equations `released` (ascending; redundant constraints resolved,

@@ -88,7 +88,7 @@ MatX withoutRows(const MatX& A, const std::vector<int>& rows) {
 }
 
 VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolerance) {
-  // minimum-norm solution of G^T l = b by a complete orthogonal decomposition (Golub & Van Loan, 4th ed., 5.5.4)
+  // minimum-norm solution of G^T l = b by a complete orthogonal decomposition (GolubVanLoan2013, sec. 5.5.4)
   Eigen::CompleteOrthogonalDecomposition<MatX> cod;
   cod.setThreshold(rankTolerance);
   cod.compute(G.transpose());
@@ -98,7 +98,7 @@ VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolera
 namespace {
 
 /// C = [C_d C_i] split at the r pivot columns d of a full-pivoting LU, and the
-/// eliminated coordinates q_d = X q_i, X = -C_d^{-1} C_i.
+/// eliminated coordinates q_d = X q_i, X = -C_d^{-1} C_i (coordinate partitioning, Haug1989).
 struct NullSpaceSplit {
   std::vector<int> pivots, free;
   MatX X;

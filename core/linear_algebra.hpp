@@ -40,11 +40,13 @@ MatX withoutRows(const MatX& A, const std::vector<int>& rows);
 /// lambda: argmin |l| subject to G^T l = G^T lambda (a redundant set's reactions are not
 /// unique; this choice spreads the load evenly over the dependent rows). Rows of G whose
 /// pivots fall below rankTolerance times the largest count as dependent, as in dependentRows.
+/// Solved by a complete orthogonal decomposition (GolubVanLoan2013, sec. 5.5.4).
 VecX minimumNormMultipliers(const MatX& G, const VecX& lambda, double rankTolerance = 1e-9);
 
 /// Basis B of the null space of the full-row-rank matrix C (r x n), chosen so that
 /// B keeps as many unit columns as possible: C = [C_d C_i] (d: r pivot columns of
-/// a full-pivoting LU), q_d = -C_d^{-1} C_i q_i, B = P [-C_d^{-1} C_i; I].
+/// a full-pivoting LU), q_d = -C_d^{-1} C_i q_i, B = P [-C_d^{-1} C_i; I] (coordinate
+/// partitioning, Haug1989).
 /// `independent` receives the kept coordinates (the columns of B are unit vectors there).
 MatX nullSpaceBasis(const MatX& C, std::vector<int>* independent = nullptr);
 /// The same basis, sparse, built without the dense n x (n - r) matrix (cost O(r^2 n)):

@@ -3,7 +3,7 @@
 namespace flexmbd {
 
 Vec4 quaternionFromRotation(const Mat3& A) {
-  // Shepperd (1978): take the largest of 4 e_k^2 from the trace and the diagonal.
+  // Shepperd1978: take the largest of 4 e_k^2 from the trace and the diagonal.
   const double tr = A.trace();
   Vec4 d(tr, A(0, 0), A(1, 1), A(2, 2));
   Eigen::Index k = 0;

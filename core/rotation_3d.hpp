@@ -1,6 +1,6 @@
 /// @file
 /// Spatial rotations: the skew-symmetric matrix of a vector and the Euler parameters (unit
-/// quaternion) of a rotation with their kinematic matrices (Nikravesh 1988, ch. 6).
+/// quaternion) of a rotation with their kinematic matrices (Nikravesh1988, ch. 6).
 #pragma once
 
 #include <Eigen/Geometry>
@@ -14,7 +14,7 @@ using Vec4 = Eigen::Vector4d;
 using Mat34 = Eigen::Matrix<double, 3, 4>;
 using Mat4 = Eigen::Matrix4d;
 
-/// a~ with a~ b = a x b.
+/// a~ with a~ b = a x b (Nikravesh1988).
 inline Mat3 skew(const Vec3& a) {
   Mat3 s;
   s << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
@@ -22,7 +22,7 @@ inline Mat3 skew(const Vec3& a) {
 }
 
 /// Rotation matrix of the Euler parameters p = (e0, e) normalised: A(p / |p|) = R(p) / |p|^2 with
-/// R(p) = (e0^2 - e.e) I + 2 e e^T + 2 e0 e~ (Nikravesh 1988, eq. 6.19). The length of p is a
+/// R(p) = (e0^2 - e.e) I + 2 e e^T + 2 e0 e~ (Nikravesh1988, eq. 6.19). The length of p is a
 /// gauge: no material point depends on it.
 inline Mat3 quaternionRotation(const Vec4& p) {
   const double e0 = p[0];
@@ -31,7 +31,7 @@ inline Mat3 quaternionRotation(const Vec4& p) {
 }
 
 /// L(p) = [-e, e0 I - e~] (3 x 4): body-axes angular velocity w = 2 L(p) p' (unit p), and
-/// p' = 1/2 L(p)^T w (Nikravesh 1988, eqs. 6.39-6.41); L p = 0, L L^T = |p|^2 I.
+/// p' = 1/2 L(p)^T w (Nikravesh1988, eqs. 6.39-6.41); L p = 0, L L^T = |p|^2 I.
 inline Mat34 quaternionL(const Vec4& p) {
   Mat34 L;
   L.col(0) = -p.tail<3>();
@@ -65,7 +65,7 @@ inline Vec4 quaternionProduct(const Vec4& p, const Vec4& r) {
   return out;
 }
 
-/// Euler parameters of a rotation matrix (Shepperd's method), e0 >= 0.
+/// Euler parameters of a rotation matrix (Shepperd's method, Shepperd1978), e0 >= 0.
 Vec4 quaternionFromRotation(const Mat3& A);
 
 }  // namespace flexmbd

@@ -11,11 +11,11 @@
 
 namespace flexmbd {
 
-/// g(q, t) = h(q) - f(t) (m), and optionally G = dg/dq (m x nq, dense).
+/// g(q, t) = h(q) - f(t) (m; Haug1989), and optionally G = dg/dq (m x nq, dense).
 void evaluateConstraints(const System& sys, const VecX& q, double t, VecX* g, MatX* G);
 /// Velocity-level residual G v - f'(t) (m).
 VecX velocityConstraintResidual(const System& sys, const VecX& q, const VecX& v, double t);
-/// Acceleration right-hand side: G a = f''(t) - [v^T H_a v]_a (m).
+/// Acceleration right-hand side: G a = f''(t) - [v^T H_a v]_a (m) (Haug1989).
 VecX accelerationConstraintRhs(const System& sys, const VecX& q, const VecX& v, double t);
 /// The augmented matrix [M G^T; G 0] (nv + m square, sparse) at q: each body writes its
 /// mass matrix's structural non-zeros through a sink, as in the DAE Jacobian, and each

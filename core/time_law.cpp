@@ -76,7 +76,7 @@ class PolynomialLaw final : public TimeLaw {
     }
   }
   // f = sum_k c_k t^k with f', f'' by Horner's scheme carrying derivatives
-  // (Knuth, TAOCP vol. 2, 4.6.4); the recursion for ddp yields p'' directly.
+  // (Knuth, sec. 4.6.4); the recursion for ddp yields p'' directly.
   LawValue evaluate(double t) const override {
     double p = c_.back();
     double dp = 0.0;
@@ -192,7 +192,7 @@ class TabulatedLaw final : public TimeLaw {
     const double h0 = x_[1] - x_[0];
     const double hn = x_[n - 1] - x_[n - 2];
     // End slopes S'(x_0), S'(x_{n-1}) of the cubic pieces with M_0 = M_{n-1} = 0
-    // (derivative of the piece formula in evaluate()).
+    // (derivative of the piece formula in evaluate(): Press2007, eq. 3.3.5).
     slopeStart_ = (y_[1] - y_[0]) / h0 - h0 * m_[1] / 6.0;
     slopeEnd_ = (y_[n - 1] - y_[n - 2]) / hn + hn * m_[n - 2] / 6.0;
   }
@@ -214,12 +214,12 @@ class TabulatedLaw final : public TimeLaw {
     const double b = t - x_[i];
     const double m0 = m_[i];
     const double m1 = m_[i + 1];
-    // Cubic piece in second-derivative form (Press et al., Numerical Recipes, 3.3.3):
+    // Cubic piece in second-derivative form (Press2007, eq. 3.3.3):
     // S = M_i a^3/(6h) + M_{i+1} b^3/(6h) + (y_i - M_i h^2/6) a/h + (y_{i+1} - M_{i+1} h^2/6) b/h.
     const double f = (m0 * a * a * a + m1 * b * b * b) / (6.0 * h) +
                      (y_[i] - m0 * h * h / 6.0) * (a / h) +
                      (y_[i + 1] - m1 * h * h / 6.0) * (b / h);
-    // S' and S'' by differentiating the same formula (Numerical Recipes 3.3.5, 3.3.6).
+    // S' and S'' by differentiating the same formula (Press2007, eqs. 3.3.5, 3.3.6).
     const double df = (m1 * b * b - m0 * a * a) / (2.0 * h) + (y_[i + 1] - y_[i]) / h -
                       (m1 - m0) * h / 6.0;
     const double ddf = (m0 * a + m1 * b) / h;
@@ -231,8 +231,8 @@ class TabulatedLaw final : public TimeLaw {
   /// Second derivatives M_i at the knots of the natural spline (M_0 = M_{n-1} = 0):
   /// h_{i-1} M_{i-1} + 2 (h_{i-1} + h_i) M_i + h_i M_{i+1}
   ///   = 6 ((y_{i+1} - y_i)/h_i - (y_i - y_{i-1})/h_{i-1}),  i = 1..n-2
-  /// (Numerical Recipes 3.3.7), solved by the Thomas algorithm. The system is strictly
-  /// diagonally dominant, so elimination without pivoting is stable.
+  /// (Press2007, eq. 3.3.7), solved by the Thomas algorithm (Press2007, sec. 2.4). The system
+  /// is strictly diagonally dominant, so elimination without pivoting is stable.
   void computeSecondDerivatives() {
     const std::size_t n = x_.size();
     m_.assign(n, 0.0);
@@ -247,7 +247,8 @@ class TabulatedLaw final : public TimeLaw {
       upper[j] = hr;  // coefficient of M_{i+1}; the sub-diagonal of row j+1 is also hr
       rhs[j] = 6.0 * ((y_[i + 1] - y_[i]) / hr - (y_[i] - y_[i - 1]) / hl);
     }
-    // Forward elimination: row j -= (lower_j / diag_{j-1}) row j-1, lower_j = upper_{j-1}.
+    // Forward elimination (Press2007, sec. 2.4): row j -= (lower_j / diag_{j-1}) row j-1,
+    // lower_j = upper_{j-1}.
     for (std::size_t j = 1; j < k; ++j) {
       const double factor = upper[j - 1] / diag[j - 1];
       diag[j] -= factor * upper[j - 1];

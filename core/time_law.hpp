@@ -50,7 +50,7 @@ TimeLawPtr makeHarmonicLaw(double amplitude, double omega, double phase = 0.0,
 /// law holds `initial` (theta, theta', theta'' all vanish at t = 0, so it stays C2).
 /// @throws InputError if T <= 0.
 TimeLawPtr makeSpinUpLaw(double speed, double rampTime, double initial = 0.0);
-/// Natural cubic spline through (times[i], values[i]); times strictly increasing,
+/// Natural cubic spline (Press2007, sec. 3.3) through (times[i], values[i]); times strictly increasing,
 /// at least 2 points. Outside the table: linear extrapolation with the end slopes
 /// (f'' = 0), so the law stays C1. @throws InputError on bad tables.
 TimeLawPtr makeTabulatedLaw(std::vector<double> times, std::vector<double> values);

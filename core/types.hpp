@@ -29,7 +29,7 @@ inline Mat2 rotation(double theta) {
   return a;
 }
 
-/// Counter-clockwise perpendicular S v = (-v_y, v_x); note dA/dtheta = S A.
+/// Counter-clockwise perpendicular S v = (-v_y, v_x); note dA/dtheta = S A (Nikravesh1988).
 inline Vec2 perp(const Vec2& v) { return Vec2(-v.y(), v.x()); }
 
 /// A planar vector in the x-y plane of space.

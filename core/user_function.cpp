@@ -59,7 +59,7 @@ class UserTimeLaw final : public TimeLaw {
       if (ddf_) {
         v.ddf = guarded("time law's second derivative", t, [&] { return ddf_(t); });
       } else {
-        // f'' = (f'(t+h) - f'(t-h)) / 2h, h = eps^(1/3) scale (header)
+        // f'' = (f'(t+h) - f'(t-h)) / 2h, h = eps^(1/3) scale (header; NocedalWright2006, sec. 8.1)
         const double h = std::cbrt(kEps) * scale;
         const double up = guarded("time law's derivative", t, [&] { return df_(t + h); });
         const double down = guarded("time law's derivative", t, [&] { return df_(t - h); });
@@ -67,7 +67,8 @@ class UserTimeLaw final : public TimeLaw {
       }
       return v;
     }
-    // central differences (header): f' with h1 = eps^(1/3) scale, f'' with h2 = eps^(1/4) scale
+    // central differences (header; NocedalWright2006, sec. 8.1): f' with h1 = eps^(1/3) scale,
+    // f'' with h2 = eps^(1/4) scale
     const double h1 = std::cbrt(kEps) * scale;
     const double h2 = std::sqrt(std::sqrt(kEps)) * scale;
     v.df = (f(t + h1) - f(t - h1)) / (2.0 * h1);
@@ -112,7 +113,7 @@ SpringLawValue SpringLaw::evaluate(double t, double x, double xdot, bool withDer
     v.dfdxdot = d[1];
     return v;
   }
-  // central differences, h = eps^(1/3) max(|x|, 1) (header)
+  // central differences, h = eps^(1/3) max(|x|, 1) (header; NocedalWright2006, sec. 8.1)
   const double hx = std::cbrt(kEps) * std::max(std::abs(x), 1.0);
   const double hv = std::cbrt(kEps) * std::max(std::abs(xdot), 1.0);
   v.dfdx = (call(t, x + hx, xdot) - call(t, x - hx, xdot)) / (2.0 * hx);

@@ -41,7 +41,7 @@ using UserTimeFunction = std::function<double(double t)>;
 /// (f'' = (df(t+h1) - df(t-h1)) / (2 h1) when only df is given). Each step balances the
 /// truncation error (h^2) against rounding (eps / h, eps / h^2): relative errors about
 /// eps^(2/3) ~ 4e-11 and eps^(1/2) ~ 1.5e-8 for a law that varies on a scale of 1 s
-/// (Nocedal & Wright, Numerical Optimization, 8.1); faster laws should give df and ddf.
+/// (NocedalWright2006, sec. 8.1); faster laws should give df and ddf.
 /// Loads use f only (TimeLaw::value): one call per evaluation. An exception thrown by a
 /// callable becomes a UserFunctionError "the user time law raised <what> at t = ...".
 /// @throws InputError if f is empty, or ddf is given without df.
@@ -63,7 +63,8 @@ using SpringDerivative = std::function<std::array<double, 2>(double t, double x,
 /// (translational) or its joint angle (rotational), x' its rate, and f has the sign of
 /// the linear law (a tension > 0 pulls the points together; a torque > 0 turns the
 /// joint back towards smaller angles). Partial derivatives from `derivative` if given,
-/// otherwise by central differences with h = eps^(1/3) max(|x|, 1) (and the same in x'):
+/// otherwise by central differences with h = eps^(1/3) max(|x|, 1) (and the same in x';
+/// NocedalWright2006, sec. 8.1):
 /// they only enter the Newton iteration matrix and linearisations (modes), never the
 /// residual, so their error (~ eps^(2/3) relative) does not change a run's results.
 class SpringLaw {

@@ -1,6 +1,6 @@
 /// @file
 /// Planar beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
-/// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 6-7).
+/// (Doc003; Shabana2005, ch. 6-7).
 #pragma once
 
 #include <Eigen/Core>
@@ -15,7 +15,7 @@ namespace flexmbd {
 /// transverse displacement, slope. The element lies along its own x axis from `start`
 /// to `end` (body frame); its intermediate element frame is parallel to it, so the
 /// constant transformation from body-frame nodal displacements (ux, uy, psi) to element
-/// coordinates is T = diag(R(beta)^T, 1, R(beta)^T, 1) (document 003, C^ij).
+/// coordinates is T = diag(R(beta)^T, 1, R(beta)^T, 1) (Doc003, C^ij).
 ///
 /// Everything constant is computed once, at construction, as the x-y restriction of the
 /// spatial BeamElement3d along the element's axis (its coordinates u, v, tz; one element
@@ -39,13 +39,13 @@ class BeamElement2d {
   const Vec2& start() const { return start_; }
   const BeamSection& section() const { return section_; }
   BeamTheory theory() const { return theory_; }
-  /// phi = 12 EI / (kappa G A l^2) of a Timoshenko element (the spatial element's
-  /// BeamShear::y); 0 otherwise.
+  /// phi = 12 EI / (kappa G A l^2) of a Timoshenko element (Przemieniecki1968, sec. 5.6;
+  /// the spatial element's BeamShear::y); 0 otherwise.
   double shear() const { return shear_; }
   /// Body-frame nodal displacements -> element coordinates (6 x 6, constant).
   const Mat6& transformation() const { return T_; }
 
-  /// Shape functions S(xi), xi = x / l (document 003; `phi` = shear(): Timoshenko's
+  /// Shape functions S(xi), xi = x / l (Doc003; `phi` = shear(): Timoshenko's
   /// interdependent interpolation, BeamElement3d; phi = 0):
   ///   w_x = [1-xi, 0, 0, xi, 0, 0] e,
   ///   w_y = [0, 1-3xi^2+2xi^3, l(xi-2xi^2+xi^3), 0, 3xi^2-2xi^3, l(xi^3-xi^2)] e.
@@ -58,7 +58,7 @@ class BeamElement2d {
   /// interpolated rotation otherwise. What a joint on the section turns with.
   static Row6 rotationShape(double xi, double l, double phi = 0.0);
 
-  // ----- inertia shape integrals, element frame (document 003) -------------------
+  // ----- inertia shape integrals, element frame (Doc003) -------------------------
   double mass() const { return mass_; }           ///< rho A l
   const Mat26& sBar() const { return sBar_; }     ///< S-bar = int rho S dV
   const Mat26& sX() const { return sX_; }         ///< int rho x S dV (x along the element)
@@ -87,8 +87,8 @@ class BeamElement2d {
   /// eps = u' (linear model) or, with geometric stiffening, the element-averaged
   /// second-order strain eps_m = u' + (1/2l) int_0^l v'^2 dx = a e + e^T G e / (2l)
   /// (constant along the element). The pointwise u' + v'^2/2 cannot vanish in bending
-  /// with a linear u and a cubic v and locks coarse meshes (membrane locking;
-  /// docs/flexible-bodies.md); the averaged strain is the standard remedy.
+  /// with a linear u and a cubic v and locks coarse meshes (membrane locking,
+  /// StolarskiBelytschko1982; docs/flexible-bodies.md); the averaged strain is the standard remedy.
   double strainEnergy(const Vec6& e, bool stiffening) const;
   /// dU/de and d2U/de2 (for the linear model: K e and K).
   Vec6 strainEnergyGradient(const Vec6& e, bool stiffening) const;
@@ -96,7 +96,7 @@ class BeamElement2d {
   /// Membrane strain: u' (linear) or the averaged eps_m (stiffening), as above.
   double membraneStrain(const Vec6& e, bool stiffening) const;
   /// Axial force N = EA eps (constant along the element) and bending moment M = EI kappa
-  /// at xi.
+  /// at xi (Przemieniecki1968).
   Vec2 sectionForces(const Vec6& e, double xi, bool stiffening) const;
 
  private:

@@ -46,7 +46,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   if (!(hint > 0.0)) {
     throw InputError(owner + ": y axis hint is zero; expected a direction not parallel to the element axis");
   }
-  const Vec3 yPerp = yHint - yHint.dot(ex) * ex;  // Gram-Schmidt: y = hint - (hint . x) x
+  const Vec3 yPerp = yHint - yHint.dot(ex) * ex;  // Gram-Schmidt (GolubVanLoan2013): y = hint - (hint . x) x
   if (!(yPerp.norm() > kParallelHint * hint)) {
     throw InputError(owner + ": y axis hint is parallel to the element axis (end - start); expected a "
                              "direction across the element");
@@ -56,7 +56,7 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   C_.col(1) = ey;
   C_.col(2) = ex.cross(ey);  // z = x cross y
   T_.setZero();
-  for (int n = 0; n < 4; ++n) T_.block<3, 3>(3 * n, 3 * n) = C_.transpose();  // e = T q (document 003, C^ij)
+  for (int n = 0; n < 4; ++n) T_.block<3, 3>(3 * n, 3 * n) = C_.transpose();  // e = T q (Doc003, C^ij)
 
   const double l = l_, rhoA = section.massPerLength();
   if (theory == BeamTheory::Timoshenko) shear_ = section.shearFlexibility(l, owner);
@@ -123,14 +123,14 @@ BeamElement3d::BeamElement3d(const Vec3& start, const Vec3& end, const Vec3& yHi
   rKL_[6] = rKL_[2];
   rKL_[7] = rKL_[5];
   for (Mat12& h : hI_) h = (0.5 * (h + h.transpose())).eval();
-  massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz
+  massMatrix_ = sKL_[0] + sKL_[4] + sKL_[8];  // m_ff = S_xx + S_yy + S_zz (Doc003)
   // x0 cross u = (y u_z - z u_y, z u_x - x u_z, x u_y - y u_x)
   skewXS_.row(0) = xS_[1].row(2) - xS_[2].row(1);
   skewXS_.row(1) = xS_[2].row(0) - xS_[0].row(2);
   skewXS_.row(2) = xS_[0].row(1) - xS_[1].row(0);
   dotXS_ = xS_[0].row(0) + xS_[1].row(1) + xS_[2].row(2);  // x0 . u
 
-  // Stiffness, closed form (Przemieniecki, Theory of Matrix Structural Analysis, sec. 5.6):
+  // Stiffness, closed form (Przemieniecki1968, sec. 5.6):
   // axial EA/l, torsion GJ/l, bending EIz/((1 + phi_y) l^3), EIy/((1 + phi_z) l^3) with the
   // shear terms (4 + phi) l^2, (2 - phi) l^2 (phi = 0: Euler-Bernoulli's Hermite matrix).
   K_.setZero();
@@ -192,8 +192,7 @@ namespace {
 using PlaneRow = std::array<double, 4>;
 
 // Shear-flexible bending of one plane (x-y: d = v, r = tz; x-z: d = w, r = -ty), the
-// interdependent interpolation of Timoshenko's beam (Przemieniecki, Theory of Matrix
-// Structural Analysis, sec. 5.6; Reddy, Int. J. Numer. Meth. Eng. 40 (1997)):
+// interdependent interpolation of Timoshenko's beam (Przemieniecki1968, sec. 5.6; Reddy1997):
 // the exact static solution for end loads, phi = 12 EI / (kappa G A l^2) (phi = 0:
 // the Hermite cubics of Euler-Bernoulli, r = d').
 PlaneRow planeDisplacement(double xi, double l, double phi) {
@@ -240,7 +239,7 @@ BeamElement3d::Row12 rowZ(const PlaneRow& c) {
 
 BeamElement3d::Mat3x12 BeamElement3d::shape(double xi, double l, const BeamShear& shear) {
   Mat3x12 S = Mat3x12::Zero();
-  S(0, kU) = 1 - xi;  // w_x = (1-xi) u1 + xi u2
+  S(0, kU) = 1 - xi;  // w_x = (1-xi) u1 + xi u2 (Doc003)
   S(0, kU + kNode2) = xi;
   S.row(1) = rowY(planeDisplacement(xi, l, shear.y));  // w_y: v1, tz1, v2, tz2
   S.row(2) = rowZ(planeDisplacement(xi, l, shear.z));  // w_z: w1, -ty1, w2, -ty2
@@ -310,11 +309,13 @@ BeamElement3d::Row12 BeamElement3d::curvatureShapeZ(double xi, double l, const B
 }
 
 BeamElement3d::Row12 BeamElement3d::shearStrainShapeY(double l, const BeamShear& shear) {
-  return slopeShapeY(0.0, l, shear) - rowY(planeRotation(0.0, l, shear.y));  // gamma_y = v' - tz (constant)
+  // gamma_y = v' - tz, constant (Przemieniecki1968, sec. 5.6)
+  return slopeShapeY(0.0, l, shear) - rowY(planeRotation(0.0, l, shear.y));
 }
 
 BeamElement3d::Row12 BeamElement3d::shearStrainShapeZ(double l, const BeamShear& shear) {
-  return slopeShapeZ(0.0, l, shear) - rowZ(planeRotation(0.0, l, shear.z));  // gamma_z = w' + ty (constant)
+  // gamma_z = w' + ty, constant (Przemieniecki1968, sec. 5.6)
+  return slopeShapeZ(0.0, l, shear) - rowZ(planeRotation(0.0, l, shear.z));
 }
 
 // The strain energy: BeamStrainEnergy (elements/beam_strain_energy.hpp), shared with the
@@ -337,6 +338,7 @@ BeamElement3d::Mat12 BeamElement3d::strainEnergyHessian(const Vec12& e, bool sti
 BeamSectionForces3d BeamElement3d::sectionForces(const Vec12& e, double xi, bool stiffening) const {
   const BeamSection3d& s = section_;
   BeamSectionForces3d f;
+  // section forces of beam theory (Przemieniecki1968):
   f.N = s.axialStiffness() * membraneStrain(e, stiffening);  // N = EA eps (constant, consistent with U)
   f.Mx = s.torsionStiffness() * twistRateShape(l_).dot(e);    // Mx = GJ tx'
   f.My = -s.bendingStiffnessY() * curvatureShapeZ(xi, l_, shear_).dot(e);  // My = EIy ty' = -EIy w''
@@ -345,7 +347,7 @@ BeamSectionForces3d BeamElement3d::sectionForces(const Vec12& e, double xi, bool
   // (Timoshenko: v'' = tz' as the shear strain is constant, and EIz tz'' = -kappa G A gamma_y)
   const double v3 = (curvatureShapeY(1.0, l_, shear_) - curvatureShapeY(0.0, l_, shear_)).dot(e) / l_;
   const double w3 = (curvatureShapeZ(1.0, l_, shear_) - curvatureShapeZ(0.0, l_, shear_)).dot(e) / l_;
-  f.Qy = -s.bendingStiffnessZ() * v3;  // dMz/dx + Qy = 0 (moment balance of a slice)
+  f.Qy = -s.bendingStiffnessZ() * v3;  // dMz/dx + Qy = 0 (moment balance of a slice; Przemieniecki1968)
   f.Qz = -s.bendingStiffnessY() * w3;  // dMy/dx - Qz = 0
   return f;
 }

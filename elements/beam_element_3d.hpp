@@ -1,7 +1,6 @@
 /// @file
 /// Spatial beam element (Euler-Bernoulli, Rayleigh or Timoshenko) of the floating frame of reference formulation
-/// (source document 003; Shabana, Dynamics of Multibody Systems, ch. 5-6; Przemieniecki,
-/// Theory of Matrix Structural Analysis, sec. 5.6). docs/spatial-flexible.md.
+/// (Doc003; Shabana2005, ch. 5-6; Przemieniecki1968, sec. 5.6). docs/spatial-flexible.md.
 #pragma once
 
 #include <Eigen/Core>
@@ -16,7 +15,8 @@ namespace flexmbd {
 
 /// Section forces of a spatial beam at one cross-section, element frame: the resultant
 /// force and moment that the part beyond the section (larger x) exerts on the part
-/// before it, i.e. the stress resultants on the face with outward normal +x.
+/// before it, i.e. the stress resultants on the face with outward normal +x
+/// (Przemieniecki1968).
 struct BeamSectionForces3d {
   double N = 0.0;   ///< axial force EA eps_m, N (tension > 0; constant per element)
   double Qy = 0.0;  ///< shear force along y, N: -dMz/dx = -EIz v''' (constant per element)
@@ -33,11 +33,12 @@ struct BeamSectionForces3d {
 /// Coordinates. Body-frame nodal coordinates q (12): per node (ux, uy, uz, thx, thy, thz),
 /// displacement and small rotation about the body axes. Element coordinates (12)
 ///   e = [u1 v1 w1 tx1 ty1 tz1  u2 v2 w2 tx2 ty2 tz2] = T q,
-/// T = blockdiag(C^T, C^T, C^T, C^T) (`transformation()`, constant; document 003's C^ij):
+/// T = blockdiag(C^T, C^T, C^T, C^T) (`transformation()`, constant; Doc003's C^ij):
 /// u, v, w displacements along the element's x, y, z; tx twist, ty, tz small rotations
 /// about the element's y and z axes (ty = -dw/dx, tz = dv/dx).
 ///
-/// Field (xi = x / l, element frame): centre line S_c(xi) e (3 x 12, `shape()`),
+/// Field (xi = x / l, element frame): centre line S_c(xi) e (3 x 12, `shape()`; Doc003's
+/// S in each bending plane; Przemieniecki1968, sec. 5.6),
 ///   w_x = (1-xi) u1 + xi u2,
 ///   w_y = h1 v1 + h2 tz1 + h3 v2 + h4 tz2,
 ///   w_z = h1 w1 - h2 ty1 + h3 w2 - h4 ty2,
@@ -47,7 +48,8 @@ struct BeamSectionForces3d {
 /// (`BeamShear`, phi = 12 EI / (kappa G A l^2); phi = 0 gives the cubics above): the
 /// nodal ty, tz are then the sections' own rotations, not the slopes, the shear strain
 /// gamma = v' - tz is constant along the element and the stiffness is Przemieniecki's
-/// shear-deformable matrix (exact for end loads, free of shear locking as l / h grows).
+/// shear-deformable matrix (Przemieniecki1968, sec. 5.6; exact for end loads, free of shear
+/// locking as l / h grows).
 /// A material point (x, y, z) of the
 /// element (y, z in the section) moves by
 ///   u = S(x, y, z) e = S_c e + tx e_x cross (0, y, z) = S_c e + (0, -z tx, y tx)  (`pointShape()`).
@@ -90,7 +92,7 @@ class BeamElement3d {
   /// C (3 x 3): columns = element x, y, z axes in the body frame; x_body = start + C x_el.
   const Mat3& rotation() const { return C_; }
   /// T (12 x 12, constant) = blockdiag(C^T, C^T, C^T, C^T): body-frame nodal coordinates
-  /// q -> element coordinates e = T q.
+  /// q -> element coordinates e = T q (Doc003, C^ij).
   const Mat12& transformation() const { return T_; }
 
   // ----- shape functions (element frame, xi = x / l) ------------------------------
@@ -123,7 +125,7 @@ class BeamElement3d {
   static Row12 curvatureShapeY(double xi, double l, const BeamShear& shear = {});
   static Row12 curvatureShapeZ(double xi, double l, const BeamShear& shear = {});
   /// The shear strains gamma_y = v' - tz and gamma_z = w' + ty (1 x 12, constant along
-  /// the element; zero rows for shear = 0).
+  /// the element; zero rows for shear = 0; Przemieniecki1968, sec. 5.6).
   static Row12 shearStrainShapeY(double l, const BeamShear& shear);
   static Row12 shearStrainShapeZ(double l, const BeamShear& shear);
 
@@ -131,15 +133,15 @@ class BeamElement3d {
   double mass() const { return mass_; }                       ///< m = int rho dV = rho A l, kg
   const Vec3& firstMoment() const { return firstMoment_; }    ///< int rho x0 dV = (m l / 2, 0, 0), kg m
   /// int rho x0 x0^T dV (3 x 3), kg m^2 = diag(m l^2 / 3, rho Iz l, rho Iy l). Not the
-  /// inertia tensor: that is tr(J) I - J of this J.
+  /// inertia tensor: that is tr(J) I - J of this J (Shabana2005, eq. 5.110).
   const Mat3& secondMoment() const { return secondMoment_; }
-  /// S-bar = int rho S dV (3 x 12), kg (the twist term integrates to zero).
+  /// S-bar = int rho S dV (3 x 12), kg (Doc003; the twist term integrates to zero).
   const Mat3x12& sBar() const { return sBar_; }
-  /// S_kl = int rho S_k^T S_l dV (12 x 12), kg, S_k = row k of the point shape S;
+  /// S_kl = int rho S_k^T S_l dV (12 x 12), kg, S_k = row k of the point shape S (Doc003);
   /// S_lk = S_kl^T. S_yy and S_zz carry the torsional inertia rho Iy, rho Iz int tx^T tx.
   /// @throws std::out_of_range unless 0 <= k, l <= 2.
   const Mat12& sKL(int k, int l) const;
-  /// m_ff of the element = S_xx + S_yy + S_zz = int rho S^T S dV (12 x 12, kg): the
+  /// m_ff of the element = S_xx + S_yy + S_zz = int rho S^T S dV (12 x 12, kg; Doc003): the
   /// consistent mass matrix in element coordinates (body frame: T^T m_ff T).
   const Mat12& massMatrix() const { return massMatrix_; }
   /// int rho x0_k S dV (3 x 12), kg m: row l is int rho x0_k S_l dV, the coupling of the
@@ -174,7 +176,8 @@ class BeamElement3d {
   const Mat12& sectionRotationCoupling(int i) const;
 
   // ----- stiffness and strain energy (element frame) -----------------------------
-  /// Linear stiffness K (12 x 12), the classic Przemieniecki matrix: axial EA/l, torsion
+  /// Linear stiffness K (12 x 12), the classic Przemieniecki matrix (Przemieniecki1968,
+  /// sec. 5.6): axial EA/l, torsion
   /// GJ/l, bending EIz/l^3 (x-y plane: v, tz) and EIy/l^3 (x-z plane: w, ty, with
   /// ty = -w'); Timoshenko: the shear-deformable bending blocks (factor 1/(1 + phi),
   /// (4 + phi) l^2 and (2 - phi) l^2 on the rotations), e^T K e / 2 = int (EI psi'^2 +
@@ -191,7 +194,8 @@ class BeamElement3d {
   ///   eps_m = u' + (1/2l) int_0^l (v'^2 + w'^2) dx = a e + e^T G e / (2l)
   /// (constant along the element; locking-free: the pointwise u' + (v'^2 + w'^2)/2
   /// cannot vanish in bending with a linear u and cubic v, w and locks coarse meshes,
-  /// docs/flexible-bodies.md). The second-order twist (Wagner) term is not included.
+  /// StolarskiBelytschko1982; docs/flexible-bodies.md). The second-order twist (Wagner) term
+  /// is not included.
   double strainEnergy(const Vec12& e, bool stiffening) const;
   /// dU/de (12) and d2U/de2 (12 x 12): K e and K for the linear model.
   Vec12 strainEnergyGradient(const Vec12& e, bool stiffening) const;

@@ -55,18 +55,19 @@ BeamShear BeamSection3d::shearFlexibility(double l, const std::string& owner) co
     }
   }
   const double gal2 = shearModulus * area * l * l;
-  // phi = 12 E I / (kappa G A l^2) (Przemieniecki sec. 5.6)
+  // phi = 12 E I / (kappa G A l^2) (Przemieniecki1968, sec. 5.6)
   return {12.0 * bendingStiffnessZ() / (shearFactorY * gal2), 12.0 * bendingStiffnessY() / (shearFactorZ * gal2)};
 }
 
 double rectangleShearFactor(double youngsModulus, double shearModulus) {
-  const double nu = youngsModulus / (2.0 * shearModulus) - 1.0;  // isotropic: G = E / (2 (1 + nu))
-  return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);                 // Cowper (1966), table 1
+  // isotropic: G = E / (2 (1 + nu)) (TimoshenkoGoodier1970)
+  const double nu = youngsModulus / (2.0 * shearModulus) - 1.0;
+  return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu);                 // Cowper1966, table 1
 }
 
 double circleShearFactor(double youngsModulus, double shearModulus) {
   const double nu = youngsModulus / (2.0 * shearModulus) - 1.0;
-  return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);  // Cowper (1966), table 1
+  return 6.0 * (1.0 + nu) / (7.0 + 6.0 * nu);  // Cowper1966, table 1
 }
 
 BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsModulus, double shearModulus,
@@ -76,7 +77,7 @@ BeamSection3d rectangularSection3d(double widthY, double heightZ, double youngsM
   s.area = widthY * heightZ;
   s.inertiaY = widthY * heightZ * heightZ * heightZ / 12.0;  // int z^2 dA = b h^3 / 12
   s.inertiaZ = heightZ * widthY * widthY * widthY / 12.0;    // int y^2 dA = h b^3 / 12
-  // St Venant torsion of a rectangle, exact series (Timoshenko & Goodier sec. 109):
+  // St Venant torsion of a rectangle, exact series (TimoshenkoGoodier1970, sec. 109):
   // J = (a b^3/3) [1 - (192/pi^5)(b/a) sum_{n odd} tanh(n pi a/(2b)) / n^5], a >= b
   const double a = std::max(std::abs(widthY), std::abs(heightZ));
   const double b = std::min(std::abs(widthY), std::abs(heightZ));
@@ -100,7 +101,7 @@ BeamSection3d circularSection3d(double diameter, double youngsModulus, double sh
   BeamSection3d s;
   s.area = pi * d2 / 4.0;                    // A = pi d^2 / 4
   s.inertiaY = s.inertiaZ = pi * d2 * d2 / 64.0;  // I = pi d^4 / 64
-  s.torsionConstant = pi * d2 * d2 / 32.0;   // J = Ip = pi d^4 / 32 (no warping)
+  s.torsionConstant = pi * d2 * d2 / 32.0;   // J = Ip = pi d^4 / 32 (no warping; TimoshenkoGoodier1970)
   s.youngsModulus = youngsModulus;
   s.shearModulus = shearModulus;
   s.density = density;

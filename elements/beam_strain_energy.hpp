@@ -8,9 +8,8 @@
 /// (constant along the element; a = the axial strain row, G = int b^T b dx over the slope
 /// rows b), and U = EA l eps_m^2 / 2 + e^T K_b e / 2 with K_b the bending (and torsion)
 /// part of K. The pointwise u' + |w'|^2 / 2 cannot vanish in bending with a linear u and
-/// cubic transverse fields and locks coarse meshes (membrane locking: Stolarski &
-/// Belytschko, J. Appl. Mech. 49 (1982); Crisfield, Non-linear Finite Element Analysis of
-/// Solids and Structures vol. 1 (1991); docs/flexible-bodies.md).
+/// cubic transverse fields and locks coarse meshes (membrane locking: StolarskiBelytschko1982;
+/// Crisfield1991; docs/flexible-bodies.md).
 #pragma once
 
 #include <Eigen/Core>

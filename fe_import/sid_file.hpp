@@ -1,5 +1,5 @@
 /// @file
-/// The text file of the Standard Input Data of a flexible body (SID, Wallrapp 1994; the
+/// The text file of the Standard Input Data of a flexible body (SID, Wallrapp1994; the
 /// ".SID_FEM" files of FEMBS and of the Modelica and Python SID tools): bodies/sid_data.hpp
 /// holds the data, this file its reading and writing. Layout, block by block:
 /// docs/fe-import.md, "SID".

@@ -26,7 +26,7 @@ AppliedLoad::AppliedLoad(std::string name, BodyIndex body, const Vec2& point, Ti
 
 void AppliedLoad::addForce(double t, const BodyStates& b, const VecX&, VecX& Q, MatX* dQdq, MatX*,
                            KinematicsWork& w) const {
-  // Q = Jr^T F + tau Jphi^T (virtual work of a force F at the point and a torque tau)
+  // Q = Jr^T F + tau Jphi^T (virtual work of a force F at the point and a torque tau; Haug1989)
   b[0].point(point_, b.pointId(0), dQdq != nullptr, w.pi);
   const PointKinematics& p = w.pi;
   Vec2 F = Vec2::Zero();

@@ -12,7 +12,8 @@ namespace flexmbd {
 /// @throws InputError "<who>: a load on the ground does nothing ..." if `body` is the ground.
 void requireLoadableBody(BodyIndex body, const std::string& who);
 
-/// Q = Jr^T F(t) + Jphi^T tau(t) at the given body point; absent laws count as zero.
+/// Q = Jr^T F(t) + Jphi^T tau(t) at the given body point (virtual work, Haug1989); absent
+/// laws count as zero.
 class AppliedLoad final : public Force {
  public:
   AppliedLoad(std::string name, BodyIndex body, const Vec2& point, TimeLawPtr forceX,

@@ -32,7 +32,7 @@ void RotationalSpringDamper::addForce(double t, const BodyStates& b, const VecX&
   makePointPair(w.pi, w.pj, withHessians, w.pair);
   const PointPair& p = w.pair;
   // phi = phi_j - phi_i, J = dphi/dq, tau = k (phi - phi0) + c J v (or the user law
-  // tau(t, phi, phidot) with k = dtau/dphi, c = dtau/dphidot), Q = -tau J^T
+  // tau(t, phi, phidot) with k = dtau/dphi, c = dtau/dphidot), Q = -tau J^T (Haug1989)
   RowVecX& J = w.row;
   J = p.JphiJ - p.JphiI;
   const double phi = p.phiJ - p.phiI;

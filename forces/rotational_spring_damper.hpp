@@ -8,7 +8,7 @@
 namespace flexmbd {
 
 /// Torque tau = k (phi - phi0) + c phidot on the relative angle phi = phi_j - phi_i of
-/// the joint's two points; Q = -tau dphi/dq^T; potential V = k (phi - phi0)^2 / 2. With a
+/// the joint's two points; Q = -tau dphi/dq^T (Haug1989); potential V = k (phi - phi0)^2 / 2. With a
 /// user law (core/user_function.hpp), tau = law(t, phi, phidot) instead (no potential).
 class RotationalSpringDamper final : public Force {
  public:

@@ -81,7 +81,7 @@ void SpatialSpringDamper::addForce(double t, const BodyStates& bodies, const Vec
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
   }
   // grad l = e^T Jd;  l' = grad l v;  f = k (l - l0) + c l' (or the user law f(t, l, l') with
-  // k = df/dl, c = df/dl');  Q = -f grad l^T
+  // k = df/dl, c = df/dl');  Q = -f grad l^T (Shabana2005, ch. 7)
   const Vec3 e = pair.d() / l;
   RowVecX& gradL = w.row;
   gradL.noalias() = e.transpose() * pair.Jd();
@@ -136,7 +136,7 @@ double SpatialRotationalSpringDamper::potentialEnergy(const BodyStates& bodies) 
 
 void SpatialRotationalSpringDamper::addForce(double t, const BodyStates& bodies, const VecX& v, VecX& Q, MatX* dQdq,
                                              MatX* dQdv, KinematicsWork& w) const {
-  // tau = -k a - c theta', theta' = grad v;  Q = tau grad^T;
+  // tau = -k a - c theta', theta' = grad v;  Q = tau grad^T (Haug1989);
   // dQ/dq = tau H + grad^T dtau/dq, dtau/dq = -k grad T+ - c v^T H;  dQ/dv = -c grad^T grad
   double theta = 0.0;
   RowVecX& grad = w.row7;

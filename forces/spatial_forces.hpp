@@ -12,7 +12,7 @@
 
 namespace flexmbd {
 
-/// Q = Jr^T F(t) + Jw^T M(t): force F at the body point and torque M, world axes; absent
+/// Q = Jr^T F(t) + Jw^T M(t) (virtual work, Haug1989): force F at the body point and torque M, world axes; absent
 /// laws count as zero. dQ/dq is the point's curvature term with weights (F, M).
 class SpatialAppliedLoad final : public Force {
  public:
@@ -31,7 +31,7 @@ class SpatialAppliedLoad final : public Force {
 };
 
 /// Tension f = k (l - l0) + c l' along the line of two body points, l = |r_j - r_i|:
-/// Q = -f grad(l)^T (Shabana, Dynamics of Multibody Systems, ch. 7, in velocity form).
+/// Q = -f grad(l)^T (Shabana2005, ch. 7, in velocity form).
 /// With a user law (core/user_function.hpp), f = law(t, l, l') instead (no potential).
 class SpatialSpringDamper final : public Force {
  public:
@@ -58,7 +58,7 @@ class SpatialSpringDamper final : public Force {
 
 /// Torque -k (theta - theta0) - c theta' about a spatial revolute or cylindrical joint's
 /// axis, theta the joint angle of SpatialJointAngleDriver (frame j's x axis from frame i's,
-/// about frame i's z axis), taken within half a turn of theta0: Q = tau grad(theta)^T.
+/// about frame i's z axis), taken within half a turn of theta0: Q = tau grad(theta)^T (Haug1989).
 /// With a user law (core/user_function.hpp), tau = -law(t, theta, theta') instead, theta
 /// within half a turn of theta0 (no potential).
 class SpatialRotationalSpringDamper final : public Force {

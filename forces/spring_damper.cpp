@@ -45,7 +45,7 @@ void SpringDamper::addForce(double t, const BodyStates& b, const VecX& v, VecX& 
     throw InputError("force '" + name() + "': the two points coincide (length 0); the spring direction is undefined");
   }
   // l = |d|, e = d / l, dl/dq = e^T D, f = k (l - l0) + c dl/dt (or the user law f(t, l, ldot)
-  // with k = df/dl, c = df/dldot), Q = -f (dl/dq)^T
+  // with k = df/dl, c = df/dldot), Q = -f (dl/dq)^T (Haug1989)
   const Vec2 e = p.d / l;
   RowVecX& eD = w.row;
   eD.noalias() = e.transpose() * p.D;

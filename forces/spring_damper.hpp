@@ -8,7 +8,7 @@
 namespace flexmbd {
 
 /// Tension f = k (l - l0) + c ldot along e = d/l, d = r_j - r_i; generalised force
-/// Q = -f D^T e (D = dd/dq); potential V = k (l - l0)^2 / 2. With a user law
+/// Q = -f D^T e (D = dd/dq; Haug1989); potential V = k (l - l0)^2 / 2. With a user law
 /// (core/user_function.hpp), f = law(t, l, ldot) instead (k, c, l0 unused; no potential).
 class SpringDamper final : public Force {
  public:

@@ -1,6 +1,6 @@
 /// @file
 /// What IDAS needs besides the DAE for adjoint sensitivities (docs/sensitivities.md,
-/// "Adjoint sensitivities"): integral outputs G_k = int_{t0}^{T} g_k(t, y) dt, the
+/// "Adjoint sensitivities"; CaoLiPetzoldSerban2003): integral outputs G_k = int_{t0}^{T} g_k(t, y) dt, the
 /// gradient of each integrand and the integrand of each gradient dG_k/dp.
 #pragma once
 
@@ -23,7 +23,7 @@ class IntegralOutputs {
   /// dg_k/dy at (t, y) into gy (size n of the DAE; zero on the multipliers).
   virtual void integrandGradient(int k, double t, const double* y, double* gy) = 0;
   /// dg_k/dp_i - lambda^T dF/dp_i at (t, y, y') for every parameter i into out
-  /// (parameterCount): the integrand of the gradient (IDAS guide, "Adjoint sensitivity
+  /// (parameterCount): the integrand of the gradient (IdasGuide, "Adjoint sensitivity
   /// analysis"), lambda the adjoint of output k (size n).
   virtual void gradientIntegrand(int k, double t, const double* y, const double* yp, const double* lambda,
                                  double* out) = 0;

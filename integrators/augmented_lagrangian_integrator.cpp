@@ -19,7 +19,7 @@ namespace flexmbd {
 namespace {
 
 /// Penalty factor alpha relative to the inertia of a step: alpha G^T G ~ kPenalty (4/h^2) M.
-/// The multiplier iteration lambda* += alpha g reduces a violation in a well-conditioned
+/// The multiplier iteration lambda* += alpha g (BayoLedesma1996, eq. 20) reduces a violation in a well-conditioned
 /// constraint direction by ~1/kPenalty per Newton iteration, while the Newton matrix loses
 /// ~log10(kPenalty) = 6 of its 16 digits: enough for rtol down to 1e-10.
 constexpr double kPenalty = 1e6;
@@ -50,7 +50,7 @@ constexpr double kRoundOffViolation = 100.0, kRoundOffCorrection = 1000.0;
 /// Velocity and acceleration projections: at most this many passes (one reaches ~1/kPenalty).
 constexpr int kProjectionPasses = 2;
 /// Step size controller for the local error est ~ h^3 (order 2 method): safety factor,
-/// largest growth and shrink factors per step (Hairer, Norsett & Wanner I, II.4).
+/// largest growth and shrink factors per step (HairerNorsettWanner, II.4).
 constexpr double kSafety = 0.9, kMaxGrowth = 2.0, kMinShrink = 0.2, kMinShrinkRejected = 0.1;
 /// An error estimate above 1 that stays above kArtifactPersistence of its value after the
 /// step shrank kArtifactShrink times does not scale as h^3: it is accepted if below
@@ -170,7 +170,7 @@ struct AugmentedLagrangianIntegrator::Impl {
     }
   }
   /// Trapezoidal rule in the displacement: v_{n+1} = 2/h d - v_n, a_{n+1} = 4/h^2 d - 4/h v_n - a_n
-  /// (Newmark beta = 1/4, gamma = 1/2; on a Lie group: Bruls, Cardona & Arnold, Mech. Mach. Theory 48 (2012) 121).
+  /// (Newmark beta = 1/4, gamma = 1/2; on a Lie group: BrulsCardonaArnold2012).
   void trapezoidalRates(double hh) {
     vN = (2.0 / hh) * dN - v;
     aN = (4.0 / (hh * hh)) * dN - (4.0 / hh) * v - a;
@@ -232,7 +232,7 @@ struct AugmentedLagrangianIntegrator::Impl {
   }
 
   /// The Newton matrix / (h^2/4) in velocity-space increments dd (q = q (+) dd, d += dd):
-  /// dF_v/dq T + 2/h dF_v/dv (cj = 2/h) + alpha G^T G (Cuadrado et al. 1997, eq. 11; T = I planar)
+  /// dF_v/dq T + 2/h dF_v/dv (cj = 2/h) + alpha G^T G (CuadradoCardenalBayo1997, eq. 11; T = I planar)
   void newtonMatrix(double hh, double alpha) {
     if (identityT) {
       P = J.block(L.v, L.q, nv, nq) + (2.0 / hh) * J.block(L.v, L.v, nv, nv);
@@ -243,7 +243,7 @@ struct AugmentedLagrangianIntegrator::Impl {
     if (m > 0) P.noalias() += alpha * G.transpose() * G;
   }
 
-  /// Mass-orthogonal projections with the last Newton matrix (Bayo & Ledesma 1996, eqs. 27, 31):
+  /// Mass-orthogonal projections with the last Newton matrix (BayoLedesma1996, eqs. 27, 31):
   /// P (v - v*) = -alpha G^T (G v* + g_t),  P (a - a*) = -alpha G^T (G a* + (G v)_q T v + g_tt)
   void project(double tn, double alpha) {
     for (int pass = 0; pass < kProjectionPasses; ++pass) {
@@ -283,13 +283,13 @@ struct AugmentedLagrangianIntegrator::Impl {
       removeDependentDirections();
       r = F.segment(L.v, nv);
       if (m > 0) {
-        // multiplier update lambda* += alpha g(q_{k+1}) (Bayo & Ledesma 1996, eq. 20), not on a
+        // multiplier update lambda* += alpha g(q_{k+1}) (BayoLedesma1996, eq. 20), not on a
         // violation at round-off: alpha times round-off moves near-singular directions
         if (it > 0 && g.cwiseAbs().maxCoeff() > kRoundOffViolation * roundOffScale) {
           lamN += alpha * g;
           r.noalias() += G.transpose() * (alpha * g);
         }
-        r.noalias() += G.transpose() * (alpha * g);  // M a + G^T (lambda* + alpha g) - Q (ibid., eq. 19)
+        r.noalias() += G.transpose() * (alpha * g);  // M a + G^T (lambda* + alpha g) - Q (BayoLedesma1996, eq. 19)
       }
       newtonMatrix(hh, alpha);
       lu.compute(P);
@@ -322,7 +322,7 @@ struct AugmentedLagrangianIntegrator::Impl {
     return qN.allFinite() && vN.allFinite() && aN.allFinite();
   }
 
-  /// Local error of the trapezoidal rule h^2/12 (a_{n+1} - a_n) (Zienkiewicz & Xie 1991,
+  /// Local error of the trapezoidal rule h^2/12 (a_{n+1} - a_n) (ZienkiewiczXie1991,
   /// beta = 1/4), velocity space, in the coordinates' error weights (through T(q_{n+1})).
   double errorEstimate(double hh) {
     err = (hh * hh / 12.0) * (aN - a);

@@ -1,12 +1,9 @@
 /// @file
 /// Index-3 augmented Lagrangian formulation with mass-orthogonal projections (ALI3-P) and
-/// the trapezoidal rule: E. Bayo, R. Ledesma, "Augmented Lagrangian and mass-orthogonal
-/// projection methods for constrained multibody dynamics", Nonlinear Dynamics 9 (1996)
-/// 113-130; J. Cuadrado, J. Cardenal, E. Bayo, "Modeling and solution methods for
-/// efficient real-time simulation of multibody dynamics", Multibody System Dynamics 1
-/// (1997) 259-280. Written from the formulas of these papers.
+/// the trapezoidal rule: BayoLedesma1996; CuadradoCardenalBayo1997. Written from the
+/// formulas of these papers.
 ///
-/// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) stays regular where the
+/// Its Newton matrix M + h/2 C + h^2/4 (K + alpha G^T G) (CuadradoCardenalBayo1997) stays regular where the
 /// constraint Jacobian G loses rank, so it carries a mechanism through the isolated
 /// singular positions (change points, dead centres) where the index-2 and index-3 DAE
 /// integrators stop: the engine uses it as a bridge across them (simulation/simulation.cpp)

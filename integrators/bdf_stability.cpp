@@ -34,7 +34,7 @@ BdfOrderLimit stableBdfOrder(const System& sys, int requested) {
     if (nf == 0 || nf > kMaxModalAnalysisSize || em.damping->nonZeros() == 0) continue;
     const MatX D(*em.damping);
     if (D.cwiseAbs().maxCoeff() == 0.0) continue;
-    // K phi = omega^2 M phi, phi^T M phi = 1 (M, K symmetric positive definite: validated)
+    // K phi = omega^2 M phi, phi^T M phi = 1 (GeradinRixen; M, K symmetric positive definite: validated)
     const Eigen::GeneralizedSelfAdjointEigenSolver<MatX> eig(MatX(*em.stiffness), MatX(*em.mass));
     if (eig.info() != Eigen::Success) continue;
     for (int i = 0; i < nf; ++i) {

@@ -9,8 +9,8 @@
 
 namespace flexmbd {
 
-/// A(alpha) stability angles of BDF orders 1..5 in degrees (index = order; Hairer &
-/// Wanner, Solving ODEs II, Table V.2.3): a mode lambda = |lambda| e^{i (pi - theta)} is
+/// A(alpha) stability angles of BDF orders 1..5 in degrees (index = order;
+/// HairerWanner1996, Table V.2.3): a mode lambda = |lambda| e^{i (pi - theta)} is
 /// stable for every step size at order k iff theta <= alpha_k. Orders 1, 2: A-stable.
 inline constexpr double kBdfStabilityAngleDegrees[6] = {90.0, 90.0, 90.0, 86.03, 73.35, 51.84};
 
@@ -40,7 +40,7 @@ struct BdfOrderLimit {
 /// ratios zeta_i = phi_i^T D phi_i / (2 omega_i) of the body's m_ff, K_ff, D_ff,
 /// mass-normalised phi_i) with zeta_i >= cos(alpha_3) lies in BDF k's stability
 /// sector: zeta_i >= cos(alpha_k) (the
-/// eigenvalues -zeta omega +- i omega sqrt(1 - zeta^2) make the angle acos(zeta) with
+/// eigenvalues -zeta omega +- i omega sqrt(1 - zeta^2) (GeradinRixen) make the angle acos(zeta) with
 /// the negative real axis; overdamped modes, zeta >= 1, are real). Exact for
 /// proportional damping D = a M + b K (the beams' stiffness-proportional damping).
 BdfOrderLimit stableBdfOrder(const System& sys, int requested);

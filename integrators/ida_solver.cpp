@@ -184,7 +184,7 @@ struct IdaSolver::Impl {
   }
 
   /// The sensitivity residuals F_y s_i + F_y' s_i' + F_p_i: the forward sensitivity system
-  /// of F(t, y, y', p) = 0 (Hindmarsh et al. 2005, ACM TOMS 31(3); docs/sensitivities.md).
+  /// of F(t, y, y', p) = 0 (HindmarshEtAl2005; docs/sensitivities.md).
   static int sensitivityResidual(int ns, realtype t, N_Vector y, N_Vector yp, N_Vector, N_Vector* yS,
                                  N_Vector* ypS, N_Vector* resS, void* user, N_Vector, N_Vector, N_Vector) {
     auto* self = static_cast<Impl*>(user);
@@ -225,7 +225,7 @@ struct IdaSolver::Impl {
   }
 
   /// (dE/dt) lambda = (E(q + e q') - E(q - e q')) lambda / (2 e) into `out` (central
-  /// difference along the motion, Nocedal & Wright 2006, sec. 8.1; E = dF/dy' depends on q
+  /// difference along the motion, NocedalWright2006, sec. 8.1; E = dF/dy' depends on q
   /// only, through M(q)): zero where q' = 0 or M is constant. Allocates nothing.
   void rateJacobianDerivativeProduct(double t, const double* y, const double* yp, const double* lambda,
                                      VecX& out) {
@@ -247,8 +247,9 @@ struct IdaSolver::Impl {
   long maxSteps = 500;  ///< IntegratorOptions::maxSteps (the backward problems' too)
   int positions = 0;  ///< number of positions (the first entries of y)
 
-  /// The adjoint residual E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y^T (IDAS
-  /// guide, "Adjoint sensitivity analysis"; E = dF/dy' symmetric for GGL: diag(I, M, 0, 0)).
+  /// The adjoint residual E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y^T (IdasGuide,
+  /// "Adjoint sensitivity analysis"; CaoLiPetzoldSerban2003; E = dF/dy' symmetric for GGL:
+  /// diag(I, M, 0, 0)).
   static int backwardResidual(realtype t, N_Vector y, N_Vector yp, N_Vector yB, N_Vector ypB, N_Vector rB,
                               void* user) {
     auto* b = static_cast<Backward*>(user);
@@ -279,7 +280,7 @@ struct IdaSolver::Impl {
   }
 
   /// The backward Newton matrix dF_B/dlambda + cj_B dF_B/dlambda' = -(F_y - cj_B E)^T =
-  /// -J(-cj_B)^T (the (dE/dt) term, O(h) against cj_B E, left out).
+  /// -J(-cj_B)^T (the (dE/dt) term, O(h) against cj_B E, left out; IdasGuide).
   static int backwardJacobian(realtype t, realtype cjB, N_Vector y, N_Vector yp, N_Vector, N_Vector, N_Vector,
                               SUNMatrix JB, void* user, N_Vector, N_Vector, N_Vector) {
     auto* b = static_cast<Backward*>(user);
@@ -438,7 +439,7 @@ void IdaSolver::startSensitivities(const SensitivityProblem& sp) {
   d.cacheYp = VecX::Zero(n);
   d.check(IDASensInit(d.mem, ns, IDA_STAGGERED, &Impl::sensitivityResidual, d.yS, d.ypS), "IDASensInit");
   // p = NULL: the parameters enter through the user's sensitivity residual; pbar scales
-  // the error weights of the sensitivities (IDAS guide, IDASetSensParams).
+  // the error weights of the sensitivities (IdasGuide, IDASetSensParams).
   std::vector<realtype> pbar(sp.scales.data(), sp.scales.data() + ns);
   d.check(IDASetSensParams(d.mem, nullptr, pbar.data(), nullptr), "IDASetSensParams");
   N_Vector* atolS = N_VCloneVectorArray(ns, d.yy);
@@ -622,7 +623,7 @@ AdjointSolution IdaSolver::integrateAdjoint(const AdjointProblem& problem, doubl
     d.check(IDAGetQuadB(d.mem, b->which, &t, b->q), "IDAGetQuadB");
     out.lambda0.col(b->k) = Eigen::Map<const VecX>(N_VGetArrayPointer(b->y), n);
     out.lambdaRate0.col(b->k) = Eigen::Map<const VecX>(N_VGetArrayPointer(b->yp), n);
-    // IDAS's backward quadrature runs from T to t0: q(t0) = -int_{t0}^{T} rhs dt
+    // IDAS's backward quadrature runs from T to t0: q(t0) = -int_{t0}^{T} rhs dt (IdasGuide)
     out.integral.col(b->k) = -Eigen::Map<const VecX>(N_VGetArrayPointer(b->q), np);
   }
   return out;

@@ -317,7 +317,8 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     cols.resize(nv);
     for (int k = 0; k < nv; ++k) cols[k] = k;
   }
-  // 1. Newton with minimum-norm corrections in velocity space: dv = -G^+ g, q <- q (+) dv.
+  // 1. Newton with minimum-norm corrections in velocity space: dv = -G^+ g, q <- q (+) dv
+  //    (GolubVanLoan2013, sec. 5.5.4).
   const double scale = 1.0 + s.q.lpNorm<Eigen::Infinity>();
   const double tol = 1e-13 * scale;
   int it = 0;
@@ -391,7 +392,7 @@ ConsistentState computeConsistentState(const System& sys, double t0, const VecX&
     }
     for (size_t k = 0; k < cols.size(); ++k) s.v[cols[k]] = vr[k];
   }
-  // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v.
+  // 3. Accelerations and multipliers: M a + G^T lambda = Q, G a = f'' - v^T H v (Haug1989).
   computeAccelerations(sys, t0, s.q, s.v, s.a, s.lambda, s.released);
   if (released.detect) throwIfReleasedConflict(sys, t0, s, G);
   return s;

@@ -27,7 +27,7 @@ struct ConsistentState {
 
 /// 1. positions projected onto g(q, t0) = 0 (Newton, minimum-norm corrections),
 /// 2. velocities onto G v = -g_t (closest to v0 in the mass metric),
-/// 3. accelerations and multipliers from [M G^T; G 0][a; lambda] = [Q; -gamma].
+/// 3. accelerations and multipliers from [M G^T; G 0][a; lambda] = [Q; -gamma] (Haug1989).
 /// With released equations, 2. and 3. use the independent rows only (the released ones
 /// hold by their dependence on them) and lambda is 0 at the released rows.
 /// @throws ModelError naming the constraints if they are redundant or conflicting
@@ -46,7 +46,7 @@ void solveAugmented(const MatX& A, int n, const VecX& r1, const VecX& r2, VecX& 
 void solveAugmented(const MatX& M, const MatX& G, const VecX& r1, const VecX& r2, VecX& x, VecX& y);
 
 /// Accelerations and multipliers of the state (q, v) at time t, from the augmented
-/// system [M G^T; G 0][a; lambda] = [Q; f'' - v^T H v] (index-1 equations). At a
+/// system [M G^T; G 0][a; lambda] = [Q; f'' - v^T H v] (index-1 equations; Haug1989). At a
 /// singular position (G rank-deficient, its rows consistent) the accelerations are the
 /// unique mass-orthogonal projection and the multipliers the minimum-norm ones.
 /// `released` (ascending): equations left out of the system, their multipliers 0.

@@ -16,7 +16,7 @@ using LVec = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
 using LMat = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
 
 /// Coefficients (ascending powers) of d^(s-1)/dx^(s-1) [x^(s-1) (x - 1)^s], whose roots
-/// are the Radau IIA nodes (H&W IV.5, (5.3)).
+/// are the Radau IIA nodes (HairerWanner1996, IV.5, (5.3)).
 LVec radauPolynomial(int s) {
   LVec p = LVec::Zero(2 * s);  // x^(s-1) (x - 1)^s: degree 2s - 1
   long double binom = 1.0L;
@@ -97,7 +97,8 @@ RadauCoefficients compute(int s) {
   r.stages = s;
   r.pairs = (s - 1) / 2;
   const LVec c = radauNodes(s);
-  // A = Q V^-1 with V_ik = c_i^k and Q_ik = c_i^(k+1) / (k + 1): a_ij = int_0^c_i l_j (IV.5, (5.4))
+  // A = Q V^-1 with V_ik = c_i^k and Q_ik = c_i^(k+1) / (k + 1): a_ij = int_0^c_i l_j
+  // (HairerWanner1996, IV.5, (5.4))
   LMat V(s, s), Q(s, s), C(s, s);
   for (int i = 0; i < s; ++i) {
     long double xp = 1.0L;
@@ -115,7 +116,7 @@ RadauCoefficients compute(int s) {
   r.W = W.cast<double>();
   r.P = C.inverse().cast<double>();
 
-  // A^-1 has one real eigenvalue gamma and pairs alpha +- i beta (IV.8, (8.15)). With the
+  // A^-1 has one real eigenvalue gamma and pairs alpha +- i beta (HairerWanner1996, IV.8, (8.15)). With the
   // eigenvector v = a + i b of alpha + i beta (beta > 0): W a = alpha a - beta b and
   // W b = beta a + alpha b, so T = [v_gamma, a_1, b_1, ...] gives the block diagonal (8.16).
   const Eigen::MatrixXd Wd = r.W;
@@ -139,7 +140,8 @@ RadauCoefficients compute(int s) {
   }
   r.Tinv = r.T.inverse();
 
-  // Embedded method of order s (IV.8, (8.17)): yhat_1 = y0 + h (gamma0 y'_0 + sum bhat_i Y'_i)
+  // Embedded method of order s (HairerWanner1996, IV.8, (8.17)):
+  // yhat_1 = y0 + h (gamma0 y'_0 + sum bhat_i Y'_i)
   // with gamma0 = 1/gamma and sum_i bhat_i c_i^(q-1) + gamma0 0^(q-1) = 1/q, q = 1..s;
   // yhat_1 - y_1 = gamma0 h y'_0 + sum_j d_j Z_j with d = W^T (bhat - b) (8.18).
   LVec rhs(s);

@@ -24,20 +24,21 @@ using VecXc = Eigen::VectorXcd;
 using MatXc = Eigen::MatrixXcd;
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-// Simplified Newton: at most 7 iterations per step (H&W IV.8, p. 121: "nit = 7").
+// Simplified Newton: at most 7 iterations per step (HairerWanner1996, IV.8, p. 121: "nit = 7").
 constexpr int kMaxNewtonIterations = 7;
-// Newton diverges if the contraction rate theta_k = ||dZ_k|| / ||dZ_k-1|| reaches this.
+// Newton diverges if the contraction rate theta_k = ||dZ_k|| / ||dZ_k-1|| (HairerWanner1996, IV.8)
+// reaches this.
 constexpr double kDivergenceRate = 0.99;
-// Step-size controller (H&W IV.8, (8.21)-(8.25)): safety factor, and h_new/h within
+// Step-size controller (HairerWanner1996, IV.8, (8.21)-(8.25)): safety factor, and h_new/h within
 // [1/5, 8].
 constexpr double kSafety = 0.9;
 constexpr double kMaxGrowth = 8.0;
 constexpr double kMaxShrink = 5.0;
 // After a Newton failure the step is halved; a step rejected by the error test at the
-// very first step (when no error history exists) is cut by ten (H&W IV.8, p. 124).
+// very first step (when no error history exists) is cut by ten (HairerWanner1996, IV.8, p. 124).
 constexpr double kNewtonFailureShrink = 0.5;
 constexpr double kFirstRejectShrink = 0.1;
-// Jacobian reuse (H&W IV.8, p. 124): keep J0, M0 for the next step if the last Newton
+// Jacobian reuse (HairerWanner1996, IV.8, p. 124): keep J0, M0 for the next step if the last Newton
 // iteration contracted at least this fast.
 constexpr double kThetaJacobianReuse = 0.1;
 // ...and keep h itself (so the LU factors too) if the new h/h lies in this range.
@@ -57,7 +58,7 @@ constexpr long kStepsBeforeOrderUp = 10;
 constexpr double kRatioOrderUpLow = 0.8, kRatioOrderUpHigh = 1.3;
 
 // ---------------------------------------------------------------------------------
-// The linear algebra of the transformed Newton systems (H&W IV.8, (8.16), for s stages):
+// The linear algebra of the transformed Newton systems (HairerWanner1996, IV.8, (8.16), for s stages):
 //   E_0 = J0 + (gamma / h) M0                     (real)
 //   E_k = J0 + ((alpha_k - i beta_k) / h) M0      (complex, k = 1 .. (s-1)/2)
 // with J0 = dF/dy and M0 = dF/dy' at the point of the last Jacobian evaluation.
@@ -291,9 +292,9 @@ struct StageSettings {
   const RadauCoefficients* k = nullptr;
   // The estimate is of order s + 1 in h while the method has order 2s - 1: the tolerances
   // are mapped to rtol' = 0.1 rtol^((s+1)/(2s)), atol' = atol rtol'/rtol so that the global
-  // error comes out near rtol (tolerance proportionality; H&W IV.8, p. 124, for s = 3).
+  // error comes out near rtol (tolerance proportionality; HairerWanner1996, IV.8, p. 124, for s = 3).
   double rtol = 0.0, atolFactor = 0.0;
-  // Newton stopping tolerance kappa Tol in the rtol'-weighted norm (H&W IV.8, (8.14) and
+  // Newton stopping tolerance kappa Tol in the rtol'-weighted norm (HairerWanner1996, IV.8, (8.14) and
   // p. 121: max(10 eps / rtol', min(0.03, sqrt(rtol')))), here with kappa Tol scaled by
   // rtol / rtol': the iteration error is held below the user's tolerance, not the
   // transformed one, because the dense-output estimate (judged against the user's
@@ -301,10 +302,10 @@ struct StageSettings {
   // error (measured on the Bari crank at 13th order: 72,000 steps at rtol 1e-5 against
   // 622 with the iteration held 1000 times tighter; docs/formulations.md).
   double newtonTol = 0.0;
-  // H&W's own: max(10 eps / rtol', min(0.03, sqrt(rtol'))); an iteration whose increments
+  // Hairer & Wanner's own: max(10 eps / rtol', min(0.03, sqrt(rtol'))); an iteration whose increments
   // stall (at round-off) below it counts as converged (RadauSolver::Impl::newton).
   double newtonTolStandard = 0.0;
-  // At most 7 simplified Newton iterations with 3 stages (H&W IV.8, p. 121), two more per
+  // At most 7 simplified Newton iterations with 3 stages (HairerWanner1996, IV.8, p. 121), two more per
   // two more stages (the higher orders start from a less accurate extrapolation).
   int maxNewton = 0;
   double errorExponent = 0.0;  // 1 / (s + 1): the step-size controller's exponent
@@ -364,7 +365,7 @@ struct RadauSolver::Impl {
   bool factored = false;
   double hFactored = 0.0;
   int sFactored = 0;
-  double eta = 1.0;    // eta = theta / (1 - theta) of the last converged Newton iteration
+  double eta = 1.0;    // eta = theta / (1 - theta) of the last converged Newton iteration (HairerWanner1996, IV.8)
   double theta = 1.0;  // contraction rate of the last Newton iteration
 
   // Step-size controller state.
@@ -445,7 +446,7 @@ struct RadauSolver::Impl {
   }
 
   /// Starting values of Newton: the last step's collocation polynomial (of its own stage
-  /// count) extrapolated to t + c_i h (H&W IV.8, p. 120), Z_i = u(t + c_i h) - y, with
+  /// count) extrapolated to t + c_i h (HairerWanner1996, IV.8, p. 120), Z_i = u(t + c_i h) - y, with
   /// y = u(tPoly + hPoly) = yPoly + Zpoly_sPoly; at the first step Z_i = c_i h y'_0.
   void predict(double hh) {
     const RadauCoefficients& k = *cur().k;
@@ -461,7 +462,7 @@ struct RadauSolver::Impl {
     }
   }
 
-  /// h Y'_i = sum_j W_ij Z_j, i.e. out = (1/h) sum_j W_ij Z_j.
+  /// h Y'_i = sum_j W_ij Z_j, i.e. out = (1/h) sum_j W_ij Z_j (HairerWanner1996, IV.8).
   void stageDerivative(const RadauCoefficients& k, int i, double hh, VecX& out) const {
     out = (k.W(i, 0) / hh) * Z[0];
     for (int j = 1; j < s; ++j) out += (k.W(i, j) / hh) * Z[j];
@@ -475,8 +476,8 @@ struct RadauSolver::Impl {
   };
 
   /// The iteration stopped contracting (round-off) or ran out of iterations above the
-  /// tighter target, but its last iterate passed H&W's own test (or the increments stall
-  /// below it): converged, as H&W would have stopped.
+  /// tighter target, but its last iterate passed Hairer & Wanner's own test (or the increments stall
+  /// below it): converged, as Hairer & Wanner would have stopped.
   NewtonResult stalledAtRoundOff(NewtonResult r, double rate) {
     eta = rate < 1.0 ? rate / (1.0 - rate) : 1.0;
     r.converged = true;
@@ -484,15 +485,15 @@ struct RadauSolver::Impl {
   }
 
   /// Simplified Newton on F(t + c_i h, y + Z_i, (1/h) sum_j W_ij Z_j) = 0, i = 1..s, with
-  /// the frozen matrix I (x) J0 + (1/h) W (x) M0 transformed by T (H&W IV.8, (8.13)-(8.16)).
+  /// the frozen matrix I (x) J0 + (1/h) W (x) M0 transformed by T (HairerWanner1996, IV.8, (8.13)-(8.16)).
   NewtonResult newton(double hh) {
     const StageSettings& ss = cur();
     const RadauCoefficients& k = *ss.k;
     NewtonResult r;
     for (int i = 0; i < n; ++i) scaleNewton[i] = atolI[i] + ss.rtol * std::abs(y[i]);
-    double etaK = std::pow(std::max(eta, kEps), 0.8);  // H&W IV.8, p. 121 (first iteration)
+    double etaK = std::pow(std::max(eta, kEps), 0.8);  // HairerWanner1996, IV.8, p. 121 (first iteration)
     double normPrev = 0.0;
-    bool metStandard = false;  // the current Z passed H&W's own stopping test
+    bool metStandard = false;  // the current Z passed Hairer & Wanner's own stopping test
     for (int it = 1; it <= ss.maxNewton; ++it) {
       r.iterations = it;
       ++st.nonlinearIterations;
@@ -507,6 +508,7 @@ struct RadauSolver::Impl {
         }
       }
       // right-hand sides V = -(T^-1 (x) I) F, then E_0 V_0 = rhs_0, E_p (V_2p-1 + i V_2p) = ...
+      // (HairerWanner1996, IV.8, (8.16))
       for (int q = 0; q < s; ++q) {
         V[q] = -k.Tinv(q, 0) * Fstage[0];
         for (int i = 1; i < s; ++i) V[q] -= k.Tinv(q, i) * Fstage[i];
@@ -529,7 +531,7 @@ struct RadauSolver::Impl {
         return r;
       }
       if (it >= 2) {
-        const double thetaK = norm / normPrev;  // H&W IV.8, (8.11)
+        const double thetaK = norm / normPrev;  // HairerWanner1996, IV.8, (8.11)
         r.rate = thetaK;
         theta = thetaK;
         if (thetaK >= kDivergenceRate) {
@@ -537,9 +539,9 @@ struct RadauSolver::Impl {
           r.failure = "the Newton iteration diverges";
           return r;
         }
-        etaK = thetaK / (1.0 - thetaK);  // (8.12)
-        // predicted error after the remaining iterations (H&W IV.8, p. 121), against H&W's
-        // own tolerance: the tighter target never fails an iteration H&W would accept
+        etaK = thetaK / (1.0 - thetaK);  // HairerWanner1996, IV.8, (8.12)
+        // predicted error after the remaining iterations (HairerWanner1996, IV.8, p. 121), against
+        // Hairer & Wanner's own tolerance: the tighter target never fails an iteration they would accept
         if (etaK * norm * std::pow(thetaK, ss.maxNewton - it) > ss.newtonTolStandard) {
           if (metStandard) return stalledAtRoundOff(r, thetaK);
           r.failure = "the Newton iteration converges too slowly";
@@ -547,12 +549,12 @@ struct RadauSolver::Impl {
         }
       }
       for (int i = 0; i < s; ++i) Z[i] += dZ[i];
-      if (etaK * norm <= ss.newtonTol) {  // stopping criterion eta_k ||dZ_k|| <= kappa Tol (8.14)
+      if (etaK * norm <= ss.newtonTol) {  // stopping criterion eta_k ||dZ_k|| <= kappa Tol (HairerWanner1996, (8.14))
         eta = etaK;
         r.converged = true;
         return r;
       }
-      metStandard = etaK * norm <= ss.newtonTolStandard;  // H&W would stop here
+      metStandard = etaK * norm <= ss.newtonTolStandard;  // Hairer & Wanner would stop here
       normPrev = norm;
     }
     if (metStandard) return stalledAtRoundOff(r, theta);
@@ -561,7 +563,7 @@ struct RadauSolver::Impl {
   }
 
   /// Stiffly filtered error estimate (derived in docs/formulations.md): for M y' = f the
-  /// estimate of H&W IV.8, (8.19)-(8.20) is err = (I - h gamma0 J)^-1 (yhat_1 - y_1); for
+  /// estimate of HairerWanner1996, IV.8, (8.19)-(8.20) is err = (I - h gamma0 J)^-1 (yhat_1 - y_1); for
   /// F(t, y, y') = 0 with E_0 = J0 + (gamma/h) M0 this is
   ///   err = E_0^-1 M0 (y'_0 + (gamma/h) sum_j d_j Z_j).
   /// If err >= 1 at the first step or after a rejection, the improved estimate of
@@ -683,7 +685,7 @@ struct RadauSolver::Impl {
       }
       const double e = estimateError(hh);
       // step-size proposal h_new = h * fac * err^(-1/(s+1)) with fac decreasing with the
-      // Newton iterations (H&W IV.8, (8.21) and p. 124)
+      // Newton iterations (HairerWanner1996, IV.8, (8.21) and p. 124)
       const int nit = cur().maxNewton;
       const double fac = std::min(kSafety, kSafety * (2 * nit + 1) / (2 * nit + nr.iterations));
       double quot = std::clamp(std::pow(e, cur().errorExponent) / fac, 1.0 / kMaxGrowth, kMaxShrink);
@@ -710,11 +712,11 @@ struct RadauSolver::Impl {
     tPoly = t;
     hPoly = hh;
     havePoly = true;
-    y += Z[s - 1];                      // stiffly accurate: y_1 = Y_s
+    y += Z[s - 1];                      // stiffly accurate: y_1 = Y_s (HairerWanner1996)
     stageDerivative(k, s - 1, hh, yp);  // u'(t_1) = Y'_s
     t = hitsStop ? tStop : t + hh;
     jacobianAtStepStart = false;
-    // predictive controller (Gustafsson; H&W IV.8, (8.25)): h_new = fac h_n err_n^(-1/(s+1))
+    // predictive controller (Gustafsson; HairerWanner1996, IV.8, (8.25)): h_new = fac h_n err_n^(-1/(s+1))
     // (h_n / h_n-1) (err_n-1 / err_n)^(1/(s+1)); the smaller of the two proposals is taken
     if (hAccepted > 0.0) {
       const double quotGus = std::clamp(
@@ -736,7 +738,7 @@ struct RadauSolver::Impl {
     if (fixedStep <= 0.0) chooseStages(nr, ratio, wasRejected);
   }
 
-  /// The order for the next step (H&W 1999, section 5: the contraction of the simplified
+  /// The order for the next step (HairerWanner1999, sec. 5: the contraction of the simplified
   /// Newton iteration as the signal; thresholds and the waiting time are this solver's,
   /// docs/formulations.md): a Newton iteration that contracts fast says the step is
   /// limited by accuracy, not by stiffness, where a higher order takes longer steps; one

@@ -4,9 +4,8 @@
 /// Newton on the collocation equations with the matrix transformed into one real and
 /// (s-1)/2 complex systems, a stiffly filtered embedded error estimate, the predictive
 /// (Gustafsson) step-size controller and continuous output from the collocation
-/// polynomial. Written from the formulas of Hairer & Wanner, Solving Ordinary Differential
-/// Equations II (2nd ed.), sections IV.5, IV.8, VI.1 and VII.4, and Hairer & Wanner,
-/// J. Comput. Appl. Math. 111 (1999) 93-111 (the variable order); the method, the order
+/// polynomial. Written from the formulas of HairerWanner1996, sections IV.5, IV.8, VI.1 and
+/// VII.4, and HairerWanner1999 (the variable order); the method, the order
 /// choice and what is reused between steps are described in docs/formulations.md.
 #pragma once
 

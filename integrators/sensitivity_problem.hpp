@@ -13,26 +13,26 @@
 namespace flexmbd {
 
 /// Relative step of the engine's central differences: eps^(1/3) balances their truncation
-/// error h^2 |f^(3)| / 6 against the round-off eps |f| / h (Nocedal & Wright 2006, sec. 8.1).
+/// error h^2 |f^(3)| / 6 against the round-off eps |f| / h (NocedalWright2006, sec. 8.1).
 inline const double kCentralDifferenceFraction = std::cbrt(2.220446049250313e-16);
 
 /// The step x + h - x actually taken from x (exact in floating point, so the difference
-/// quotient divides by the step its points are apart; Press et al. 2007, sec. 5.7).
+/// quotient divides by the step its points are apart; Press2007, sec. 5.7).
 inline double stepTaken(double x, double h) {
   const volatile double shifted = x + h;
   return shifted - x;
 }
 
 /// The five-point central difference of the parameter derivatives (fourth order,
-/// Abramowitz & Stegun 1964, eq. 25.3.6): f'(p) = sum_j w_j f(p + o_j h) / h + h^4 f^(5) / 30,
+/// AbramowitzStegun1964, eq. 25.3.6): f'(p) = sum_j w_j f(p + o_j h) / h + h^4 f^(5) / 30,
 /// with round-off sqrt(2 (8^2 + 1)) / 12 eps |f| / h = 0.95 eps |f| / h. Its points o_j h:
 inline constexpr int kStencilPoints = 4;
 inline constexpr std::array<double, kStencilPoints> kStencilOffsets{1.0, -1.0, 2.0, -2.0};
 /// and weights w_j (the same order).
 inline constexpr std::array<double, kStencilPoints> kStencilWeights{8.0 / 12.0, -8.0 / 12.0, -1.0 / 12.0, 1.0 / 12.0};
 
-/// sum_j w_j f_j / h for the values f_j = at(j) at the stencil's points (a number or an
-/// Eigen vector or matrix; those allocate).
+/// sum_j w_j f_j / h (AbramowitzStegun1964, eq. 25.3.6) for the values f_j = at(j) at the
+/// stencil's points (a number or an Eigen vector or matrix; those allocate).
 template <class Value, class At>
 Value stencilDerivative(double h, At&& at) {
   Value d = (kStencilWeights[0] / h) * at(0);
@@ -74,14 +74,14 @@ class ParameterDerivatives {
 };
 
 /// The forward sensitivity problem of one run: s_i = dy/dp_i solves
-/// F_y s_i + F_y' s_i' + F_p_i = 0 (IDAS guide, "Forward sensitivity analysis").
+/// F_y s_i + F_y' s_i' + F_p_i = 0 (IdasGuide, "Forward sensitivity analysis"; HindmarshEtAl2005).
 struct SensitivityProblem {
   ParameterDerivatives* derivatives = nullptr;  ///< dF/dp; outlives the integrator
   MatX s0;   ///< consistent initial sensitivities dy0/dp (n x count)
   MatX sp0;  ///< their rates dy0'/dp (n x count)
   /// Typical magnitude of each parameter (count): the sensitivity s_i enters the error
   /// test with the state's relative tolerance and absolute tolerances atolS.col(i), the
-  /// state's ones divided by |scale_i| (IDAS guide, "estimated" sensitivity tolerances), so
+  /// state's ones divided by |scale_i| (IdasGuide, "estimated" sensitivity tolerances), so
   /// that p_i s_i is controlled like y.
   VecX scales;
   /// Absolute tolerances of the sensitivities (n x count).

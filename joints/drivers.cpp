@@ -24,7 +24,7 @@ JointAngleDriver::JointAngleDriver(std::string name, BodyIndex bodyI, const Vec2
     : LawDriver<TwoPointConstraint>(std::move(law), std::move(name), bodyI, pointI, bodyJ, pointJ) {}
 
 void JointAngleDriver::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  // h = phi_j - phi_i
+  // h = phi_j - phi_i (Haug1989)
   const PointPair& p = pair(bodies, withHessians, out.work);
   out.h.setConstant(1, p.phiJ - p.phiI);
   out.G = p.JphiJ - p.JphiI;
@@ -43,7 +43,7 @@ JointDisplacementDriver::JointDisplacementDriver(std::string name, BodyIndex bod
 
 void JointDisplacementDriver::evaluate(const BodyStates& bodies, bool withHessians,
                                        ConstraintEvaluation& out) const {
-  // h = a_w^T (r_j - r_i)
+  // h = a_w^T (r_j - r_i) (Haug1989)
   const PointPair& p = pair(bodies, withHessians, out.work);
   double s = 0.0;
   out.H.resize(1);

@@ -1,5 +1,6 @@
 /// @file
-/// Drivers: rheonomic constraints h(q) - f(t) = 0 that prescribe a motion in time.
+/// Drivers: rheonomic constraints h(q) - f(t) = 0 that prescribe a motion in time (driving
+/// constraints, Haug1989).
 #pragma once
 
 #include "core/errors.hpp"
@@ -42,7 +43,7 @@ class LawDriver : public Base {
 };
 
 /// Prescribes coordinate k of one body (e.g. a frame angle theta or position x):
-/// h = q_k, f = law(t).
+/// h = q_k, f = law(t) (Haug1989).
 class BodyCoordinateDriver final : public LawDriver<Constraint> {
  public:
   BodyCoordinateDriver(std::string name, BodyIndex body, int coordinate, std::string coordinateName,
@@ -57,7 +58,7 @@ class BodyCoordinateDriver final : public LawDriver<Constraint> {
 };
 
 /// Prescribes the relative angle phi_j - phi_i of a revolute joint's two points:
-/// h = phi_j - phi_i, f = law(t).
+/// h = phi_j - phi_i, f = law(t) (Haug1989).
 class JointAngleDriver final : public LawDriver<TwoPointConstraint> {
  public:
   JointAngleDriver(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
@@ -67,7 +68,7 @@ class JointAngleDriver final : public LawDriver<TwoPointConstraint> {
 };
 
 /// Prescribes the displacement of a prismatic joint: s = a_w^T (r_j - r_i), with a_w the
-/// sliding axis carried by body i; f = law(t).
+/// sliding axis carried by body i; f = law(t) (Haug1989).
 class JointDisplacementDriver final : public LawDriver<TwoPointConstraint> {
  public:
   JointDisplacementDriver(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,

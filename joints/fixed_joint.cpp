@@ -10,7 +10,7 @@ FixedJoint::FixedJoint(std::string name, BodyIndex bodyI, const Vec2& pointI, Bo
 }
 
 void FixedJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  // h = (r_j - r_i, phi_j - phi_i - phi0)
+  // h = (r_j - r_i, phi_j - phi_i - phi0) (Haug1989)
   const PointPair& p = pair(bodies, withHessians, out.work);
   out.h.resize(3);
   out.h << p.d, p.phiJ - p.phiI - referenceAngle_;

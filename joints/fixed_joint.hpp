@@ -6,7 +6,7 @@
 
 namespace flexmbd {
 
-/// h = [r_j - r_i; phi_j - phi_i - phi0] = 0 (3 equations); phi0 is the relative
+/// h = [r_j - r_i; phi_j - phi_i - phi0] = 0 (3 equations; Haug1989); phi0 is the relative
 /// angle of the assembled model (addFixedJoint of builders/planar_builders.hpp takes it
 /// from the initial positions).
 class FixedJoint final : public TwoPointConstraint {

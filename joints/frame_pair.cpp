@@ -39,7 +39,8 @@ FramePair::FramePair(const BodyStates& bodies, const JointFrame& frameI, const J
 Vec3 FramePair::axisI(int a) const { return w_.fi.A * frameI_.axes.col(a); }
 Vec3 FramePair::axisJ(int b) const { return w_.fj.A * frameJ_.axes.col(b); }
 
-// a frame axis as a world vector u = A c with its Jacobian -u~ Jw (zero on the other body)
+// a frame axis as a world vector u = A c with its Jacobian -u~ Jw (zero on the other body;
+// Haug1989, ch. 9)
 void FramePair::axis(bool onI, int k, Vec3& u, Mat3X& J) const {
   const FrameKinematics& f = onI ? w_.fi : w_.fj;
   u = onI ? axisI(k) : axisJ(k);

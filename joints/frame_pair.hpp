@@ -1,6 +1,6 @@
 /// @file
 /// Relative kinematics of two body frames and the three scalar primitives spatial joints
-/// and drivers are written in (Haug 1989, ch. 9): with d = r_j - r_i,
+/// and drivers are written in (Haug1989, ch. 9): with d = r_j - r_i,
 ///   gap(k)        = e_k . d        (world axis k)
 ///   axisGap(a)    = x_a^i . d      (along axis a of frame i)
 ///   axisAxis(a,b) = x_a^i . x_b^j  (axes of the two frames)

@@ -13,7 +13,7 @@ namespace flexmbd {
 /// Allocates nothing once `out` has been filled for as many coordinates.
 void makePointPair(const PointKinematics& pi, const PointKinematics& pj, bool withHessians, PointPair& out);
 
-/// Scalar s = a_w^T d with a_w = A(phi_i) a the body-i axis `a` carried by the material
+/// Scalar s = a_w^T d (Haug1989) with a_w = A(phi_i) a the body-i axis `a` carried by the material
 /// angle at point i; its gradient and, if hessian is given, its Hessian (used by
 /// prismatic joints and drivers). ds/dq = a_w^T D + (S a_w)^T d dphi_i/dq, and d2s/dq2
 /// follows by the product rule. `work` is a 1 x n row of working memory.

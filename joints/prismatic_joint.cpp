@@ -18,7 +18,7 @@ PrismaticJoint::PrismaticJoint(std::string name, BodyIndex bodyI, const Vec2& po
 }
 
 void PrismaticJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  // h = (a_w^T d, phi_j - phi_i - phi0) with a_w the normal to the sliding axis
+  // h = (a_w^T d, phi_j - phi_i - phi0) with a_w the normal to the sliding axis (Haug1989)
   const PointPair& p = pair(bodies, withHessians, out.work);
   double s = 0.0;
   out.H.resize(2);

@@ -7,7 +7,8 @@
 namespace flexmbd {
 
 /// h1 = n_w^T (r_j - r_i) = 0 with n_w = A(phi_i) S a the normal of the sliding axis a
-/// (body-i frame); h2 = phi_j - phi_i - phi0 = 0 (phi0: relative angle when assembled).
+/// (body-i frame); h2 = phi_j - phi_i - phi0 = 0 (phi0: relative angle when assembled;
+/// Haug1989).
 class PrismaticJoint final : public TwoPointConstraint {
  public:
   /// @throws InputError if the axis is zero or not finite.

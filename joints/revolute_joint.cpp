@@ -3,7 +3,7 @@
 namespace flexmbd {
 
 void RevoluteJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  // h = r_j - r_i
+  // h = r_j - r_i (Haug1989)
   const PointPair& p = pair(bodies, withHessians, out.work);
   out.h = p.d;
   out.G = p.D;
@@ -14,7 +14,7 @@ void RevoluteJoint::evaluate(const BodyStates& bodies, bool withHessians, Constr
 }
 
 VecX RevoluteJoint::reactions(const BodyStates&, const VecX& lambda) const {
-  // Constraint force on body j is -G_j^T lambda = force -lambda at point j.
+  // Constraint force on body j is -G_j^T lambda = force -lambda at point j (Haug1989).
   return Eigen::Vector3d(-lambda[0], -lambda[1], 0.0);
 }
 

@@ -6,7 +6,7 @@
 
 namespace flexmbd {
 
-/// h = r_j - r_i = 0 (2 equations).
+/// h = r_j - r_i = 0 (2 equations; Haug1989).
 class RevoluteJoint final : public TwoPointConstraint {
  public:
   using TwoPointConstraint::TwoPointConstraint;

@@ -41,7 +41,8 @@ class SpatialJointAngleDriver final : public LawDriver<FramePairConstraint> {
   void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
 };
 
-/// h = z_i . (r_j - r_i): the displacement of frame j's origin along the z axis of frame i.
+/// h = z_i . (r_j - r_i): the displacement of frame j's origin along the z axis of frame i
+/// (FramePair::axisGap, Haug1989, ch. 9).
 class SpatialJointDisplacementDriver final : public LawDriver<FramePairConstraint> {
  public:
   SpatialJointDisplacementDriver(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,

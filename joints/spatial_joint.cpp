@@ -82,7 +82,7 @@ VecX SpatialJoint::reactions(const BodyStates& bodies, const VecX& lambda) const
   const FrameKinematics& fi = ev.work.fi;
   const FrameKinematics& fj = ev.work.fj;
   const int ni = fi.numVelocities(), nj = fj.numVelocities();
-  // generalised constraint force on a body: -G^T lambda over its columns; the wrench
+  // generalised constraint force on a body: -G^T lambda over its columns (Haug1989); the wrench
   // (F, M) at the joint point that gives it: [Jr^T Jw^T] [F; M] = Q
   const bool onJ = nj > 0;
   const FrameKinematics& f = onJ ? fj : fi;

@@ -15,7 +15,7 @@ enum class SpatialJointType { Spherical, Revolute, Prismatic, Cylindrical, Unive
 const char* toString(SpatialJointType type);
 
 /// The joint's equations, each one of three primitives of the frames i (on body i) and j
-/// (Haug 1989, ch. 9): d = r_j - r_i,
+/// (Haug1989, ch. 9): d = r_j - r_i,
 ///   Gap(k):       e_k . d = 0            (world axis k: the points coincide along it)
 ///   AxisGap(a):   x_a^i . d = 0          (no relative motion along axis a of frame i)
 ///   AxisAxis(a,b): x_a^i . x_b^j = 0     (axes stay perpendicular: rotation locked)

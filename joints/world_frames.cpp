@@ -29,7 +29,7 @@ Mat3 frameAxesFromZ(const Vec3& zIn, const Vec3* xHint, const std::string& who) 
   Vec3 x;
   if (xHint) {
     const Vec3 hint = unitDirection(*xHint, who + ": x_axis");
-    x = hint - z.dot(hint) * z;  // Gram-Schmidt: the part of the hint normal to z
+    x = hint - z.dot(hint) * z;  // Gram-Schmidt (GolubVanLoan2013): the part of the hint normal to z
     if (!(x.norm() > 1e-9)) {
       throw InputError(who + ": x_axis must not be parallel to axis (expected a direction across the axis)");
     }
@@ -57,7 +57,7 @@ JointFrame worldJointFrame(const Vec3& point, const Vec3& axis, const Vec3* xHin
 JointFrame bodyFrameFromWorld(const Body& body, const JointFrame& world, const std::string& who) {
   const BodyPose pose = spatialBodyPose(body, body.initialCoordinates(), who);
   JointFrame f;
-  // r = R + A u  =>  u = A^T (r - R); world axes C = A C_body  =>  C_body = A^T C
+  // r = R + A u  =>  u = A^T (r - R); world axes C = A C_body  =>  C_body = A^T C (Nikravesh1988)
   f.point = pose.orientation.transpose() * (world.point - pose.position);
   f.axes = pose.orientation.transpose() * world.axes;
   body.resolvePoint(f.point, who);  // a flexible body: the point must be a node (throws naming `who`)

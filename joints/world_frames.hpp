@@ -30,7 +30,7 @@ struct BodyPose {
 BodyPose spatialBodyPose(const Body& body, const ConstVecRef& q, const std::string& who);
 
 /// The axes (columns x, y, z, world axes) of a frame with z along `z`: x is `xHint`
-/// made perpendicular to z (Gram-Schmidt), or without a hint the world axis least
+/// made perpendicular to z (Gram-Schmidt, GolubVanLoan2013), or without a hint the world axis least
 /// aligned with z made perpendicular; y = z x x.
 /// @throws InputError naming `who` if z or xHint cannot be normalised (directionProblem,
 ///         core/magnitude_checks.hpp: not finite, zero, or shorter than 1e-100), or xHint

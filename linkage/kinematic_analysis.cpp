@@ -121,7 +121,7 @@ KinematicAnalysis::Correction KinematicAnalysis::correct(double alpha, VecX& X, 
   VecX zeta = linkage_.deformations(X);  // residual of the exact deformation parameters
   c.residual = maxAbs(zeta);
   while (c.residual > settings_.tolerance && c.iterations < settings_.maxIterations) {
-    VecX du;  // u* = -(D L1)^-1 zeta, eq. 27
+    VecX du;  // u* = -(D L1)^-1 zeta, Doc000, eq. 27
     if (frozen) {
       du = -frozenLu.solve(zeta);
     } else {
@@ -156,12 +156,12 @@ KinematicAnalysis::TransferFunctions KinematicAnalysis::transferFunctions(const 
   const Eigen::PartialPivLU<MatX> lu(A);
   const VecX rates = linkage_.inputRates();
   tf.first = VecX::Zero(X.size());
-  const VecX x1 = -lu.solve(B * rates);  // eq. 22
+  const VecX x1 = -lu.solve(B * rates);  // Doc000, eq. 22
   for (std::size_t j = 0; j < u.size(); ++j) tf.first[u[j]] = x1[j];
   for (std::size_t j = 0; j < in.size(); ++j) tf.first[in[j]] = rates[j];
 
   // D X' = 0 along the motion; differentiating once more, D X'' + (dD/dalpha) X' = 0
-  // with X''_2 = 0: x''1 = -(D L1)^-1 (dD/dalpha) X' (eq. 23).
+  // with X''_2 = 0: x''1 = -(D L1)^-1 (dD/dalpha) X' (Doc000, eq. 23).
   tf.second = VecX::Zero(X.size());
   const VecX x2 = -lu.solve(linkage_.secondDerivative(X, tf.first));
   for (std::size_t j = 0; j < u.size(); ++j) tf.second[u[j]] = x2[j];
@@ -178,8 +178,8 @@ KinematicState KinematicAnalysis::makeState(int step, double alpha, const VecX& 
   s.xpp = tf.second;
   s.rcond = tf.rcond;
   const double w = settings_.speed, wd = settings_.acceleration;
-  s.v = s.xp * w;                          // eq. 24
-  s.a = s.xpp * (w * w) + s.xp * wd;       // eq. 25
+  s.v = s.xp * w;                          // Doc000, eq. 24
+  s.a = s.xpp * (w * w) + s.xp * wd;       // Doc000, eq. 25
   s.iterations = c.iterations;
   s.residual = c.residual;
   return s;
@@ -334,7 +334,7 @@ KinematicSummary KinematicAnalysis::run(const std::function<void(const Kinematic
     const double alpha = settings_.start + k * h;
     pollStop(alpha);  // core/stop_request.hpp
     const double da = alpha - prev.alpha;
-    VecX X = prev.x + da * prev.xp + 0.5 * da * da * prev.xpp;  // eq. 26
+    VecX X = prev.x + da * prev.xp + 0.5 * da * da * prev.xpp;  // Doc000, eq. 26
     MatX frozen;
     if (settings_.corrector == CorrectorKind::ModifiedNewton) frozen = unknownJacobian(prev.x);
     const Correction c =

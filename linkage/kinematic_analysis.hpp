@@ -1,6 +1,6 @@
 /// @file
 /// Kinematic analysis of a planar linkage by the deformation-parameter method of source
-/// document 000 (Yamada & Tatsumi 1981, after van der Werff 1977): transfer functions,
+/// Doc000 (after VanDerWerff1977): transfer functions,
 /// Taylor predictor and Newton corrector on the exact deformation parameters, velocities
 /// and accelerations, and detection of singular positions (lock, dead and change points).
 #pragma once
@@ -25,7 +25,7 @@ struct KinematicSettings {
   double start = 0.0;              ///< alpha at step 0 (the initial geometry)
   double end = 2.0 * M_PI;         ///< alpha at the last step
   int steps = 60;                  ///< number of input steps (>= 1)
-  double speed = 1.0;              ///< alphadot at every step (eqs. 24-25)
+  double speed = 1.0;              ///< alphadot at every step (Doc000, eqs. 24-25)
   double acceleration = 0.0;       ///< alphaddot at every step
   double tolerance = 1e-13;        ///< max |eps| to reach (length units: eps2,3 carry l0)
   int maxIterations = 50;          ///< corrector iterations per step
@@ -44,10 +44,10 @@ struct KinematicState {
   int step = 0;
   double alpha = 0.0;
   VecX x;      ///< coordinates (Linkage2d::coordinateNames())
-  VecX xp;     ///< first-order transfer functions dX/dalpha (eq. 22)
-  VecX xpp;    ///< second-order transfer functions d2X/dalpha2 (eq. 23)
-  VecX v;      ///< dX/dt = X' alphadot (eq. 24)
-  VecX a;      ///< d2X/dt2 = X'' alphadot^2 + X' alphaddot (eq. 25)
+  VecX xp;     ///< first-order transfer functions dX/dalpha (Doc000, eq. 22)
+  VecX xpp;    ///< second-order transfer functions d2X/dalpha2 (Doc000, eq. 23)
+  VecX v;      ///< dX/dt = X' alphadot (Doc000, eq. 24)
+  VecX a;      ///< d2X/dt2 = X'' alphadot^2 + X' alphaddot (Doc000, eq. 25)
   int iterations = 0;      ///< corrector iterations (step 0: those of the assembly)
   double residual = 0.0;   ///< max |eps| at the converged position
   double rcond = 0.0;      ///< reciprocal condition number of the scaled D L1
@@ -99,7 +99,7 @@ class KinematicAnalysis {
     double residual = 0;  ///< max |eps| at the end
   };
   /// Sets the inputs of X to their values at alpha and corrects the unknowns, u* =
-  /// -(D L1)^-1 zeta (eq. 27), until max |eps| <= tolerance. `frozen`: D L1 to use at
+  /// -(D L1)^-1 zeta (Doc000, eq. 27), until max |eps| <= tolerance. `frozen`: D L1 to use at
   /// every iteration (modified Newton); null: D L1 at every iterate.
   Correction correct(double alpha, VecX& X, const MatX* frozen = nullptr) const;
 
@@ -108,8 +108,8 @@ class KinematicAnalysis {
     double rcond = 0.0;       ///< of D L1, columns scaled to unit max norm
     int determinantSign = 0;  ///< sign of det(D L1) (0: exactly singular)
   };
-  /// X' = L1 x'1 + L2 x'2 with x'1 = -(D L1)^-1 D L2 x'2 (eq. 22), and
-  /// X'' with x''1 = -(D L1)^-1 (dD/dalpha) X' (eq. 23, x''2 = 0: the inputs are affine
+  /// X' = L1 x'1 + L2 x'2 with x'1 = -(D L1)^-1 D L2 x'2 (Doc000, eq. 22), and
+  /// X'' with x''1 = -(D L1)^-1 (dD/dalpha) X' (Doc000, eq. 23, x''2 = 0: the inputs are affine
   /// in alpha). Meaningful only when rcond is not tiny.
   TransferFunctions transferFunctions(const VecX& X) const;
 
@@ -117,8 +117,8 @@ class KinematicAnalysis {
   /// corrector does not converge.
   KinematicState solve(double alpha, const VecX& guess) const;
 
-  /// Steps alpha from start to end (settings.steps steps): Taylor predictor (eq. 26),
-  /// corrector (eqs. 27-28), transfer functions, velocities and accelerations; every
+  /// Steps alpha from start to end (settings.steps steps): Taylor predictor (Doc000, eq. 26),
+  /// corrector (Doc000, eqs. 27-28), transfer functions, velocities and accelerations; every
   /// state goes to onStep. A singular position stops the run: it is located, reported
   /// in the summary (ok = false), and the states up to it have been passed on.
   KinematicSummary run(const std::function<void(const KinematicState&)>& onStep) const;

@@ -1,6 +1,6 @@
 /// @file
 /// Kinematics scene files: a planar linkage of rigid link elements, its inputs and the
-/// settings of the kinematic analysis (source document 000), read strictly (unknown keys,
+/// settings of the kinematic analysis (Doc000), read strictly (unknown keys,
 /// missing keys, wrong types, non-finite numbers are errors naming their location).
 /// The format is documented in docs/kinematics.md.
 #pragma once

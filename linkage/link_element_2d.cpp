@@ -30,9 +30,9 @@ LinkElement2d::Vec3 LinkElement2d::deformations(const Vec6& x) const {
   const double l = chordLength(x);
   const double beta = chordAngle(x);
   Vec3 eps;
-  eps[0] = l - l0_;                        // eq. 5
-  eps[1] = wrapAngle(x[2] - beta) * l0_;   // eq. 6
-  eps[2] = wrapAngle(beta - x[5]) * l0_;   // eq. 7
+  eps[0] = l - l0_;                        // Doc000, eq. 5
+  eps[1] = wrapAngle(x[2] - beta) * l0_;   // Doc000, eq. 6
+  eps[2] = wrapAngle(beta - x[5]) * l0_;   // Doc000, eq. 7
   return eps;
 }
 
@@ -49,7 +49,7 @@ LinkElement2d::Mat36 LinkElement2d::jacobian(const Vec6& x) const {
 
 LinkElement2d::Mat36 LinkElement2d::linearisedMatrix(double beta0, double l0) {
   const double c = std::cos(beta0), s = std::sin(beta0);
-  Mat36 d;  // eq. 15
+  Mat36 d;  // Doc000, eq. 15
   d << -c, -s, 0.0, c, s, 0.0,  //
       -s, c, l0, s, -c, 0.0,    //
       s, -c, 0.0, -s, c, -l0;
@@ -62,6 +62,7 @@ LinkElement2d::Vec3 LinkElement2d::secondDerivative(const Vec6& x, const Vec6& d
   const Vec2 e = d / l, n = perp(e);
   const Vec2 dd(dx[3] - dx[0], dx[4] - dx[1]);
   const double ed = e.dot(dd), nd = n.dot(dd);
+  // second derivatives of eq. 9 and eqs. 12-13 along dx (Doc000, eq. 23's dD/dalpha)
   const double d2l = nd * nd / l;              // d/dalpha (e . dd) with de = n dbeta
   const double d2beta = -2.0 * ed * nd / (l * l);  // d/dalpha (n . dd / l)
   return Vec3(d2l, -l0_ * d2beta, l0_ * d2beta);

@@ -1,6 +1,6 @@
 /// @file
-/// Planar rigid link element of the deformation-parameter formulation (source document
-/// 000: Yamada & Tatsumi 1981, after K. van der Werff, CMAME 11 (1977) 1-18).
+/// Planar rigid link element of the deformation-parameter formulation (Doc000, after
+/// VanDerWerff1977).
 #pragma once
 
 #include <string>
@@ -11,15 +11,15 @@
 
 namespace flexmbd {
 
-/// Two nodes; nodal coordinates x = [x1, y1, beta1, x2, y2, beta2] (eq. 2): the node
+/// Two nodes; nodal coordinates x = [x1, y1, beta1, x2, y2, beta2] (Doc000, eq. 2): the node
 /// positions and the orientation angles of the element at its two ends. Three
-/// deformation parameters (eqs. 5-7), all zero for a rigid link:
+/// deformation parameters (Doc000, eqs. 5-7), all zero for a rigid link:
 ///
 ///   eps1 = l - l0                      (elongation)
 ///   eps2 = (beta1 - beta) l0           (rotation of end 1 relative to the chord, x l0)
 ///   eps3 = (beta - beta2) l0           (rotation of end 2 relative to the chord, x l0)
 ///
-/// with l the current node distance and beta the chord angle (eqs. 9, 12, 13). Angle
+/// with l the current node distance and beta the chord angle (Doc000, eqs. 9, 12, 13). Angle
 /// differences are taken modulo 2 pi into (-pi, pi], so the end angles may be
 /// continuous coordinates (a crank angle running past 2 pi).
 ///
@@ -35,7 +35,7 @@ class LinkElement2d {
 
   double referenceLength() const { return l0_; }
 
-  /// Exact deformation parameters eps(x), eqs. 5-7.
+  /// Exact deformation parameters eps(x), Doc000, eqs. 5-7.
   Vec3 deformations(const Vec6& x) const;
 
   /// D(x) = d eps / d x at any x. With e = (c, s) the chord direction and l the current
@@ -43,21 +43,21 @@ class LinkElement2d {
   ///   row 1: [-c, -s, 0, c, s, 0]
   ///   row 2: (l0 / l) [-s, c, 0, s, -c, 0] + [0, 0, l0, 0, 0, 0]
   ///   row 3: (l0 / l) [s, -c, 0, -s, c, 0] + [0, 0, 0, 0, 0, -l0]
-  /// At a rigid position (l = l0) this is the linearised matrix D^0 of eq. 15.
+  /// At a rigid position (l = l0) this is the linearised matrix D^0 of Doc000, eq. 15.
   Mat36 jacobian(const Vec6& x) const;
 
-  /// Eq. 15 exactly as printed: D^0 for chord angle beta0 and length l0.
+  /// Doc000's eq. 15 exactly as printed: D^0 for chord angle beta0 and length l0.
   static Mat36 linearisedMatrix(double beta0, double l0);
 
   /// Second derivatives along a direction: component k is dx^T (d2 eps_k / dx2) dx,
   /// i.e. (dD/dalpha) x' for dx = x' (the term that makes the second-order transfer
-  /// functions, eq. 23). With dd = (dx2 - dx1, dy2 - dy1), n = (-s, c):
+  /// functions, Doc000, eq. 23). With dd = (dx2 - dx1, dy2 - dy1), n = (-s, c):
   ///   d2 l    = (n . dd)^2 / l,
   ///   d2 beta = -2 (e . dd)(n . dd) / l^2,
   /// so [d2 l, -l0 d2 beta, l0 d2 beta] (eps is linear in the end angles).
   Vec3 secondDerivative(const Vec6& x, const Vec6& dx) const;
 
-  /// Chord angle beta of eqs. 12-13 (atan2, in (-pi, pi]) and length l of eq. 9.
+  /// Chord angle beta of Doc000, eqs. 12-13 (atan2, in (-pi, pi]) and length l of eq. 9.
   static double chordAngle(const Vec6& x);
   static double chordLength(const Vec6& x);
 

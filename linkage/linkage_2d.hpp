@@ -1,5 +1,5 @@
 /// @file
-/// A planar linkage assembled from rigid link elements (source document 000): nodes
+/// A planar linkage assembled from rigid link elements (Doc000): nodes
 /// (fixed, free, or sliding along a line), links between them, and the prescribed
 /// input coordinates. The model of the kinematic analysis (linkage/kinematic_analysis).
 #pragma once
@@ -16,14 +16,14 @@ using NodeIndex = TypedIndex<struct LinkageNodeTag>;
 using LinkIndex = TypedIndex<struct LinkTag>;
 using InputIndex = TypedIndex<struct LinkageInputTag>;
 
-/// Coordinates of the linkage, stacked in one vector X (the x of document 000):
+/// Coordinates of the linkage, stacked in one vector X (the x of Doc000):
 ///   - a free node: x, y (2 coordinates);
 ///   - a slider node: s, its displacement along its line, position r = r0 + s d with d
-///     the unit direction (1 coordinate: eq. 29 of the document prescribes v3 = 0 for a
+///     the unit direction (1 coordinate: Doc000's eq. 29 prescribes v3 = 0 for a
 ///     slider on the x axis, which is the same thing);
 ///   - a fixed node: none;
 ///   - every link: the orientation angles beta1, beta2 of the link at its two ends
-///     (eq. 2; each link end has its own angle, so links meeting at a node are hinged).
+///     (Doc000, eq. 2; each link end has its own angle, so links meeting at a node are hinged).
 /// Every link contributes three deformation parameters that must vanish; the mobility
 /// is (number of coordinates) - 3 (number of links), and exactly that many inputs must
 /// be prescribed. Inputs are coordinates, each an affine function of the one input
@@ -107,7 +107,7 @@ class Linkage2d {
   /// coordinates.
   const std::vector<int>& unknownCoordinates() const { return unknown_; }
   const std::vector<int>& inputCoordinates() const { return prescribed_; }
-  /// dX_2 / dalpha: the ratios of the inputs (x'^2 of eq. 22).
+  /// dX_2 / dalpha: the ratios of the inputs (x'^2 of Doc000, eq. 22).
   VecX inputRates() const;
   /// "O2.x", "O3.s", "crank.beta1", ... for every coordinate.
   std::vector<std::string> coordinateNames() const;
@@ -125,7 +125,7 @@ class Linkage2d {
   VecX deformations(const VecX& X) const;
   /// D(X) = d eps / d X (numDeformations x numCoordinates, dense).
   MatX jacobian(const VecX& X) const;
-  /// (dD/dalpha) X' = [X'^T H_k X']_k (eq. 23's dD/dalpha applied to X').
+  /// (dD/dalpha) X' = [X'^T H_k X']_k (Doc000, eq. 23: its dD/dalpha applied to X').
   VecX secondDerivative(const VecX& X, const VecX& dX) const;
 
  private:

@@ -662,7 +662,7 @@ void bindScene(py::module_& m) {
           py::arg("progress") = false);
 }
 
-// ----- kinematic analysis of linkages (linkage/, document 000) -------------------------
+// ----- kinematic analysis of linkages (linkage/, Doc000) -------------------------------
 /// run_kinematics_text.
 void bindKinematics(py::module_& m) {
   m.def(
@@ -716,7 +716,7 @@ void bindKinematics(py::module_& m) {
       "A kinematics scene (docs/kinematics.md) analysed: (columns, table, summary dict)");
 }
 
-// ----- tensegrity structures (tensegrity/, document 001) --------------------------------
+// ----- tensegrity structures (tensegrity/, Doc001) --------------------------------------
 /// run_tensegrity_text.
 void bindTensegrity(py::module_& m) {
   m.def(

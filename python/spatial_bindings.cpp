@@ -146,7 +146,8 @@ std::array<double, 6> sixArg(const py::handle& h, const char* fn, const char* ar
   return a;
 }
 
-/// Shear modulus from exactly one of shear_modulus or poisson_ratio (isotropic: G = E / (2 (1 + nu))).
+/// Shear modulus from exactly one of shear_modulus or poisson_ratio (isotropic: G = E / (2 (1 + nu)),
+/// TimoshenkoGoodier1970).
 double shearModulusArg(double E, const py::handle& G, const py::handle& nu, const char* fn) {
   if (G.is_none() == nu.is_none()) throw InputError(std::string(fn) + ": give exactly one of shear_modulus or poisson_ratio");
   if (!G.is_none()) return positiveArg(G, fn, "shear_modulus");

@@ -100,7 +100,7 @@ IntegralOutput integralOutput(const std::string& spec, const Scene& base, const 
   } else {
     // Kreisselmeier-Steinhauser aggregate, a smooth maximum of c(t) over the run:
     // KS = ln(int exp(rho c) dt / T) / rho, dKS/dp = dG/dp / (rho G) with G = int exp(rho c) dt
-    // (Kreisselmeier & Steinhauser 1979; its continuous form, e.g. Poon & Martins 2007)
+    // (KreisselmeierSteinhauser1979; its continuous form, e.g. PoonMartins2007)
     out.integrand = [value, rho](const System& sys, double, const VecX& q, const VecX& v) {
       return std::exp(rho * value(sys, q, v));
     };

@@ -17,7 +17,8 @@ namespace flexmbd {
 
 /// An integral output of a scene, "KIND:COLUMN": KIND "integral" (int c dt),
 /// "integral_square" (int c^2 dt) or "ks" ("ks:COLUMN:RHO": the Kreisselmeier-Steinhauser
-/// aggregate ln(int exp(RHO c) dt / T) / RHO, a smooth maximum of c over the run, reported
+/// aggregate ln(int exp(RHO c) dt / T) / RHO (KreisselmeierSteinhauser1979; PoonMartins2007),
+/// a smooth maximum of c over the run, reported
 /// with its gradient) of a results column c of positions and velocities: a
 /// coordinate "<body>.<coord>", a velocity "<body>.<coord>_dot" or a column of the scene's
 /// "outputs" (point, deflection, energy, stress). The integrand is evaluated on the scene

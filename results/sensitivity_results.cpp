@@ -84,7 +84,8 @@ void sensitivityRow(const SensitivityScenes& scenes, const std::vector<std::stri
       resultRow(*scenes.perturbed[i][j], columns, sample.perturbed[i].at[j], rows[j]);
     }
     const double h = scenes.parameters[i].step;
-    // dc/dp = sum_j w_j c(p + o_j h, y + o_j h s) / h + O(h^4) (docs/sensitivities.md, "Output derivatives")
+    // dc/dp = sum_j w_j c(p + o_j h, y + o_j h s) / h + O(h^4) (AbramowitzStegun1964, eq. 25.3.6;
+    // docs/sensitivities.md, "Output derivatives")
     for (std::size_t c = 1; c < columns.size(); ++c) {
       values.push_back(stencilDerivative<double>(h, [&](int j) { return rows[static_cast<std::size_t>(j)][c]; }));
     }

@@ -201,7 +201,7 @@ void TensegrityVtkWriter::write(const TensegritySample& smp) {
   std::vector<std::string> names;
   for (int i = 0; i < s_.numStruts(); ++i) {
     g.cells.push_back({s_.strut(i).nodeI, s_.strut(i).nodeJ});
-    force.push_back(s_.strutForce(smp.x, i));  // N = EA (l - l0) / l0
+    force.push_back(s_.strutForce(smp.x, i));  // N = EA (l - l0) / l0 (Doc001)
     type.push_back(0);
     slack.push_back(0);
     names.push_back(s_.strut(i).name);

@@ -67,7 +67,7 @@ class VtkWriter {
 };
 
 /// A tensegrity structure: its nodes as points (point data: velocity) and every member
-/// as a line cell (cell data: "axial_force", the strut force N = EA (l - l0)/l0 or the
+/// as a line cell (cell data: "axial_force", the strut force N = EA (l - l0)/l0 (Doc001) or the
 /// cable tension of the sample; "member_type" 0 strut, 1 cable; "slack" 0/1 for cables).
 /// Field data "body_names" holds the structure's name (the scene name, or
 /// "tensegrity"), "member_names" the member of every cell.

@@ -144,7 +144,7 @@ BeamSection parseSection(const json& j, const std::string& where) {
   s.youngsModulus = r.positive("youngs_modulus");
   s.density = r.positive("density");
   s.damping = r.nonNegative("damping", 0.0);
-  // Timoshenko beams: G and kappa (a rectangle's default kappa: Cowper's, with nu from E and G)
+  // Timoshenko beams: G and kappa (a rectangle's default kappa: Cowper's, Cowper1966, with nu from E and G)
   if (r.has("shear_modulus")) s.shearModulus = r.positive("shear_modulus");
   if (r.has("shear_factor")) {
     s.shearFactor = r.positive("shear_factor");

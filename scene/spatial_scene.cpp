@@ -126,9 +126,9 @@ FrameState3d parseFrameState3d(const ObjectReader& r) {
 
 /// A spatial beam section: "width" and "height" (rectangle, along the section's y and z
 /// axes) or "area", "inertia_y", "inertia_z", "torsion_constant"; "youngs_modulus", one
-/// of "shear_modulus" or "poisson_ratio" (G = E / (2 (1 + nu))), "density", "damping";
+/// of "shear_modulus" or "poisson_ratio" (G = E / (2 (1 + nu)): TimoshenkoGoodier1970), "density", "damping";
 /// for Timoshenko beams "shear_factor_y" and "shear_factor_z" (a rectangle's default:
-/// Cowper's factor, rectangleShearFactor).
+/// Cowper's factor, rectangleShearFactor; Cowper1966).
 BeamSection3d parseSection3d(const json& j, const std::string& where) {
   ObjectReader r(j, where);
   r.allowOnly(scenekeys::kSection3d, " for a spatial section");

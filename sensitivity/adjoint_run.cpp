@@ -70,7 +70,7 @@ class SystemIntegrals final : public IntegralOutputs {
     if (!explicitParameters_[K][I]) return 0.0;
     unpack(y);
     const SensitivityParameter& p = params_[I];
-    // five-point difference (Abramowitz & Stegun 1964, eq. 25.3.6), as dF/dp
+    // five-point difference (AbramowitzStegun1964, eq. 25.3.6), as dF/dp
     return stencilDerivative<double>(p.step, [&](int j) {
       return outputs_[K].integrand(*p.systems[static_cast<std::size_t>(j)], t, q_, v_);
     });
@@ -105,7 +105,7 @@ class SystemIntegrals final : public IntegralOutputs {
     }
     const bool terminal = outputs_[static_cast<std::size_t>(k)].terminal;
     for (int i = 0; i < parameterCount(); ++i) {
-      // g_p - lambda^T F_p (IDAS guide, "Adjoint sensitivity analysis"); g = 0 for a terminal output
+      // g_p - lambda^T F_p (IdasGuide, "Adjoint sensitivity analysis"); g = 0 for a terminal output
       out[i] = -Lambda.dot(dFdp_.col(i)) + (terminal ? 0.0 : explicitDerivative(k, i, t, y));
     }
   }
@@ -230,7 +230,7 @@ MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const 
   const int nd = L.nq + L.nv, na = L.size - nd;
   const bool moving = lambdaD.size() == nd && lambdaD.cwiseAbs().maxCoeff() > 0.0;
   // the rates of F_y and E along the motion, (X(y + e y') - X(y - e y')) / (2 e) (central
-  // difference, Nocedal & Wright 2006, sec. 8.1): the terms (dE/dt)^T lambda_D and the
+  // difference, NocedalWright2006, sec. 8.1): the terms (dE/dt)^T lambda_D and the
   // derivatives of the algebraic rows (d/dt F_Da)^T lambda_D; not needed at lambda_D = 0
   MatX FyRate = MatX::Zero(L.size, L.size), ERate = MatX::Zero(L.size, L.size);
   if (moving && yp.cwiseAbs().maxCoeff() > 0.0) {
@@ -245,7 +245,7 @@ MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const 
   // unknowns x = [lambda_D' (nd); lambda_A (na)] at the given lambda_D
   MatX A = MatX::Zero(L.size, L.size);
   VecX b = VecX::Zero(L.size);
-  // differential rows of E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y = 0
+  // differential rows of E^T lambda' + (dE/dt)^T lambda - F_y^T lambda + g_y = 0 (CaoLiPetzoldSerban2003)
   A.topLeftCorner(nd, nd) = E.topLeftCorner(nd, nd).transpose();
   A.topRightCorner(nd, na) = -Fy.bottomLeftCorner(na, nd).transpose();
   b.head(nd) = -gy.head(nd) - ERate.topLeftCorner(nd, nd).transpose() * lD + Fy.topLeftCorner(nd, nd).transpose() * lD;
@@ -277,7 +277,7 @@ TerminalAdjoint terminalAdjoint(const DaeSystem& dae, double t, const VecX& y, c
   MatX Fy, E;
   denseJacobians(dae, t, y, yp, Fy, E);
   const int nd = L.nq + L.nv, na = L.size - nd;
-  // c_D = E_DD^T lambda_D + F_AD^T nu with lambda_D on the adjoint's algebraic rows
+  // c_D = E_DD^T lambda_D + F_AD^T nu (CaoLiPetzoldSerban2003) with lambda_D on the adjoint's algebraic rows
   // (F_Da^T lambda_D = 0 where no equation is released; a released row's nu = 0): then
   // c_D s_D = lambda_D^T E s_D - nu^T F_Ap for every consistent s (F_AD s_D + F_Ap = 0)
   MatX A = MatX::Zero(L.size, L.size);
@@ -491,14 +491,14 @@ AdjointSummary simulateWithAdjoint(const System& sys, const std::vector<Sensitiv
     std::function<void(double, long)> report;  // none where nothing is shown
     if (backwardProgress.enabled()) report = [&](double t, long steps) { backwardProgress.update(t, steps); };
     const AdjointSolution backward = recording.integrateAdjoint(problem, t0, report);
-    // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IDAS guide, "Adjoint sensitivity analysis")
+    // dG/dp = int (g_p - lambda^T F_p) dt + lambda(t0)^T E(t0) s(t0) (IdasGuide, "Adjoint sensitivity analysis")
     MatX Fy0, E0;
     denseJacobians(dae, t0, start.y0, start.yp0, Fy0, E0);
     for (int k = 0; k < count; ++k) {
       IntegralGradient r{outputs[static_cast<std::size_t>(k)].name, G[k], backward.integral.col(k)};
       r.gradient += (backward.lambda0.col(k).transpose() * E0 * s0.s0).transpose();
       if (outputs[static_cast<std::size_t>(k)].terminal) {
-        // dc(T)/dp = c_p - nu^T F_p(T) + the adjoint's part above (terminalAdjoint)
+        // dc(T)/dp = c_p - nu^T F_p(T) + the adjoint's part above (terminalAdjoint; CaoLiPetzoldSerban2003)
         r.value = integrals.value(k, tEnd, recording.y().data());
         VecX Fp(n);
         for (Eigen::Index i = 0; i < np; ++i) {

@@ -1,6 +1,6 @@
 /// @file
 /// A run with adjoint sensitivities (docs/sensitivities.md, "Adjoint sensitivities"): the
-/// gradients of integral outputs G = int_{t0}^{T} g(t, q, v) dt with respect to every
+/// gradients of integral outputs G = int_{t0}^{T} g(t, q, v) dt (CaoLiPetzoldSerban2003) with respect to every
 /// parameter from one forward run (IDAS, recorded at checkpoints) and one backward
 /// integration per output, whatever the number of parameters.
 #pragma once
@@ -13,7 +13,7 @@
 
 namespace flexmbd {
 
-/// One integral output: G = int_{t0}^{T} g(t, q, v) dt. The integrand is evaluated on a
+/// One integral output: G = int_{t0}^{T} g(t, q, v) dt (CaoLiPetzoldSerban2003). The integrand is evaluated on a
 /// system: the run's, or a parameter's perturbed one (g may depend on a parameter, a
 /// point's attachment for example: its derivative g_p enters the gradient).
 struct IntegralOutput {
@@ -45,7 +45,8 @@ struct AdjointSummary {
   double backwardCpuSeconds = 0.0;
 };
 
-/// Consistent terminal values of the adjoint for the GGL form (docs/sensitivities.md) with
+/// Consistent terminal values of the adjoint for the GGL form (docs/sensitivities.md;
+/// CaoLiPetzoldSerban2003) with
 /// its differential part lambda_D = [lambda_q; lambda_v] given (empty: 0, an integral
 /// output's E^T lambda(T) = 0): lambda_g, lambda_gv and lambda_q', lambda_v' from the
 /// adjoint's differential rows and the derivatives of its algebraic rows (the hidden
@@ -64,7 +65,7 @@ MatX adjointTerminalValues(const DaeSystem& dae, double t, const VecX& y, const 
 /// The adjoint of a terminal output c(y(T)) at T: c_y = E^T lambda + F_A^T nu on the
 /// consistent states (lambda_D meeting the adjoint's algebraic rows), so that
 /// dc/dp = c_p - nu^T F_p(T) + lambda(t0)^T E s(t0) - int lambda^T F_p dt with lambda the
-/// homogeneous adjoint from these terminal values (Cao, Li, Petzold and Serban 2003 for the
+/// homogeneous adjoint from these terminal values (CaoLiPetzoldSerban2003 for the
 /// index-2 case; docs/sensitivities.md).
 struct TerminalAdjoint {
   VecX lambda, rate;  ///< lambda(T), lambda'(T)

@@ -49,7 +49,7 @@ std::vector<ModeDerivative> modeDerivatives(const LinearizedSystem& lin, const R
   const std::vector<int> dep = dependentVelocities(lin);
   std::array<ReducedSystem, kStencilPoints> r;
   for (std::size_t j = 0; j < kStencilPoints; ++j) r[j] = reduceNear(perturbed[j], red.N, dep);
-  // five-point differences (Abramowitz & Stegun 1964, eq. 25.3.6): error h^4 |d5K/dp5| / 30
+  // five-point differences (AbramowitzStegun1964, eq. 25.3.6): error h^4 |d5K/dp5| / 30
   // + 0.95 eps |K| / h (docs/modes.md)
   const auto at = [&](int j) -> const ReducedSystem& { return r[static_cast<std::size_t>(j)]; };
   const MatX dM = stencilDerivative<MatX>(h, [&](int j) { return MatX(at(j).M); });
@@ -83,6 +83,7 @@ std::vector<ModeDerivative> modeDerivatives(const LinearizedSystem& lin, const R
     const CVec x = nullVector(Eigen::PartialPivLU<CMat>(Q), n);
     const CVec w = nullVector(Eigen::PartialPivLU<CMat>(Q.transpose()), n);
     // d/dp [w^T Q(s, p) x] = 0: ds/dp = -w^T (s^2 dM + s dC + dK) x / w^T (2 s M + C) x
+    // (left and right eigenvectors: TisseurMeerbergen2001, sec. 3)
     const CMat dQ = (s * s) * dM.cast<std::complex<double>>() + s * dC.cast<std::complex<double>>() +
                     dK.cast<std::complex<double>>();
     const std::complex<double> num = (w.transpose() * dQ * x)(0, 0);

@@ -3,10 +3,9 @@
 /// modes"): the derivative of each eigenvalue s of the reduced equations
 /// Mr x'' + Cr x' + Kr x = 0 with respect to a scene parameter p, from the linearisations of
 /// the systems built with p + h and p - h (the same perturbed scenes as a sensitivity run,
-/// results/sensitivity_results.hpp). Sources: Fox & Kapoor, AIAA J. 6(12) (1968) 2426-2429
-/// (undamped modes, the Rayleigh quotient's stationarity); Tisseur & Meerbergen, SIAM Rev.
-/// 43(2) (2001) 235-286, sec. 3 (the quadratic eigenvalue problem's left and right
-/// eigenvectors).
+/// results/sensitivity_results.hpp). Sources: FoxKapoor1968 (undamped modes, the Rayleigh
+/// quotient's stationarity); TisseurMeerbergen2001, sec. 3 (the quadratic eigenvalue
+/// problem's left and right eigenvectors).
 #pragma once
 
 #include <array>
@@ -38,7 +37,8 @@ inline constexpr double kRepeatedEigenvalueFraction = 1e-6;
 ///     ds/dp = - w^T (s^2 dMr/dp + s dCr/dp + dKr/dp) x / (w^T (2 s Mr + Cr) x)
 ///
 /// (the derivative of w^T Q(s(p), p) x = 0; for undamped symmetric modes w = x, s = i omega
-/// and it is the Rayleigh quotient's d(omega^2)/dp = x^T (dK/dp - omega^2 dM/dp) x / x^T M x).
+/// and it is the Rayleigh quotient's d(omega^2)/dp = x^T (dK/dp - omega^2 dM/dp) x / x^T M x,
+/// FoxKapoor1968; TisseurMeerbergen2001, sec. 3).
 /// dMr/dp, dCr/dp, dKr/dp: five-point differences (stencilDerivative) of the reduced
 /// matrices of `perturbed` (the linearisations at p + kStencilOffsets[j] h, each about its
 /// own reference state), in red.N moved onto their null spaces (reduceNear, with the base's

@@ -140,7 +140,7 @@ void ResidualDifferences::residualDerivative(int i, double t, const double* y, c
   Eigen::Map<VecX> d(dFdp, term_.size());
   d.setZero();
   // the terms that differ (the others cancel exactly in the differences):
-  // sum_j w_j F(p + o_j h) / h + O(h^4) (five-point difference, Abramowitz & Stegun 1964, eq. 25.3.6)
+  // sum_j w_j F(p + o_j h) / h + O(h^4) (five-point difference, AbramowitzStegun1964, eq. 25.3.6)
   for (std::size_t j = 0; j < kStencilPoints && parts.anyStencil; ++j) {
     p.daes[j]->residualOfParts(t, y, yp, term_.data(), parts.stencil, *scratch_[k][j]);
     d += (kStencilWeights[j] / p.step) * term_;
@@ -191,7 +191,7 @@ InitialSensitivities initialSensitivities(const DaeSystem& base, const std::vect
       const ConsistentState c = computeConsistentState(sys, t0, sys.initialCoordinates(), sys.initialVelocities(), released);
       dae.packState(c.q, c.v, c.a, c.lambda, y[j], yp[j]);
     }
-    // s0 = dy0/dp, s0' = dy0'/dp: five-point differences (Abramowitz & Stegun 1964, eq. 25.3.6)
+    // s0 = dy0/dp, s0' = dy0'/dp: five-point differences (AbramowitzStegun1964, eq. 25.3.6)
     // of the consistent initialisation (docs/sensitivities.md, "Consistent initial sensitivities")
     const double h = stencils[i].step;
     s.s0.col(static_cast<Eigen::Index>(i)) = stencilDerivative<VecX>(h, [&](int j) { return y[static_cast<std::size_t>(j)]; });

@@ -1,7 +1,8 @@
 /// @file
 /// A run with forward sensitivities (docs/sensitivities.md): the state y(t) of the DAE
 /// F(t, y, y', p) = 0 and its derivatives s_i = dy/dp_i with respect to scene parameters,
-/// by IDAS (staggered corrector). dF/dp_i is a five-point central difference of the
+/// by IDAS (staggered corrector; HindmarshEtAl2005). dF/dp_i is a five-point central difference
+/// (AbramowitzStegun1964, eq. 25.3.6) of the
 /// residuals of four systems built from the scene with p_i +- h_i and p_i +- 2 h_i, at the
 /// same (t, y, y').
 #pragma once
@@ -23,7 +24,8 @@ namespace flexmbd {
 /// tolerances are not tightened further (PerturbedDaes::scales).
 inline constexpr double kParameterTypicalMagnitude = 1.0;
 /// Relative step of the parameters' five-point differences (kStencilWeights). Their total
-/// error h^4 |f^(5)| / 30 + 0.95 eps |f| / h is smallest at eps^(1/5) = 7.4e-4; the step is
+/// error h^4 |f^(5)| / 30 (AbramowitzStegun1964, eq. 25.3.6) + 0.95 eps |f| / h is smallest
+/// at eps^(1/5) = 7.4e-4; the step is
 /// a little longer because the round-off is noise to the integrator (it does not shrink
 /// with the step: an error test at rtol 1e-10 chased it down to h = 5e-15 with the
 /// three-point difference at eps^(1/3)), where the truncation is a smooth bias
@@ -92,7 +94,8 @@ struct SensitivitySettings {
 ///   agrees to the last bit at a generic state is the same term).
 /// A section dimension of one beam body thus costs that body's terms (and the drivers'),
 /// not the whole model's; an initial condition the drivers' only.
-/// The terms of time take the five-point difference sum_j w_j F_j / h (kStencilWeights):
+/// The terms of time take the five-point difference sum_j w_j F_j / h (kStencilWeights;
+/// AbramowitzStegun1964, eq. 25.3.6):
 /// error h^4 |F^(5)| / 30 plus 0.95 eps |F| / h. The terms of the state take it too, unless
 /// they are linear in p at the test states (a mass, a density, a Young's modulus, a
 /// stiffness): then the two-point difference (F(p + 2h) - F(p - 2h)) / (4 h), exact for
@@ -130,6 +133,7 @@ class ResidualDifferences final : public ParameterDerivatives {
 };
 
 /// Consistent initial sensitivities: s0 = dy0/dp, s0' = dy0'/dp by five-point differences
+/// (AbramowitzStegun1964, eq. 25.3.6)
 /// of the engine's consistent initialisation (computeConsistentState, with the same released
 /// equations) on the perturbed systems, so the constraint projection is differentiated too.
 struct InitialSensitivities {

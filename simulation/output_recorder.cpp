@@ -44,7 +44,7 @@ void OutputRecorder::recordElasticDisplacement(double t, const VecX& q) {
     const SpMat* mff = body.elasticMatrices().mass;
     if (!mff || mff->rows() == 0 || !(body.mass() > 0.0)) continue;
     const int off = sys_.coordinateOffset(BodyIndex(b)) + body.numFrameCoordinates();
-    double qmq = 0.0;  // q_f^T m_ff q_f = int rho |u_f|^2 dV
+    double qmq = 0.0;  // q_f^T m_ff q_f = int rho |u_f|^2 dV (m_ff of Doc003)
     for (int j = 0; j < mff->outerSize(); ++j) {
       for (SpMat::InnerIterator it(*mff, j); it; ++it) qmq += q[off + it.row()] * it.value() * q[off + j];
     }

@@ -42,7 +42,7 @@ double largestInitialSpeed(const System& sys, const VecX& v0, double L) {
 }
 
 /// Squared lowest natural frequency omega_1^2 of K phi = omega^2 M phi (both symmetric
-/// positive definite, the bodies validate them) by inverse iteration from a start with
+/// positive definite, the bodies validate them) by inverse iteration (GolubVanLoan2013) from a start with
 /// a component along every mode in practice; 0 if K cannot be factorised.
 double lowestSquaredFrequency(const SpMat& M, const SpMat& K) {
   const Eigen::SimplicialLDLT<SpMat> ldlt(K);
@@ -52,11 +52,11 @@ double lowestSquaredFrequency(const SpMat& M, const SpMat& K) {
   for (int i = 0; i < n; ++i) x[i] = 1.0 + 0.5 * std::sin(1.0 + i);  // no symmetry of the mesh
   double lambda = 0.0;
   for (int it = 0; it < kMaxInverseIterations; ++it) {
-    VecX y = ldlt.solve(M * x);               // y = K^-1 M x
+    VecX y = ldlt.solve(M * x);               // y = K^-1 M x (inverse iteration, GolubVanLoan2013)
     const double yMy = y.dot(M * y);
     if (!(yMy > 0.0)) return 0.0;
     y /= std::sqrt(yMy);
-    const double next = y.dot(K * y);         // Rayleigh quotient, y^T M y = 1
+    const double next = y.dot(K * y);         // Rayleigh quotient, y^T M y = 1 (GeradinRixen)
     x = y;
     if (std::fabs(next - lambda) <= kInverseIterationTolerance * next) return next;
     lambda = next;

@@ -35,13 +35,13 @@ class BarElement {
   static double length(const Vec& xi, const Vec& xj) { return (xj - xi).norm(); }
 
   /// Axial force, tension positive, of a linear (engineering-strain) bar:
-  ///   N = EA (l - l0) / l0                      (Tamba, doc. 001, strut law K_s u)
+  ///   N = EA (l - l0) / l0                      (Doc001, strut law K_s u)
   double axialForce(double l) const { return ea_ * (l - l0_) / l0_; }
 
-  /// Strain energy U = EA (l - l0)^2 / (2 l0), so that dU/dl = N.
+  /// Strain energy U = EA (l - l0)^2 / (2 l0), so that dU/dl = N (Doc001's strut law).
   double strainEnergy(double l) const { return 0.5 * ea_ * (l - l0_) * (l - l0_) / l0_; }
 
-  /// Gradient of the length with respect to [xi; xj]: dl/dx = [-e; e], e = (xj - xi)/l.
+  /// Gradient of the length with respect to [xi; xj]: dl/dx = [-e; e], e = (xj - xi)/l (Doc001, eq. 6).
   /// @pre xi != xj
   static NodalVec lengthGradient(const Vec& xi, const Vec& xj) {
     const Vec e = (xj - xi).normalized();
@@ -51,7 +51,7 @@ class BarElement {
   }
 
   /// Internal (elastic) nodal forces g = dU/dx = N dl/dx; the equations of motion read
-  /// M a = f - g (doc. 001 eq. (6): the term K_s(u) u).
+  /// M a = f - g (Doc001, eq. 6: the term K_s(u) u).
   NodalVec internalForces(const Vec& xi, const Vec& xj) const {
     return axialForce(length(xi, xj)) * lengthGradient(xi, xj);
   }
@@ -64,7 +64,8 @@ class BarElement {
       m.template topLeftCorner<Dim, Dim>() = 0.5 * mass_ * I;
       m.template bottomRightCorner<Dim, Dim>() = 0.5 * mass_ * I;
     } else {
-      // Linear shape functions N1 = 1 - s, N2 = s: int rho A N_a N_b dx = m/6 [2 1; 1 2].
+      // Linear shape functions N1 = 1 - s, N2 = s: int rho A N_a N_b dx = m/6 [2 1; 1 2]
+      // (the bar's consistent mass, Przemieniecki1968).
       m.template topLeftCorner<Dim, Dim>() = (mass_ / 3.0) * I;
       m.template bottomRightCorner<Dim, Dim>() = (mass_ / 3.0) * I;
       m.template topRightCorner<Dim, Dim>() = (mass_ / 6.0) * I;

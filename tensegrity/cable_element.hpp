@@ -28,25 +28,25 @@ class CableElement {
 
   static double length(const Vec& xi, const Vec& xj) { return (xj - xi).norm(); }
 
-  /// Elongation e_c = l - l0 = e^e + e^s (doc. 001 sec. 3.1): the elastic part e^e >= 0
+  /// Elongation e_c = l - l0 = e^e + e^s (Doc001, sec. 3.1): the elastic part e^e >= 0
   /// carries the tension, the slack part e^s <= 0 carries none.
   double elongation(double l) const { return l - l0_; }
 
-  /// Tension of the elastic law tau = k_c e^e = (EA/l0) max(l - l0, 0) (doc. 001 eq. (7)).
+  /// Tension of the elastic law tau = k_c e^e = (EA/l0) max(l - l0, 0) (Doc001, eq. 7).
   /// Zero for an inextensible cable (its tension comes from the LCP).
   double tension(double l) const {
     if (inextensible_) return 0.0;
     return ea_ * std::max(l - l0_, 0.0) / l0_;
   }
 
-  /// Stored energy U = EA max(l - l0, 0)^2 / (2 l0) (dU/dl = tau; zero when slack).
+  /// Stored energy U = EA max(l - l0, 0)^2 / (2 l0) (dU/dl = tau of Doc001, eq. 7; zero when slack).
   double storedEnergy(double l) const {
     if (inextensible_) return 0.0;
     const double e = std::max(l - l0_, 0.0);
     return 0.5 * ea_ * e * e / l0_;
   }
 
-  /// b_c = dl/dx = [-e; e], e = (xj - xi)/l: the cable's column of B_c^T (doc. 001 eq. (6)).
+  /// b_c = dl/dx = [-e; e], e = (xj - xi)/l: the cable's column of B_c^T (Doc001, eq. 6).
   static NodalVec lengthGradient(const Vec& xi, const Vec& xj) {
     const Vec e = (xj - xi).normalized();
     NodalVec b;

@@ -1,5 +1,5 @@
 /// @file
-/// Linear complementarity problems  w = M z + q,  z >= 0,  w >= 0,  z^T w = 0,
+/// Linear complementarity problems  w = M z + q,  z >= 0,  w >= 0,  z^T w = 0 (Doc001, method 1),
 /// solved with Siconos numerics (lexicographic Lemke or projected Gauss-Seidel) behind a
 /// small interface, so the time-stepper does not see Siconos.
 #pragma once

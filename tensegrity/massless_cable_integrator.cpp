@@ -17,7 +17,7 @@ namespace {
 /// Figures in messages: six significant digits (core/number_text.hpp).
 std::string num(double x) { return fmt(x, 6); }
 
-/// y = [u_free, v_free]; y' = [v_free, M^-1 (f - g)].
+/// y = [u_free, v_free]; y' = [v_free, M^-1 (f - g)] (Doc001, method 2).
 class TensegrityOde : public OdeSystem {
  public:
   explicit TensegrityOde(const TensegrityStructure& s)

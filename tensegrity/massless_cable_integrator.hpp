@@ -1,5 +1,5 @@
 /// @file
-/// Method 2 of source document 001 (Tamba & Kanno): massless elastic cables. A cable
+/// Method 2 of Doc001 (Tamba & Kanno): massless elastic cables. A cable
 /// that snaps taut receives no impulse (v+ = v- when its mass m_c -> 0), so the motion
 /// follows the smooth equations with the piecewise (tension-only) cable law
 ///   M u'' = f(t) - g_struts(u) - sum_c b_c(u) tau_c(u),  tau_c = (EA/l0) max(l_c - l0, 0),

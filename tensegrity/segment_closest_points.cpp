@@ -6,7 +6,7 @@ namespace flexmbd {
 
 SegmentClosestPoints closestPointsOfSegments(const Eigen::Vector3d& p1, const Eigen::Vector3d& q1,
                                              const Eigen::Vector3d& p2, const Eigen::Vector3d& q2) {
-  // Ericson (2005) sec. 5.1.9: minimise |p1 + s d1 - p2 - t d2|^2 over [0,1]^2.
+  // Ericson2005, sec. 5.1.9: minimise |p1 + s d1 - p2 - t d2|^2 over [0,1]^2.
   constexpr double kEps = 1e-300;
   const Eigen::Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);

@@ -1,6 +1,6 @@
 /// @file
 /// Closest points of two segments in 3D (planar segments: z = 0). The clamped
-/// segment-segment algorithm of Ericson, "Real-Time Collision Detection" (2005), sec. 5.1.9.
+/// segment-segment algorithm of Ericson2005, sec. 5.1.9.
 #pragma once
 
 #include <Eigen/Core>

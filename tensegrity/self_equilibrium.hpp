@@ -1,6 +1,6 @@
 /// @file
-/// Self-equilibrium of a tensegrity (source document 001, sec. 1; the force-density
-/// method of Schek 1974 and Pellegrino & Calladine 1986): with force densities q_j =
+/// Self-equilibrium of a tensegrity (Doc001, sec. 1; the force-density
+/// method of Schek1974 and PellegrinoCalladine1986): with force densities q_j =
 /// t_j / l_j (tension positive), the equilibrium of the free node coordinates reads
 ///   A q = f,   A[node i, member j] = x_i - x_k  (j joins i and k),
 /// so self-stress states (f = 0) span the null space of the equilibrium matrix A,
@@ -17,7 +17,7 @@ struct SelfStressStates {
   MatX forceDensities;
   VecX singularValues;  ///< of A, descending
   int rank = 0;         ///< of A
-  /// Infinitesimal mechanisms (Pellegrino & Calladine): free coordinates - rank (rigid
+  /// Infinitesimal mechanisms (PellegrinoCalladine1986): free coordinates - rank (rigid
   /// body motions of an unsupported structure included).
   int mechanisms = 0;
 };
@@ -32,7 +32,7 @@ SelfStressStates computeSelfStress(const TensegrityStructure& s, const VecX& x, 
 /// Prestresses s in its initial geometry with the self-stress q (one force density per
 /// member, struts then cables) times `scale`: natural lengths are set so that the
 /// member forces t_j = q_j l_j hold at the initial lengths,
-///   elastic member  t = EA (l - l0)/l0  =>  l0 = l / (1 + t/EA),
+///   elastic member  t = EA (l - l0)/l0 (Doc001)  =>  l0 = l / (1 + t/EA),
 ///   inextensible cable: l0 = l (its tension is carried by the LCP).
 /// @throws InputError if a cable would be compressed (q_j scale < 0) or a strut
 /// stretched, naming the member.

@@ -80,7 +80,7 @@ class TensegrityStructure;
 
 /// The columns of a tensegrity run's results table (results.csv): t; every node's
 /// coordinates "<node>.x", ".y" (".z"); their velocities "<node>.vx", ...; per strut
-/// ".force" (N = EA (l - l0) / l0, tension positive), ".length"; per cable ".tension",
+/// ".force" (N = EA (l - l0) / l0, tension positive; Doc001), ".length"; per cable ".tension",
 /// ".slack" (0/1), ".impulse", ".length"; energy.kinetic, energy.potential, energy.total.
 std::vector<std::string> tensegrityColumns(const TensegrityStructure& s);
 /// One sample's row in tensegrityColumns' order, into `values` (cleared).

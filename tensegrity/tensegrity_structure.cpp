@@ -367,7 +367,7 @@ double TensegrityStructure::strutLength(const VecX& x, int i) const {
 
 double TensegrityStructure::strutForce(const VecX& x, int i) const {
   const TensegrityStrut& st = struts_.at(i);
-  // N = EA (l - l0) / l0 (BarElement::internalForces), independent of the dimension.
+  // N = EA (l - l0) / l0 (BarElement::internalForces; Doc001), independent of the dimension.
   return st.axialStiffness * (strutLength(x, i) - st.naturalLength) / st.naturalLength;
 }
 
@@ -376,7 +376,7 @@ VecX TensegrityStructure::elasticCableTensions(const VecX& x) const {
   VecX tau(numCables());
   for (int c = 0; c < numCables(); ++c) {
     const TensegrityCable& cb = cables_[c];
-    // tau = (EA/l0) max(l - l0, 0) (CableElement::tension), independent of the dimension.
+    // tau = (EA/l0) max(l - l0, 0) (CableElement::tension; Doc001, eq. 7), independent of the dimension.
     tau[c] = cb.inextensible ? 0.0 : cb.axialStiffness * std::max(l[c] - cb.naturalLength, 0.0) / cb.naturalLength;
   }
   return tau;
@@ -385,7 +385,7 @@ VecX TensegrityStructure::elasticCableTensions(const VecX& x) const {
 std::vector<std::pair<int, double>> TensegrityStructure::cableGradientEntries(const VecX& x, int c) const {
   const TensegrityCable& cb = cables_.at(c);
   const VecX d = x.segment(dim_ * cb.nodeJ, dim_) - x.segment(dim_ * cb.nodeI, dim_);
-  const VecX e = d / d.norm();  // b_c = [-e; e] (CableElement::lengthGradient)
+  const VecX e = d / d.norm();  // b_c = [-e; e] (CableElement::lengthGradient; Doc001, eq. 6)
   std::vector<std::pair<int, double>> out;
   out.reserve(2 * dim_);
   for (int a = 0; a < dim_; ++a) {

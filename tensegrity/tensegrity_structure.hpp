@@ -1,8 +1,8 @@
 /// @file
 /// A tensegrity (pin-jointed truss): point-mass nodes in 2D or 3D, struts (axially
 /// elastic bars with their own mass), tension-only cables (elastic or inextensible),
-/// fixed node coordinates, gravity and nodal loads with time laws. Tamba & Kanno,
-/// source document 001 (docs/tensegrity.md).
+/// fixed node coordinates, gravity and nodal loads with time laws. Doc001 (Tamba & Kanno;
+/// docs/tensegrity.md).
 ///
 /// Build phase: add nodes and members, then finalize(); afterwards the structure is
 /// frozen and its evaluations are pure functions of (t, x, v).
@@ -132,11 +132,11 @@ class TensegrityStructure {
   /// of energy that potentialEnergy does not contain.
   VecX loadForces(double t) const;
   /// Elastic forces of struts and of elastic cables, g(x) = dU/dx (full vector): the
-  /// equations of motion read M a = f(t) - g(x) - B_c^T tau (inextensible part).
+  /// equations of motion read M a = f(t) - g(x) - B_c^T tau (inextensible part; Doc001).
   VecX internalForces(const VecX& x) const;
   /// Current cable lengths.
   VecX cableLengths(const VecX& x) const;
-  /// Axial force of strut i at positions x, N = EA (l - l0) / l0 (BarElement; tension
+  /// Axial force of strut i at positions x, N = EA (l - l0) / l0 (BarElement, Doc001; tension
   /// positive, a compressed strut negative). No allocation.
   double strutForce(const VecX& x, int i) const;
   /// Length of strut i at positions x.

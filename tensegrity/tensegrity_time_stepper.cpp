@@ -67,7 +67,7 @@ void tensegrityRow(const TensegrityStructure& s, const TensegritySample& smp, st
   values.insert(values.end(), smp.x.data(), smp.x.data() + smp.x.size());
   values.insert(values.end(), smp.v.data(), smp.v.data() + smp.v.size());
   for (int i = 0; i < s.numStruts(); ++i) {
-    // N = EA (l - l0) / l0, tension positive (TensegrityStructure::strutForce)
+    // N = EA (l - l0) / l0, tension positive (TensegrityStructure::strutForce; Doc001)
     const double force = s.strutForce(smp.x, i), length = s.strutLength(smp.x, i);
     check(std::isfinite(force) && std::isfinite(length), "force or length of strut \"" + s.strut(i).name + "\"");
     values.insert(values.end(), {force, length});
@@ -93,7 +93,7 @@ namespace {
 
 using Row = std::vector<std::pair<int, double>>;
 
-/// W = B Minv B^T for sparse rows B (each at most 6 entries).
+/// W = B Minv B^T for sparse rows B (each at most 6 entries; Doc001, method 1).
 MatX delassus(const std::vector<Row>& B, const MatX& Minv) {
   const int n = static_cast<int>(B.size());
   MatX W(n, n);
@@ -397,7 +397,7 @@ void TimeSteppingRun::takeStep(long step) {
   const VecX xi = x_, vi = v_;
   const double Ei = energy(xi, vi);
   const VecX vFreeI = s_.restrict(vi);
-  // Midpoint u_m = u_i + v_i dt/2 (doc. 001, sec. 3.2).
+  // Midpoint u_m = u_i + v_i dt/2 (Doc001, sec. 3.2).
   const VecX xm = xi + 0.5 * dt * vi;
   const StepImpulses imp = stepImpulses(step, dt, tm, xm, vFreeI);
   VecX xf = xm + 0.5 * dt * s_.expand(imp.vf, VecX::Zero(s_.numCoordinates()));
@@ -408,7 +408,7 @@ void TimeSteppingRun::takeStep(long step) {
 
 TimeSteppingRun::StepImpulses TimeSteppingRun::stepImpulses(long step, double dt, double tm, const VecX& xm,
                                                             const VecX& vFreeI) {
-  // v_free = v_i + M^-1 (f(t_m) - g(u_m)) dt
+  // v_free = v_i + M^-1 (f(t_m) - g(u_m)) dt (Doc001, method 1)
   const VecX force = s_.restrict(s_.externalForces(tm) - s_.internalForces(xm));
   VecX vf = vFreeI + Minv_ * (force * dt);
   // Active set: inextensible cables at or beyond their natural length at u_m.

@@ -1,5 +1,5 @@
 /// @file
-/// Method 1 of source document 001 (Tamba & Kanno): inextensible cables, struts with
+/// Method 1 of Doc001 (Tamba & Kanno): inextensible cables, struts with
 /// finite stiffness, nonsmooth time-stepping with one LCP per step (docs/tensegrity.md).
 ///
 /// Over [t_i, t_f], dt = t_f - t_i, with the midpoint u_m = u_i + v_i dt/2:

@@ -68,7 +68,8 @@ void addSurfaces(const Body& body, const ConstVecRef& q, const std::vector<Surfa
 
 Vec3 inertiaBoxSides(double mass, const Vec3& I) {
   Vec3 s2;
-  for (int k = 0; k < 3; ++k) s2[k] = 6.0 * (I.sum() - 2.0 * I[k]) / mass;  // a_k^2 = 6 (I_j + I_l - I_k) / m
+  // a_k^2 = 6 (I_j + I_l - I_k) / m, from the box's moments (MeriamKraige, table D/4)
+  for (int k = 0; k < 3; ++k) s2[k] = 6.0 * (I.sum() - 2.0 * I[k]) / mass;
   Vec3 s = s2.cwiseMax(0.0).cwiseSqrt();
   const double floor = 1e-3 * s.maxCoeff();
   return s.cwiseMax(floor);
@@ -120,7 +121,7 @@ SystemDrawer::SystemDrawer(const System& sys, int subdivisions, const std::vecto
   }
   if (inertiaBoxes) {
     // a planar rigid body whose points coincide (a slider) would be drawn as nothing: the
-    // square plate of its inertia, J = m a^2 / 6, a kept within 2 % and 20 % of the model
+    // square plate of its inertia, J = m a^2 / 6 (MeriamKraige, table D/4), a kept within 2 % and 20 % of the model
     const double L = sys.characteristicLength();
     for (int b = 1; b < sys.numBodies(); ++b) {
       const auto* rb = dynamic_cast<const RigidBody2d*>(&sys.body(BodyIndex(b)));

@@ -68,7 +68,8 @@ class SystemDrawer {
 };
 
 /// The box whose inertia about its centre equals the principal moments (Ix, Iy, Iz) of a
-/// body of mass m: side a_x^2 = 6 (Iy + Iz - Ix) / m, and so on (Ix = m (a_y^2 + a_z^2) / 12);
+/// body of mass m: side a_x^2 = 6 (Iy + Iz - Ix) / m, and so on (Ix = m (a_y^2 + a_z^2) / 12:
+/// MeriamKraige, table D/4);
 /// a side that would be imaginary or below 1e-3 of the longest is set to that.
 Vec3 inertiaBoxSides(double mass, const Vec3& principalMoments);
 
