@@ -9,7 +9,7 @@
 namespace flexmbd {
 
 /// h = z_i^T (r_j - r_i) = 0, with z_i the plane's normal (body-i axes) through point i
-/// (Haug 1989, sec. 9.3, the planar joint's gap equation). One equation.
+/// (Haug1989, ch. 9, the planar joint's gap equation). One equation.
 class PointInPlaneJoint final : public FramePairConstraint {
  public:
   /// @throws InputError if a point or the normal is not finite or the normal is zero.

@@ -12,7 +12,7 @@
 namespace flexmbd {
 
 /// Planar: h = n_w^T (r_j - r_i) = 0, n_w = A(phi_i) S a the normal of the line's
-/// direction a (body-i axes) through point i (Haug 1989, sec. 3.3, the translational
+/// direction a (body-i axes) through point i (Haug1989, ch. 3, the translational
 /// joint's first equation). One equation.
 class PointOnLineJoint final : public TwoPointConstraint {
  public:
@@ -35,7 +35,7 @@ class PointOnLineJoint final : public TwoPointConstraint {
 };
 
 /// Spatial: h = (x_i^T d, y_i^T d) = 0 with d = r_j - r_i and x_i, y_i normal to the
-/// line's direction z_i (body-i axes) through point i (Haug 1989, sec. 9.3, the
+/// line's direction z_i (body-i axes) through point i (Haug1989, ch. 9, the
 /// cylindrical joint's lateral equations). Two equations.
 class PointOnLineJoint3d final : public FramePairConstraint {
  public:
