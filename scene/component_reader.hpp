@@ -33,7 +33,7 @@ bool readDriverOfRegisteredJoint(const std::string& driverType, const std::strin
                                  const jsonread::ObjectReader& r, System& sys);
 
 /// Builds a component of a declared kind from its keys as a JSON object (the Python
-/// module's add_<type>_<kind> methods: the same checks and messages as a scene's).
+/// module's `add_<type>_<kind>` methods: the same checks and messages as a scene's).
 /// `where` names the object in messages. @throws InputError.
 void addComponent(System& sys, int dimension, const std::string& section, const std::string& type,
                   const nlohmann::json& keys, const std::string& where);
