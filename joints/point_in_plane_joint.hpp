@@ -4,23 +4,19 @@
 #pragma once
 
 #include "core/system.hpp"
-#include "joints/spatial_drivers.hpp"
+#include "joints/point_gap_joint.hpp"
 
 namespace flexmbd {
 
 /// h = z_i^T (r_j - r_i) = 0, with z_i the plane's normal (body-i axes) through point i
 /// (Haug1989, ch. 9, the planar joint's gap equation). One equation.
-class PointInPlaneJoint final : public FramePairConstraint {
+class PointInPlaneJoint final : public PointGapJoint {
  public:
   /// @throws InputError if a point or the normal is not finite or the normal is zero.
   PointInPlaneJoint(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
-                    const Vec3& normal);
-  int numEquations() const override { return 1; }
+                    const Vec3& normal)
+      : PointGapJoint(std::move(name), bodyI, pointI, normal, "normal", bodyJ, pointJ, {2}) {}
   std::string typeName() const override { return "point_in_plane"; }
-  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
-  /// The force on body j at its point (world axes): along the normal, no moment.
-  std::vector<std::string> reactionNames() const override { return {"fx", "fy", "fz"}; }
-  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
 };
 
 /// pointJ of bodyJ in the plane through pointI of bodyI with `normal` (body-i axes).

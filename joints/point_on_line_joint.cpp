@@ -4,7 +4,6 @@
 #include "core/errors.hpp"
 #include "core/magnitude_checks.hpp"
 #include "joints/drivers.hpp"
-#include "joints/world_frames.hpp"
 
 namespace flexmbd {
 
@@ -46,54 +45,6 @@ ConstraintIndex addPointOnLineJoint(System& sys, const std::string& name, BodyIn
 }
 
 // ----- spatial ------------------------------------------------------------------------
-
-namespace {
-
-/// Frame i: the line's point, z along the line (x, y: frameAxesFromZ); frame j: the point.
-JointFrame lineFrame(const Vec3& point, const Vec3& direction, const std::string& who) {
-  JointFrame f;
-  f.point = point;
-  f.axes = frameAxesFromZ(direction, nullptr, who + ": direction");
-  return f;
-}
-
-JointFrame pointFrame(const Vec3& point) {
-  JointFrame f;
-  f.point = point;
-  return f;
-}
-
-}  // namespace
-
-PointOnLineJoint3d::PointOnLineJoint3d(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ,
-                                       const Vec3& pointJ, const Vec3& direction)
-    : FramePairConstraint(name, bodyI, lineFrame(pointI, direction, "joint '" + name + "'"), bodyJ,
-                          pointFrame(pointJ)) {
-  const std::string who = "joint '" + this->name() + "'";
-  if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
-  checkJointFrame(frameI_, who + " frame 0");
-  checkJointFrame(frameJ_, who + " frame 1");
-}
-
-void PointOnLineJoint3d::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  FramePair pair(bodies, frameI_, frameJ_, withHessians, out.work);
-  const int n = pair.numVelocities(), nq = pair.numCoordinates();
-  out.h.resize(2);
-  out.G.resize(2, n);
-  if (withHessians) out.H.resize(2);
-  for (int a = 0; a < 2; ++a) {  // the line's normals x_i, y_i
-    MatX* H = withHessians ? &out.H[a] : nullptr;
-    if (H) H->setZero(n, nq);
-    pair.axisGap(a, out.h[a], out.G.row(a), H);
-  }
-}
-
-VecX PointOnLineJoint3d::reactions(const BodyStates& bodies, const VecX& lambda) const {
-  KinematicsWork work;
-  const FramePair pair(bodies, frameI_, frameJ_, false, work);
-  // -G^T lambda over body j's translation: -(lambda_0 x_i + lambda_1 y_i)
-  return -(lambda[0] * pair.axisI(0) + lambda[1] * pair.axisI(1));
-}
 
 std::unique_ptr<Constraint> PointOnLineJoint3d::makeDriver(const std::string& quantity, std::string name,
                                                            TimeLawPtr law) const {

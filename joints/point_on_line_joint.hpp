@@ -5,9 +5,8 @@
 #pragma once
 
 #include "core/system.hpp"
-#include "joints/frame_pair.hpp"
+#include "joints/point_gap_joint.hpp"
 #include "joints/point_pair.hpp"
-#include "joints/spatial_drivers.hpp"
 
 namespace flexmbd {
 
@@ -35,19 +34,15 @@ class PointOnLineJoint final : public TwoPointConstraint {
 };
 
 /// Spatial: h = (x_i^T d, y_i^T d) = 0 with d = r_j - r_i and x_i, y_i normal to the
-/// line's direction z_i (body-i axes) through point i (Haug1989, ch. 9, the
-/// cylindrical joint's lateral equations). Two equations.
-class PointOnLineJoint3d final : public FramePairConstraint {
+/// line's direction z_i (body-i axes) through point i (Haug1989, ch. 9, the cylindrical
+/// joint's lateral equations). Two equations.
+class PointOnLineJoint3d final : public PointGapJoint {
  public:
   /// @throws InputError if a point or the direction is not finite or the direction is zero.
   PointOnLineJoint3d(std::string name, BodyIndex bodyI, const Vec3& pointI, BodyIndex bodyJ, const Vec3& pointJ,
-                     const Vec3& direction);
-  int numEquations() const override { return 2; }
+                     const Vec3& direction)
+      : PointGapJoint(std::move(name), bodyI, pointI, direction, "direction", bodyJ, pointJ, {0, 1}) {}
   std::string typeName() const override { return "point_on_line"; }
-  void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
-  /// The force on body j at its point (world axes): normal to the line, no moment.
-  std::vector<std::string> reactionNames() const override { return {"fx", "fy", "fz"}; }
-  VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
   /// "displacement": s = z_i^T (r_j - r_i) = law(t), the point's position along the line.
   std::unique_ptr<Constraint> makeDriver(const std::string& quantity, std::string name,
                                          TimeLawPtr law) const override;

@@ -5,9 +5,9 @@
 namespace flexmbd {
 
 FramePairConstraint::FramePairConstraint(std::string name, BodyIndex bodyI, const JointFrame& frameI,
-                                         BodyIndex bodyJ, const JointFrame& frameJ)
+                                         BodyIndex bodyJ, const JointFrame& frameJ, const std::string& kind)
     : Constraint(std::move(name), {bodyI, bodyJ}), frameI_(frameI), frameJ_(frameJ) {
-  const std::string who = "driver '" + this->name() + "'";
+  const std::string who = kind + " '" + this->name() + "'";
   if (bodyI == bodyJ) throw InputError(who + ": connects a body to itself; expected two different bodies");
   checkJointFrame(frameI, who + " frame 0");
   checkJointFrame(frameJ, who + " frame 1");

@@ -17,8 +17,10 @@ void evaluateJointAngle(const BodyStates& bodies, const JointFrame& frameI, cons
 /// Base of drivers between two body frames.
 class FramePairConstraint : public Constraint {
  public:
+  /// `kind` names the element in messages ("driver", "joint").
+  /// @throws InputError if the bodies are the same or a frame is not a finite point and a rotation.
   FramePairConstraint(std::string name, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,
-                      const JointFrame& frameJ);
+                      const JointFrame& frameJ, const std::string& kind = "driver");
   const JointFrame& frameI() const { return frameI_; }
   std::vector<Attachment> attachments() const override {
     return {{bodies()[0], frameI_.point}, {bodies()[1], frameJ_.point}};
