@@ -1,6 +1,6 @@
 /// @file
 /// The declaration of a kind of component (a joint, and in time every body, driver,
-/// force and output): its scene name, its keys with their types, units, defaults, ranges
+/// force and output): its scene name, its keys with their types, units
 /// and one-line descriptions, and how it is built from their values. One declaration
 /// serves every front end: the scene readers validate an object against it and build it
 /// (scene/component_reader.hpp), the key reference of docs/scene-format.md is generated
@@ -23,28 +23,24 @@ enum class KeyType {
   BodyPair,   ///< two body names, ["ground", "slider"] ("ground": the ground)
   PointPair,  ///< two points, each in its body's axes: 2 coordinates each in a planar scene, 3 in a spatial one
   Direction,  ///< a direction (2 or 3 coordinates as the scene; normalised, not zero)
-  Number,     ///< a finite real number
 };
-
-/// The values a Number key accepts.
-enum class KeyRange { Any, Positive, NonNegative };
 
 /// Scenes a kind may appear in.
 enum class KindDimensions { Planar, Spatial, Both };
 
-/// One key of a kind ("name" and "type", which every kind has, are not listed).
+/// One key of a kind ("name" and "type", which every kind has, are not listed). Every
+/// key is required: numbers, ranges and defaults join the vocabulary with the first kind
+/// that needs them.
 struct KeySpec {
   std::string name;
   KeyType type;
   std::string unit;         ///< SI unit of the value ("m", "rad", ""); a direction or point's coordinates
-  std::string fallback;     ///< the default as the reference writes it; empty: the key is required
   std::string description;  ///< one sentence
-  KeyRange range = KeyRange::Any;
 };
 
 /// The values of one object's keys, read by a front end that has checked them against
-/// the kind's KeySpecs (present where required, of their type, in their range). Points
-/// and directions are spatial; in a planar scene their z is 0.
+/// the kind's KeySpecs (present and of their type). Points and directions are spatial;
+/// in a planar scene their z is 0.
 class ComponentArgs {
  public:
   virtual ~ComponentArgs() = default;
@@ -56,10 +52,6 @@ class ComponentArgs {
   virtual std::array<Vec3, 2> pointPair(const std::string& key) const = 0;
   /// A unit vector.
   virtual Vec3 direction(const std::string& key) const = 0;
-  /// The value, or the key's default when it is absent.
-  virtual double number(const std::string& key) const = 0;
-  /// @throws InputError naming the object and, in `message`, the key.
-  [[noreturn]] virtual void fail(const std::string& message) const = 0;
 };
 
 /// A kind of component.

@@ -15,6 +15,25 @@ void checkJointFrame(const JointFrame& f, const std::string& who) {
   }
 }
 
+void evaluateFrameEquations(const BodyStates& bodies, const JointFrame& frameI, const JointFrame& frameJ,
+                            const std::vector<FrameEquation>& equations, bool withHessians, ConstraintEvaluation& out) {
+  FramePair pair(bodies, frameI, frameJ, withHessians, out.work);
+  const int m = static_cast<int>(equations.size()), n = pair.numVelocities(), nq = pair.numCoordinates();
+  out.h.resize(m);
+  out.G.resize(m, n);
+  if (withHessians) out.H.resize(m);
+  for (int e = 0; e < m; ++e) {
+    const FrameEquation& eq = equations[e];
+    MatX* H = withHessians ? &out.H[e] : nullptr;
+    if (H) H->setZero(n, nq);
+    switch (eq.kind) {
+      case FrameEquation::Gap: pair.gap(eq.a, out.h[e], out.G.row(e), H); break;
+      case FrameEquation::AxisGap: pair.axisGap(eq.a, out.h[e], out.G.row(e), H); break;
+      case FrameEquation::AxisAxis: pair.axisAxis(eq.a, eq.b, out.h[e], out.G.row(e), H); break;
+    }
+  }
+}
+
 FramePair::FramePair(const BodyStates& bodies, const JointFrame& frameI, const JointFrame& frameJ, bool withH,
                      KinematicsWork& work)
     : bodies_(bodies), frameI_(frameI), frameJ_(frameJ), w_(work) {

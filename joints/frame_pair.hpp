@@ -7,6 +7,9 @@
 /// each with its velocity gradient (1 x nv) and its H = d(G^T)/dq (nv x nq).
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "core/constraint.hpp"
 
 namespace flexmbd {
@@ -19,6 +22,18 @@ struct JointFrame {
 
 /// @throws InputError naming `who` unless the frame's point is finite and its axes are a rotation.
 void checkJointFrame(const JointFrame& f, const std::string& who);
+
+/// One scalar equation between two frames, a primitive below (axes: 0 = x, 1 = y, 2 = z).
+struct FrameEquation {
+  enum Kind { Gap, AxisGap, AxisAxis } kind;
+  int a = 0, b = 0;
+};
+
+/// h, G and, if withHessians, every H of the `equations` between the two frames (the
+/// joints written in the primitives: SpatialJoint, PointGapJoint). Allocates nothing once
+/// `out` holds as many equations and columns.
+void evaluateFrameEquations(const BodyStates& bodies, const JointFrame& frameI, const JointFrame& frameJ,
+                            const std::vector<FrameEquation>& equations, bool withHessians, ConstraintEvaluation& out);
 
 /// The two frames' kinematics at a state (in `work`, whose memory it reuses).
 class FramePair {

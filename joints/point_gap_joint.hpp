@@ -21,13 +21,13 @@ class PointGapJoint : public FramePairConstraint {
   /// @throws InputError if a point or z is not finite, z is zero, or the bodies are the same.
   PointGapJoint(std::string name, BodyIndex bodyI, const Vec3& pointI, const Vec3& z, const std::string& zName,
                 BodyIndex bodyJ, const Vec3& pointJ, std::vector<int> axes);
-  int numEquations() const override { return static_cast<int>(axes_.size()); }
+  int numEquations() const override { return static_cast<int>(gaps_.size()); }
   void evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const override;
   std::vector<std::string> reactionNames() const override { return {"fx", "fy", "fz"}; }
   VecX reactions(const BodyStates& bodies, const VecX& lambda) const override;
 
  private:
-  std::vector<int> axes_;
+  std::vector<FrameEquation> gaps_;  ///< AxisGap of each chosen axis
 };
 
 }  // namespace flexmbd

@@ -17,10 +17,10 @@ ComponentKind pointInPlaneJointKind() {
   k.summary = "A point of the second body stays in a plane fixed in the first; it moves freely in the plane and "
               "the bodies turn freely.";
   k.keys = {
-      {"bodies", KeyType::BodyPair, "", "", "The body carrying the plane, then the body carrying the point."},
-      {"points", KeyType::PointPair, "m", "",
+      {"bodies", KeyType::BodyPair, "", "The body carrying the plane, then the body carrying the point."},
+      {"points", KeyType::PointPair, "m",
        "A point of the plane in the first body's axes, then the point in the second body's axes."},
-      {"normal", KeyType::Direction, "", "", "The plane's normal in the first body's axes."},
+      {"normal", KeyType::Direction, "", "The plane's normal in the first body's axes."},
   };
   k.build = [](System& sys, const ComponentArgs& a) {
     const auto [bi, bj] = a.bodyPair("bodies");

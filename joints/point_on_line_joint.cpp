@@ -1,7 +1,6 @@
 #include "joints/point_on_line_joint.hpp"
 
 #include "core/component_kind.hpp"
-#include "core/errors.hpp"
 #include "core/magnitude_checks.hpp"
 #include "joints/drivers.hpp"
 
@@ -12,10 +11,7 @@ namespace flexmbd {
 PointOnLineJoint::PointOnLineJoint(std::string name, BodyIndex bodyI, const Vec2& pointI, BodyIndex bodyJ,
                                    const Vec2& pointJ, const Vec2& direction)
     : TwoPointConstraint(std::move(name), bodyI, pointI, bodyJ, pointJ) {
-  const std::string who = "joint '" + this->name() + "'";
-  requireFinite(direction.x(), who + ": direction[0]");
-  requireFinite(direction.y(), who + ": direction[1]");
-  direction_ = unitDirection(direction, who + ": direction");
+  direction_ = unitDirection(direction, "joint '" + this->name() + "': direction");  // finite, not zero
 }
 
 void PointOnLineJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
@@ -68,10 +64,10 @@ ComponentKind pointOnLineJointKind() {
   k.summary = "A point of the second body stays on a line fixed in the first; it slides along the line and the "
               "bodies turn freely (a joint_displacement driver prescribes its position along the line).";
   k.keys = {
-      {"bodies", KeyType::BodyPair, "", "", "The body carrying the line, then the body carrying the point."},
-      {"points", KeyType::PointPair, "m", "",
+      {"bodies", KeyType::BodyPair, "", "The body carrying the line, then the body carrying the point."},
+      {"points", KeyType::PointPair, "m",
        "A point of the line in the first body's axes, then the point in the second body's axes."},
-      {"direction", KeyType::Direction, "", "", "The line's direction in the first body's axes."},
+      {"direction", KeyType::Direction, "", "The line's direction in the first body's axes."},
   };
   k.build = [](System& sys, const ComponentArgs& a) {
     const auto [bi, bj] = a.bodyPair("bodies");

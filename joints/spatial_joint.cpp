@@ -59,21 +59,7 @@ SpatialJoint::SpatialJoint(std::string name, SpatialJointType type, BodyIndex bo
 }
 
 void SpatialJoint::evaluate(const BodyStates& bodies, bool withHessians, ConstraintEvaluation& out) const {
-  FramePair pair(bodies, frameI_, frameJ_, withHessians, out.work);
-  const int m = numEquations(), n = pair.numVelocities(), nq = pair.numCoordinates();
-  out.h.resize(m);
-  out.G.resize(m, n);
-  if (withHessians) out.H.resize(m);
-  for (int e = 0; e < m; ++e) {
-    const Eq& eq = equations_[e];
-    MatX* H = withHessians ? &out.H[e] : nullptr;
-    if (H) H->setZero(n, nq);
-    switch (eq.kind) {
-      case Eq::Gap: pair.gap(eq.a, out.h[e], out.G.row(e), H); break;
-      case Eq::AxisGap: pair.axisGap(eq.a, out.h[e], out.G.row(e), H); break;
-      case Eq::AxisAxis: pair.axisAxis(eq.a, eq.b, out.h[e], out.G.row(e), H); break;
-    }
-  }
+  evaluateFrameEquations(bodies, frameI_, frameJ_, equations_, withHessians, out);
 }
 
 VecX SpatialJoint::reactions(const BodyStates& bodies, const VecX& lambda) const {

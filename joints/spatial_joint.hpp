@@ -24,10 +24,7 @@ const char* toString(SpatialJointType type);
 /// universal (Cardan) joint's cross joins frame i's x axis and frame j's y axis.
 class SpatialJoint final : public Constraint {
  public:
-  struct Equation {
-    enum Kind { Gap, AxisGap, AxisAxis } kind;
-    int a = 0, b = 0;
-  };
+  using Equation = FrameEquation;
   /// @throws InputError naming the joint if the bodies are the same or a frame's axes are
   /// not orthonormal and right-handed.
   SpatialJoint(std::string name, SpatialJointType type, BodyIndex bodyI, const JointFrame& frameI, BodyIndex bodyJ,

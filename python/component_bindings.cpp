@@ -21,8 +21,7 @@ std::string docstring(const ComponentKind& k) {
   std::string d = k.summary + "\n\nKeyword arguments (the keys of the scene's \"" + k.type +
                   "\" object, docs/scene-format.md):\n  name: the name, unique in the system\n";
   for (const KeySpec& s : k.keys) {
-    d += "  " + s.name + (s.unit.empty() ? "" : " [" + s.unit + "]") + ": " + s.description +
-         (s.fallback.empty() ? "" : " Default " + s.fallback + ".") + "\n";
+    d += "  " + s.name + (s.unit.empty() ? "" : " [" + s.unit + "]") + ": " + s.description + "\n";
   }
   return d + "Bodies are given by name (\"ground\" for the ground); points and directions have 2 "
              "coordinates in a planar model, 3 in a spatial one. Returns the index of the new element.";

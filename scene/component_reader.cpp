@@ -34,7 +34,7 @@ class SceneArgs final : public ComponentArgs {
     r.allowOnly(allowed, " for a " + kind.type + " " + singular(kind.section));
     name_ = r.name("name");
     for (const KeySpec& k : kind.keys) {
-      if (k.fallback.empty() && !r.has(k.name)) {
+      if (!r.has(k.name)) {
         r.fail("missing key " + jsonread::inQuotes(k.name) + " of a " + kind.type + " " + singular(kind.section) +
                " (" + k.description + ")");
       }
@@ -64,17 +64,6 @@ class SceneArgs final : public ComponentArgs {
     const Vec3 v = dimension_ == 2 ? Vec3(d[0], d[1], 0.0) : Vec3(d[0], d[1], d[2]);
     return v.normalized();
   }
-  double number(const std::string& key) const override {
-    const KeySpec& k = spec(key, KeyType::Number);
-    if (!r_.has(key)) return std::stod(k.fallback);
-    switch (k.range) {
-      case KeyRange::Positive: return r_.positive(key);
-      case KeyRange::NonNegative: return r_.nonNegative(key);
-      case KeyRange::Any: break;
-    }
-    return r_.number(key);
-  }
-  [[noreturn]] void fail(const std::string& message) const override { r_.fail(message); }
 
  private:
   /// The declaration of `key`; a kind's build that reads a key it did not declare, or
@@ -116,16 +105,6 @@ std::string typeText(KeyType t, KindDimensions d) {
     case KeyType::BodyPair: return "[name, name]";
     case KeyType::PointPair: return planarOrSpatial("[[x, y], [x, y]]", "[[x, y, z], [x, y, z]]");
     case KeyType::Direction: return planarOrSpatial("[x, y]", "[x, y, z]") + ", not zero";
-    case KeyType::Number: return "number";
-  }
-  return "";
-}
-
-const char* rangeText(KeyRange r) {
-  switch (r) {
-    case KeyRange::Any: return "";
-    case KeyRange::Positive: return ", > 0";
-    case KeyRange::NonNegative: return ", >= 0";
   }
   return "";
 }
@@ -181,8 +160,8 @@ std::string componentReference() {
     out += "| `name` | name | | required | The " + singular(k.section) + "'s name, unique in the scene. |\n";
     out += "| `type` | `\"" + k.type + "\"` | | required | |\n";
     for (const KeySpec& s : k.keys) {
-      out += "| `" + s.name + "` | " + typeText(s.type, k.dimensions) + rangeText(s.range) + " | " + s.unit + " | " +
-             (s.fallback.empty() ? "required" : s.fallback) + " | " + s.description + " |\n";
+      out += "| `" + s.name + "` | " + typeText(s.type, k.dimensions) + " | " + s.unit + " | required | " + s.description +
+             " |\n";
     }
     out += "\n";
   }

@@ -1,7 +1,7 @@
 /// @file
 /// Scene objects of the kinds declared through the registry (builders/component_kinds.hpp):
 /// their keys validated against the declaration (unknown, missing, of the wrong shape or
-/// out of range: an InputError naming the object and the key), then built; and the
+/// not a body of the model: an InputError naming the object and the key), then built; and the
 /// reference of their keys that docs/scene-format.md holds (generated, kept current by
 /// a test).
 #pragma once
@@ -39,7 +39,7 @@ void addComponent(System& sys, int dimension, const std::string& section, const 
                   const nlohmann::json& keys, const std::string& where);
 
 /// The Markdown reference of every declared kind: per kind a heading, its summary and a
-/// table of its keys (type, unit, default, range, description).
+/// table of its keys (type, unit, description).
 std::string componentReference();
 
 /// The markers around the generated reference in docs/scene-format.md.

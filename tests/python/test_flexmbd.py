@@ -23,8 +23,9 @@ def example(name):
     return os.path.join(SOURCE, "examples", name)
 
 
-def rigid_crank_in_python():
-    """examples/slider_crank_rigid.json built with the C++ API's objects and names."""
+def rigid_crank_in_python(slider_joint=None):
+    """examples/slider_crank_rigid.json built with the C++ API's objects and names;
+    slider_joint(system) adds the slider's joint in place of the prismatic one."""
     scene = flexmbd.Scene("rigid slider-crank, l1 = 1, l2 = 2 (source document 000)")
     sys = scene.system
     crank = sys.add_rigid_body("crank", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.1, com=(0.5, 0.0)),
@@ -36,7 +37,10 @@ def rigid_crank_in_python():
     sys.add_revolute_joint("O1", flexmbd.GROUND, (0, 0), crank, (0, 0))
     sys.add_revolute_joint("O2", crank, (1, 0), rod, (0, 0))
     sys.add_revolute_joint("O3", rod, (2, 0), slider, (0, 0))
-    sys.add_prismatic_joint("P", "ground", (0, 0), "slider", (0, 0), axis=(1, 0))
+    if slider_joint:
+        slider_joint(sys)
+    else:
+        sys.add_prismatic_joint("P", "ground", (0, 0), "slider", (0, 0), axis=(1, 0))
     sys.add_body_coordinate_driver("motor", crank, "theta", flexmbd.constant_speed_law(1.0))
     s = scene.solver
     s.formulation = "ggl"
@@ -75,25 +79,10 @@ def test_a_declared_joint_from_python_equals_the_scene_and_checks_its_keys():
             "points": [[0.0, 0.0], [0.0, 0.0]], "direction": [1.0, 0.0]}
     a = flexmbd.load_scene(example("slider_crank_rigid.json"),
                            overrides={"solver.output_step": math.pi / 30, "joints[3]": line}).run()
-    scene = flexmbd.Scene("rigid slider-crank, l1 = 1, l2 = 2 (source document 000)")
-    sys = scene.system
-    crank = sys.add_rigid_body("crank", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.1, com=(0.5, 0.0)),
-                               flexmbd.FrameState2d(position=(0.0, 0.0), angle=0.0))
-    rod = sys.add_rigid_body("rod", flexmbd.RigidBodyProperties(mass=1.0, inertia=0.4, com=(1.0, 0.0)),
-                             flexmbd.FrameState2d(position=(1.0, 0.0)))
-    slider = sys.add_rigid_body("slider", flexmbd.RigidBodyProperties(mass=0.5, inertia=0.01),
-                                flexmbd.FrameState2d(position=(3.0, 0.0)))
-    sys.add_revolute_joint("O1", flexmbd.GROUND, (0, 0), crank, (0, 0))
-    sys.add_revolute_joint("O2", crank, (1, 0), rod, (0, 0))
-    sys.add_revolute_joint("O3", rod, (2, 0), slider, (0, 0))
-    joint = sys.add_point_on_line_joint(**{k: v for k, v in line.items() if k != "type"})
-    assert isinstance(joint, flexmbd.ConstraintIndex) and joint.value == 3
-    sys.add_body_coordinate_driver("motor", crank, "theta", flexmbd.constant_speed_law(1.0))
-    s = scene.solver
-    s.formulation = "ggl"
-    s.rtol, s.atol = 1e-8, 1e-10
-    s.t_end, s.output_step = 2 * math.pi, math.pi / 30
-    b = scene.run()
+    added = []
+    b = rigid_crank_in_python(lambda sys: added.append(
+        sys.add_point_on_line_joint(**{k: v for k, v in line.items() if k != "type"}))).run()
+    assert isinstance(added[0], flexmbd.ConstraintIndex) and added[0].value == 3
     assert a.ok and b.ok, (a.message, b.message)
     assert a.columns == b.columns and np.array_equal(a.data, b.data)
     exact = np.cos(b.t) + np.sqrt(4.0 - np.sin(b.t) ** 2)
